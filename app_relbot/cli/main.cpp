@@ -1,0 +1,72 @@
+// The single `hiltwin` binary: parses the command line, runs the chosen subcommand and maps
+// every failure to the documented exit codes (DESIGN.md "Contracts").
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "hiltwin/app_relbot/commands.h"
+
+namespace hiltwin::app {
+
+std::vector<CommandEntry>& CommandRegistry() {
+  static std::vector<CommandEntry> registry;  // function-local: safe during static init
+  return registry;
+}
+
+bool RegisterCommand(int order, CommandFactory factory) {
+  CommandRegistry().push_back({order, factory});
+  return true;
+}
+
+}  // namespace hiltwin::app
+
+int main(int argc, char** argv) {
+  using hiltwin::app::ExitCode;
+  CLI::App app{
+      "hiltwin: a real-time Hardware-in-the-Loop runtime for digital twins.\n"
+      "Runs a plant model behind the plant's own electrical interface, checks every deadline\n"
+      "and tells you whether a run can be trusted.",
+      "hiltwin"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "hiltwin 0.1.0");
+  app.footer("Run 'hiltwin <command> --help' for the flags of one command.");
+
+  auto entries = hiltwin::app::CommandRegistry();
+  std::stable_sort(entries.begin(), entries.end(),
+                   [](const auto& a, const auto& b) { return a.order < b.order; });
+  std::vector<hiltwin::app::Command> commands;
+  for (const auto& entry : entries) commands.push_back(entry.factory(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hiltwin: %s\n", e.what());
+    std::fprintf(stderr, "hiltwin: run 'hiltwin --help' or 'hiltwin <command> --help' for usage\n");
+    return static_cast<int>(ExitCode::kUsage);
+  }
+
+  for (auto& command : commands) {
+    if (!command.app->parsed()) continue;
+    try {
+      return command.run();
+    } catch (const hiltwin::app::CommandError& e) {
+      std::fprintf(stderr, "hiltwin %s: %s\n", command.app->get_name().c_str(), e.what());
+      return static_cast<int>(e.code());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "hiltwin %s: internal error: %s\n", command.app->get_name().c_str(),
+                   e.what());
+      return static_cast<int>(ExitCode::kInternal);
+    }
+  }
+  return static_cast<int>(ExitCode::kUsage);
+}
