@@ -1,0 +1,42 @@
+#pragma once
+/// Streaming statistics of one timing quantity (e.g. wake-up latency): exact count, min,
+/// mean and max, percentiles from a log-linear histogram. Constant memory, O(1) per value.
+
+#include <cstdint>
+
+#include "hiltwin/scheduler/log_linear_histogram.h"
+
+namespace hiltwin::scheduler {
+
+/// Summary figures in nanoseconds, as they go into the run report.
+struct TimingSummary {
+  std::uint64_t count = 0;
+  std::int64_t min_ns = 0;
+  double mean_ns = 0.0;
+  std::int64_t p50_ns = 0;
+  std::int64_t p99_ns = 0;
+  std::int64_t p999_ns = 0;
+  std::int64_t max_ns = 0;
+};
+
+class TimingStats {
+ public:
+  /// Records a value. Signed quantities (period jitter) keep their signed min/max; the
+  /// percentiles are of the magnitude |value|.
+  void Record(std::int64_t value_ns) noexcept;
+  void Reset() noexcept;
+  [[nodiscard]] TimingSummary Summary() const noexcept;
+  [[nodiscard]] std::uint64_t count() const noexcept { return count_; }
+  [[nodiscard]] std::int64_t max_ns() const noexcept { return max_ns_; }
+  [[nodiscard]] const LogLinearHistogram& histogram() const noexcept { return histogram_; }
+
+ private:
+  LogLinearHistogram histogram_;
+  std::uint64_t count_ = 0;
+  std::int64_t min_ns_ = 0;
+  std::int64_t max_ns_ = 0;
+  // Sum in long double-free integer form: 2^63 ns of total time cannot overflow in practice.
+  std::int64_t sum_ns_ = 0;
+};
+
+}  // namespace hiltwin::scheduler

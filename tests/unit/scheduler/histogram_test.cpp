@@ -1,0 +1,86 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "hiltwin/scheduler/log_linear_histogram.h"
+#include "hiltwin/scheduler/timing_stats.h"
+
+namespace hiltwin::scheduler {
+namespace {
+
+std::int64_t NearestRank(std::vector<std::int64_t> sorted, double q) {
+  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
+}
+
+TEST(LogLinearHistogram, BucketsTileTheRangeWithoutGaps) {
+  for (std::size_t i = 0; i + 1 < LogLinearHistogram::BucketCount(); ++i) {
+    ASSERT_EQ(LogLinearHistogram::BucketHigh(i), LogLinearHistogram::BucketLow(i + 1)) << i;
+  }
+  for (std::int64_t v : {0LL, 1LL, 255LL, 256LL, 257LL, 511LL, 512LL, 123456789LL, (1LL << 40) - 1}) {
+    const std::size_t i = LogLinearHistogram::BucketIndex(v);
+    EXPECT_LE(LogLinearHistogram::BucketLow(i), v) << v;
+    EXPECT_GT(LogLinearHistogram::BucketHigh(i), v) << v;
+    // Width relative to value: the 1 % accuracy promise.
+    EXPECT_LE(static_cast<double>(LogLinearHistogram::BucketHigh(i) - LogLinearHistogram::BucketLow(i)),
+              std::max(1.0, static_cast<double>(v) / 128.0)) << v;
+  }
+}
+
+TEST(LogLinearHistogram, SmallValuesAreExact) {
+  LogLinearHistogram h;
+  for (std::int64_t v = 1; v <= 100; ++v) h.Record(v);
+  EXPECT_EQ(h.ValueAtQuantile(0.5), 50);
+  EXPECT_EQ(h.ValueAtQuantile(0.99), 99);
+  EXPECT_EQ(h.ValueAtQuantile(1.0), 100);
+  EXPECT_EQ(h.ValueAtQuantile(0.0), 1);
+}
+
+TEST(LogLinearHistogram, PercentilesWithinOnePercentOfExactSortedData) {
+  std::mt19937_64 rng(42);
+  // Heavy-tailed like real latencies: mostly ~15 µs, a tail to milliseconds.
+  std::lognormal_distribution<double> dist(std::log(15'000.0), 0.6);
+  std::vector<std::int64_t> values;
+  LogLinearHistogram h;
+  for (int i = 0; i < 200'000; ++i) {
+    const auto v = static_cast<std::int64_t>(dist(rng));
+    values.push_back(v);
+    h.Record(v);
+  }
+  std::sort(values.begin(), values.end());
+  for (double q : {0.01, 0.5, 0.9, 0.99, 0.999, 0.9999}) {
+    const double exact = static_cast<double>(NearestRank(values, q));
+    const double got = static_cast<double>(h.ValueAtQuantile(q));
+    EXPECT_NEAR(got, exact, 0.01 * exact) << "q=" << q;
+  }
+  EXPECT_EQ(h.ValueAtQuantile(1.0), values.back());
+  EXPECT_EQ(h.ValueAtQuantile(0.0), values.front());
+}
+
+TEST(LogLinearHistogram, HugeAndNegativeValuesAreClampedNotLost) {
+  LogLinearHistogram h;
+  h.Record(-5);
+  h.Record(std::int64_t{1} << 50);
+  EXPECT_EQ(h.count(), 2U);
+  EXPECT_EQ(h.ValueAtQuantile(0.0), 0);
+  EXPECT_EQ(h.ValueAtQuantile(1.0), std::int64_t{1} << 50);  // exact max survives
+}
+
+TEST(TimingStats, ExactMinMeanMaxAndSignedJitter) {
+  TimingStats s;
+  for (std::int64_t v : {-300, 100, 200, 1000}) s.Record(v);
+  const TimingSummary sum = s.Summary();
+  EXPECT_EQ(sum.count, 4U);
+  EXPECT_EQ(sum.min_ns, -300);
+  EXPECT_EQ(sum.max_ns, 1000);
+  EXPECT_DOUBLE_EQ(sum.mean_ns, 250.0);
+  EXPECT_EQ(sum.p50_ns, 200);  // percentiles of |value|: {100,200,300,1000}
+  s.Reset();
+  EXPECT_EQ(s.Summary().count, 0U);
+}
+
+}  // namespace
+}  // namespace hiltwin::scheduler
