@@ -1,0 +1,116 @@
+// Records a real LTTng trace of the hiltwin provider: session daemon, session, emitter
+// process, babeltrace2. Label `integration`. Uses a running session daemon if one answers,
+// otherwise starts one (and stops only that one).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kEvents = 500;
+
+class TraceSessionTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    home_ = fs::temp_directory_path() / ("hiltwin_lttng_" + std::to_string(::getpid()));
+    fs::remove_all(home_);
+    fs::create_directories(home_);
+    log_ = (home_ / "commands.log").string();
+  }
+
+  void TearDown() override {
+    Run("lttng destroy " + Session());
+    if (started_daemon_) {
+      // The daemon writes its pid under its run directory: /var/run/lttng for root,
+      // $LTTNG_HOME/.lttng otherwise.
+      for (const fs::path& pid_file : {fs::path("/var/run/lttng/lttng-sessiond.pid"),
+                                       home_ / ".lttng" / "lttng-sessiond.pid"}) {
+        std::ifstream in(pid_file);
+        pid_t pid = 0;
+        if (in >> pid && pid > 0) {
+          ::kill(pid, SIGTERM);
+          // Wait for it to go, so a following run does not find a daemon that is dying.
+          for (int i = 0; i < 100 && ::kill(pid, 0) == 0; ++i) ::usleep(50'000);
+          break;
+        }
+      }
+    }
+    fs::remove_all(home_);
+  }
+
+  // Runs a shell command with LTTNG_HOME pointing into the test directory, output appended
+  // to the command log; returns the exit status.
+  int Run(const std::string& command) const {
+    const std::string line =
+        "LTTNG_HOME='" + home_.string() + "' " + command + " >>'" + log_ + "' 2>&1";
+    const int status = std::system(line.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  [[nodiscard]] std::string Session() const { return "hiltwin_test_" + std::to_string(::getpid()); }
+
+  [[nodiscard]] std::string CommandLog() const {
+    std::ifstream in(log_);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+  fs::path home_;
+  std::string log_;
+  bool started_daemon_ = false;
+};
+
+TEST_F(TraceSessionTest, RecordsCycleAndQosEventsWithTheirFields) {
+  if (Run("lttng list") != 0) {
+    if (Run("lttng-sessiond --daemonize --no-kernel") != 0) {
+      GTEST_SKIP() << "cannot start lttng-sessiond here; log:\n" << CommandLog();
+    }
+    started_daemon_ = true;
+  }
+  const std::string trace_dir = (home_ / "trace").string();
+  ASSERT_EQ(Run("lttng create " + Session() + " --output='" + trace_dir + "'"), 0) << CommandLog();
+  ASSERT_EQ(Run("lttng enable-event --userspace --session=" + Session() + " 'hiltwin:*'"), 0)
+      << CommandLog();
+  ASSERT_EQ(Run("lttng start " + Session()), 0) << CommandLog();
+  ASSERT_EQ(Run("'" HILTWIN_TRACE_EMITTER "' " + std::to_string(kEvents)), 0) << CommandLog();
+  ASSERT_EQ(Run("lttng stop " + Session()), 0) << CommandLog();
+  const std::string text_path = (home_ / "trace.txt").string();
+  ASSERT_EQ(std::system(
+                ("babeltrace2 '" + trace_dir + "' >'" + text_path + "' 2>>'" + log_ + "'").c_str()),
+            0)
+      << CommandLog();
+
+  std::ifstream text(text_path);
+  int cycles = 0;
+  int qos = 0;
+  bool saw_cycle_42 = false;
+  bool saw_qos_42 = false;
+  // babeltrace2's text form: "... hiltwin:cycle: { cpu_id = 0 }, { k = 42, ... }".
+  const std::string cycle_42 =
+      "{ k = 42, release_ns = 42000, wake_ns = 42010, start_ns = 42020, end_ns = 42030, "
+      "skipped = 1, missed = 0 }";
+  const std::string qos_42 = "{ k = 42, distance_to_failure = 458, verdict = 0 }";
+  for (std::string line; std::getline(text, line);) {
+    if (line.find("hiltwin:cycle:") != std::string::npos) {
+      ++cycles;
+      saw_cycle_42 = saw_cycle_42 || line.find(cycle_42) != std::string::npos;
+    }
+    if (line.find("hiltwin:qos:") != std::string::npos) {
+      ++qos;
+      saw_qos_42 = saw_qos_42 || line.find(qos_42) != std::string::npos;
+    }
+  }
+  EXPECT_EQ(cycles, kEvents) << CommandLog();
+  EXPECT_EQ(qos, kEvents);
+  EXPECT_TRUE(saw_cycle_42);
+  EXPECT_TRUE(saw_qos_42);
+}
+
+}  // namespace

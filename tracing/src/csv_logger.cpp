@@ -1,0 +1,344 @@
+#include "hiltwin/tracing/csv_logger.h"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <set>
+#include <stdexcept>
+#include <system_error>
+#include <utility>
+
+namespace hiltwin::tracing {
+namespace {
+
+// Large enough that the writer makes one write() per few hundred rows, small enough to stay
+// out of the way of the loop's locked memory budget.
+constexpr std::size_t kFileBufferBytes = std::size_t{256} * 1024;
+// Keeps the preallocated queue below ~8 GiB even at the widest row; a larger request is a
+// typo, not a plan.
+constexpr std::size_t kMaxQueueCapacityRows = std::size_t{1} << 24;
+// MATLAB's namelengthmax: longer names would be truncated by readtable.
+constexpr std::size_t kMaxColumnNameChars = 63;
+
+std::string ErrnoText(int err) {
+  // strerror is not thread-safe in theory; this runs on set-up and error paths only, and the
+  // GNU strerror_r form returns a pointer that may or may not be the buffer.
+  char buffer[256];
+  const char* text = strerror_r(err, buffer, sizeof buffer);
+  return text;
+}
+
+bool IsPlainIdentifier(const std::string& name) {
+  if (name.empty()) return false;
+  const auto is_alpha = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); };
+  const auto is_digit = [](char c) { return c >= '0' && c <= '9'; };
+  if (!is_alpha(name.front())) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [&](char c) { return is_alpha(c) || is_digit(c) || c == '_'; });
+}
+
+CsvLoggerConfig Validate(CsvLoggerConfig config) {
+  const std::string where = "CsvLogger('" + config.path + "'): ";
+  if (config.path.empty()) {
+    throw std::invalid_argument("CsvLogger: empty log path; pass a file name such as run.csv");
+  }
+  if (config.columns.size() > kMaxLogColumns) {
+    throw std::invalid_argument(where + std::to_string(config.columns.size()) +
+                                " columns requested, at most " + std::to_string(kMaxLogColumns) +
+                                " supported; log fewer signals");
+  }
+  std::set<std::string> seen{"time_s"};
+  for (std::size_t i = 0; i < config.columns.size(); ++i) {
+    const std::string& name = config.columns[i];
+    if (!IsPlainIdentifier(name) || name.size() > kMaxColumnNameChars) {
+      throw std::invalid_argument(
+          where + "column " + std::to_string(i + 1) + " name '" + name +
+          "' is not a plain identifier ([A-Za-z][A-Za-z0-9_]*, at most 63 characters) that "
+          "MATLAB and 20-sim read without quoting; rename it, e.g. wheel_left_m");
+    }
+    if (!seen.insert(name).second) {
+      throw std::invalid_argument(where + "column " + std::to_string(i + 1) + " name '" + name +
+                                  "' is used twice (time_s is reserved); make names unique");
+    }
+  }
+  const std::size_t capacity = config.queue_capacity_rows;
+  if (capacity == 0 || (capacity & (capacity - 1)) != 0 || capacity > kMaxQueueCapacityRows) {
+    throw std::invalid_argument(where + "queue_capacity_rows " + std::to_string(capacity) +
+                                " must be a power of two between 1 and " +
+                                std::to_string(kMaxQueueCapacityRows) + ", e.g. 65536");
+  }
+  if (config.decimation == 0) {
+    throw std::invalid_argument(where + "decimation 0; use 1 to log every cycle, N for every Nth");
+  }
+  if (config.writer_poll_period_ns <= 0) {
+    throw std::invalid_argument(where + "writer_poll_period_ns must be positive, e.g. 2000000");
+  }
+  if (config.file_flush_period_ns < 0) {
+    throw std::invalid_argument(where + "file_flush_period_ns must be >= 0 (0 = every drain)");
+  }
+  for (const int cpu : config.writer_cpus) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE) {
+      throw std::invalid_argument(where + "writer CPU " + std::to_string(cpu) +
+                                  " out of range; list CPUs from 0 to " +
+                                  std::to_string(CPU_SETSIZE - 1));
+    }
+  }
+  return config;
+}
+
+std::int64_t SteadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Shortest text that parses back to the same double; NaN/Inf spelled the way MATLAB writes
+// them (strtod reads them too).
+char* FormatDouble(char* first, char* last, double value) noexcept {
+  if (std::isnan(value)) return std::copy_n("NaN", 3, first);
+  if (std::isinf(value)) {
+    if (value < 0) *first++ = '-';
+    return std::copy_n("Inf", 3, first);
+  }
+  return std::to_chars(first, last, value).ptr;
+}
+
+}  // namespace
+
+CsvLogger::CsvLogger(CsvLoggerConfig config)
+    : config_(Validate(std::move(config))),
+      row_stride_(1 + config_.columns.size()),
+      ring_(config_.queue_capacity_rows),
+      // Value-initialised, so every page is touched now rather than in the loop.
+      rows_(std::make_unique<double[]>(config_.queue_capacity_rows * row_stride_)),
+      file_buffer_(std::make_unique<char[]>(kFileBufferBytes)) {
+  file_ = std::fopen(config_.path.c_str(), "we");
+  if (file_ == nullptr) {
+    const int err = errno;
+    throw std::runtime_error("CsvLogger: cannot open '" + config_.path + "' for writing: " +
+                             ErrnoText(err) + "; check that the directory exists and is writable");
+  }
+  std::setvbuf(file_, file_buffer_.get(), _IOFBF, kFileBufferBytes);
+  std::string header = "time_s";
+  for (const std::string& name : config_.columns) header.append(",").append(name);
+  header += "\n";
+  if (std::fwrite(header.data(), 1, header.size(), file_) != header.size() ||
+      std::fflush(file_) != 0) {
+    const int err = errno;
+    std::fclose(file_);
+    file_ = nullptr;
+    throw std::runtime_error("CsvLogger: cannot write the header of '" + config_.path +
+                             "': " + ErrnoText(err));
+  }
+  last_flush_ns_ = SteadyNowNs();
+}
+
+CsvLogger::~CsvLogger() {
+  try {
+    Stop();
+  } catch (...) {
+    // A destructor must not throw; Stop only throws if joining the thread fails.
+  }
+}
+
+void CsvLogger::Start() {
+  std::unique_lock lock(mutex_);
+  if (started_) throw std::logic_error("CsvLogger::Start called twice for '" + config_.path + "'");
+  if (stopped_) throw std::logic_error("CsvLogger::Start after Stop for '" + config_.path + "'");
+  std::string start_error;
+  writer_ready_ = false;
+  writer_ = std::thread([this] { WriterMain(); });
+  writer_done_.wait(lock, [this] { return writer_ready_; });
+  if (!error_.empty()) {
+    // The writer could not be configured and has returned; stay unstarted so Stop drains
+    // inline.
+    start_error = error_;
+    error_.clear();
+    lock.unlock();
+    writer_.join();
+    throw std::runtime_error("CsvLogger: writer thread for '" + config_.path + "': " + start_error);
+  }
+  started_ = true;
+}
+
+bool CsvLogger::TryLog(double time_s, std::span<const double> values) noexcept {
+  offered_.store(offered_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  if (decimation_countdown_ != 0) {
+    --decimation_countdown_;
+    return true;
+  }
+  decimation_countdown_ = config_.decimation - 1;
+  std::size_t slot = 0;
+  if (!accepting_.load(std::memory_order_relaxed) || values.size() + 1 != row_stride_ ||
+      !ring_.TryClaim(slot)) {
+    producer_dropped_.store(producer_dropped_.load(std::memory_order_relaxed) + 1,
+                            std::memory_order_relaxed);
+    return false;
+  }
+  double* row = rows_.get() + slot * row_stride_;
+  row[0] = time_s;
+  std::copy(values.begin(), values.end(), row + 1);
+  ring_.Publish();
+  return true;
+}
+
+void CsvLogger::Flush() {
+  std::unique_lock lock(mutex_);
+  if (stopped_) return;
+  if (started_) {
+    const std::uint64_t target = ++flush_requested_;
+    wake_writer_.notify_all();
+    writer_done_.wait(lock, [&] { return flush_completed_ >= target; });
+    return;
+  }
+  lock.unlock();
+  DrainAvailable();
+  FlushFile();
+}
+
+void CsvLogger::Stop() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopped_) return;
+    stopped_ = true;
+    stop_requested_ = true;
+  }
+  accepting_.store(false, std::memory_order_relaxed);
+  if (writer_.joinable()) {
+    wake_writer_.notify_all();
+    writer_.join();
+  }
+  // The writer drained after seeing the stop request; this catches a writer that never ran.
+  DrainAvailable();
+  if (file_ != nullptr) {
+    FlushFile();
+    if (std::fclose(file_) != 0) RecordIoError("close", errno);
+    file_ = nullptr;
+  }
+}
+
+void CsvLogger::WriterMain() {
+  ConfigureWriterThread();
+  std::unique_lock lock(mutex_);
+  writer_ready_ = true;
+  const bool configured = error_.empty();
+  writer_done_.notify_all();
+  if (!configured) return;
+  const auto poll_period = std::chrono::nanoseconds(config_.writer_poll_period_ns);
+  for (;;) {
+    const bool stop = stop_requested_;
+    const std::uint64_t flush_target = flush_requested_;
+    lock.unlock();
+    DrainAvailable();
+    const std::int64_t now_ns = SteadyNowNs();
+    if (stop || flush_target != flush_completed_ ||
+        now_ns - last_flush_ns_ >= config_.file_flush_period_ns) {
+      FlushFile();
+      last_flush_ns_ = now_ns;
+    }
+    lock.lock();
+    flush_completed_ = flush_target;
+    writer_done_.notify_all();
+    if (stop) return;
+    // The producer never signals (no syscall per row); control requests cut the sleep short.
+    wake_writer_.wait_for(lock, poll_period,
+                          [&] { return stop_requested_ || flush_requested_ != flush_target; });
+  }
+}
+
+void CsvLogger::ConfigureWriterThread() {
+  // Threads inherit the creator's policy: if Start runs on a SCHED_FIFO loop thread the
+  // writer would compete with it, so demote explicitly.
+  std::string problem;
+  sched_param param{};
+  param.sched_priority = 0;
+  if (const int rc = pthread_setschedparam(pthread_self(), SCHED_OTHER, &param); rc != 0) {
+    problem = "pthread_setschedparam(SCHED_OTHER) failed: " + ErrnoText(rc);
+  }
+  if (problem.empty() && !config_.writer_cpus.empty()) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (const int cpu : config_.writer_cpus) CPU_SET(static_cast<std::size_t>(cpu), &set);
+    if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof set, &set); rc != 0) {
+      problem =
+          "pthread_setaffinity_np failed: " + ErrnoText(rc) + "; list CPUs this process may use";
+    }
+  }
+  pthread_setname_np(pthread_self(), "hiltwin-log");
+  int policy = -1;
+  sched_param actual{};
+  if (pthread_getschedparam(pthread_self(), &policy, &actual) == 0) {
+    writer_policy_.store(policy, std::memory_order_relaxed);
+  }
+  if (!problem.empty()) {
+    std::lock_guard lock(mutex_);
+    error_ = problem;
+  }
+}
+
+void CsvLogger::DrainAvailable() {
+  std::size_t available = ring_.Available();
+  while (available != 0) {
+    for (; available != 0; --available) {
+      const double* row = rows_.get() + ring_.ReadSlot(0) * row_stride_;
+      char* const first = line_.data();
+      char* const last = first + line_.size();
+      char* out = FormatDouble(first, last, row[0]);
+      for (std::size_t c = 1; c < row_stride_; ++c) {
+        *out++ = ',';
+        out = FormatDouble(out, last, row[c]);
+      }
+      *out++ = '\n';
+      // Release per row: frees space for the producer as early as possible (a plain store).
+      ring_.Release(1);
+      const auto length = static_cast<std::size_t>(out - first);
+      if (file_ != nullptr && std::fwrite(first, 1, length, file_) == length) {
+        written_.store(written_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      } else {
+        if (file_ != nullptr) RecordIoError("write", errno);
+        write_failed_.store(write_failed_.load(std::memory_order_relaxed) + 1,
+                            std::memory_order_relaxed);
+      }
+    }
+    available = ring_.Available();
+  }
+}
+
+void CsvLogger::FlushFile() {
+  if (file_ != nullptr && std::fflush(file_) != 0) RecordIoError("flush", errno);
+}
+
+void CsvLogger::RecordIoError(const char* what, int err) {
+  std::lock_guard lock(mutex_);
+  if (error_.empty()) error_ = std::string(what) + " '" + config_.path + "': " + ErrnoText(err);
+}
+
+std::uint64_t CsvLogger::rows_written() const noexcept {
+  return written_.load(std::memory_order_relaxed);
+}
+
+std::uint64_t CsvLogger::rows_dropped() const noexcept {
+  return producer_dropped_.load(std::memory_order_relaxed) +
+         write_failed_.load(std::memory_order_relaxed);
+}
+
+std::uint64_t CsvLogger::rows_offered() const noexcept {
+  return offered_.load(std::memory_order_relaxed);
+}
+
+std::string CsvLogger::error() const {
+  std::lock_guard lock(mutex_);
+  return error_;
+}
+
+int CsvLogger::writer_sched_policy() const noexcept {
+  return writer_policy_.load(std::memory_order_relaxed);
+}
+
+}  // namespace hiltwin::tracing
