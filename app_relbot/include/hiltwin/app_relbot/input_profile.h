@@ -1,0 +1,77 @@
+#pragma once
+/// Duty-cycle input profiles for the RELbot twin: the built-in `openloop` profile (after thesis
+/// fig. 5.1) and user CSV files `time,left,right`. A profile is a continuous-time signal:
+/// knots joined by straight lines, a repeated time marks a sudden step, and the whole profile
+/// repeats with its period. Sampling and holding the signal (as a PWM does) is the job of
+/// whoever plays it (the ECS side at its own rate), not of the profile.
+
+#include <filesystem>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hiltwin::app {
+
+/// Duty cycle of both drivetrains, each a fraction of the supply voltage in [-1, 1].
+struct Duty {
+  double left = 0.0;   ///< left wheel, + drives forward
+  double right = 0.0;  ///< right wheel, + drives forward
+};
+
+/// One corner of a piecewise-linear profile.
+struct ProfileKnot {
+  double time_s = 0.0;  ///< time since the start of one repetition
+  Duty duty;            ///< duty at time_s (right-continuous at steps)
+};
+
+/// A bad profile (file or knots); the message says file:line:column, what and what to do.
+class ProfileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A piecewise-linear, periodic duty profile. Evaluation is allocation-free and noexcept.
+class InputProfile {
+ public:
+  /// Validates and takes the knots: at least two, times finite, >= 0, non-decreasing, at most
+  /// two knots per time (a step), last time > 0, duties finite and within [-1, 1].
+  /// Throws ProfileError naming `name` and the offending knot index.
+  static InputProfile FromKnots(std::string name, std::vector<ProfileKnot> knots);
+
+  /// Duty at t_s. The profile repeats with period_s(); before the first knot of a repetition
+  /// the first knot's duty holds; at a step the later value applies. Non-finite t_s gives 0.
+  [[nodiscard]] Duty At(double t_s) const noexcept;
+  /// Length of one repetition: the last knot's time.
+  [[nodiscard]] double period_s() const noexcept { return knots_.back().time_s; }
+  /// Built-in name or the file the profile came from (for messages and reports).
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// The knots, in time order.
+  [[nodiscard]] std::span<const ProfileKnot> knots() const noexcept { return knots_; }
+
+ private:
+  InputProfile(std::string name, std::vector<ProfileKnot> knots)
+      : name_(std::move(name)), knots_(std::move(knots)) {}
+  std::string name_;
+  std::vector<ProfileKnot> knots_;
+};
+
+/// The names LoadInputProfile accepts besides CSV paths.
+[[nodiscard]] std::span<const std::string_view> BuiltinProfileNames() noexcept;
+
+/// The 36 s open-loop test profile: sudden steps and gradual ramps on both wheels, straight
+/// driving, turning in place, arcs and reversals, starting and ending at rest.
+[[nodiscard]] InputProfile OpenLoopProfile();
+
+/// Parses CSV text (header `time,left,right`, then one row per knot). `source_name` is used in
+/// messages ("file:line:column: ..."). Throws ProfileError.
+[[nodiscard]] InputProfile ParseCsvProfile(std::string_view text, std::string_view source_name);
+
+/// Reads and parses a CSV profile file. Throws ProfileError (also when it cannot be read).
+[[nodiscard]] InputProfile LoadCsvProfile(const std::filesystem::path& path);
+
+/// A built-in name (see BuiltinProfileNames) or a path to a CSV file. Throws ProfileError.
+[[nodiscard]] InputProfile LoadInputProfile(std::string_view name_or_path);
+
+}  // namespace hiltwin::app

@@ -1,0 +1,93 @@
+#include "hiltwin/app_relbot/overrun_injection.h"
+
+#include <charconv>
+#include <stdexcept>
+
+namespace hiltwin::app {
+namespace {
+
+constexpr const char* kForms =
+    "accepted forms: 'at=K[,count=N],extra-us=US' or 'every=P[,offset=O],extra-us=US', "
+    "e.g. 'at=40000,count=5,extra-us=600' or 'every=1000,extra-us=300'";
+
+[[noreturn]] void Fail(std::string_view spec, const std::string& what) {
+  throw std::invalid_argument("--inject-overrun '" + std::string(spec) + "': " + what + "; " +
+                              kForms);
+}
+
+std::uint64_t ParseCount(std::string_view spec, std::string_view key, std::string_view text) {
+  std::uint64_t value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
+    Fail(spec, "'" + std::string(key) + "' needs a whole number ≥ 0, got '" + std::string(text) + "'");
+  }
+  return value;
+}
+
+}  // namespace
+
+OverrunInjection ParseOverrunInjection(std::string_view spec) {
+  OverrunInjection injection;
+  bool have_at = false, have_every = false, have_extra = false, have_count = false,
+       have_offset = false;
+  std::string_view rest = spec;
+  while (!rest.empty()) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string_view::npos) Fail(spec, "'" + std::string(item) + "' is not key=value");
+    const std::string_view key = item.substr(0, eq);
+    const std::string_view value = item.substr(eq + 1);
+    if (key == "at") {
+      injection.first_cycle = ParseCount(spec, key, value);
+      have_at = true;
+    } else if (key == "count") {
+      injection.count = ParseCount(spec, key, value);
+      have_count = true;
+    } else if (key == "every") {
+      injection.every = ParseCount(spec, key, value);
+      have_every = true;
+    } else if (key == "offset") {
+      injection.offset = ParseCount(spec, key, value);
+      have_offset = true;
+    } else if (key == "extra-us") {
+      const std::uint64_t extra_us = ParseCount(spec, key, value);
+      if (extra_us == 0 || extra_us > 10'000'000) Fail(spec, "extra-us must be 1 .. 10000000 µs");
+      injection.extra_ns = static_cast<kernel_glue::TimeNs>(extra_us) * kernel_glue::kNsPerUs;
+      have_extra = true;
+    } else {
+      Fail(spec, "unknown key '" + std::string(key) + "'");
+    }
+  }
+  if (have_at == have_every) Fail(spec, "give exactly one of 'at=' and 'every='");
+  if (!have_extra) Fail(spec, "'extra-us=' is required");
+  if (have_at && have_offset) Fail(spec, "'offset=' goes with 'every='");
+  if (have_every && have_count) Fail(spec, "'count=' goes with 'at='");
+  if (have_at && injection.count == 0) Fail(spec, "count must be at least 1");
+  if (have_every) {
+    if (injection.every == 0) Fail(spec, "every must be at least 1");
+    if (injection.offset >= injection.every) Fail(spec, "offset must be less than every");
+    injection.kind = OverrunInjection::Kind::kEvery;
+  }
+  return injection;
+}
+
+void OverrunInjector::Add(const OverrunInjection& injection) {
+  if (size_ == kMaxInjections) throw std::length_error("at most 8 --inject-overrun specs");
+  injections_[size_++] = injection;
+}
+
+kernel_glue::TimeNs OverrunInjector::ExtraNs(std::uint64_t cycle) const noexcept {
+  kernel_glue::TimeNs extra_ns = 0;
+  for (std::size_t i = 0; i < size_; ++i) {
+    const OverrunInjection& inj = injections_[i];
+    const bool hit = inj.kind == OverrunInjection::Kind::kAt
+                         ? cycle >= inj.first_cycle && cycle - inj.first_cycle < inj.count
+                         : cycle % inj.every == inj.offset;
+    if (hit) extra_ns += inj.extra_ns;
+  }
+  return extra_ns;
+}
+
+}  // namespace hiltwin::app

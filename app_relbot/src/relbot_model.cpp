@@ -1,0 +1,151 @@
+#include "hiltwin/app_relbot/relbot_model.h"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace hiltwin::app {
+
+double EquivalentWheelInertiaKgM2(const RelbotParams& p) noexcept {
+  // Thesis §6.3.1: rotor inertia, wheel inertia and wheel mass pulled through the gear and
+  // wheel transformers into one I-element, which gives the drivetrain preferred causality.
+  const double n = p.gear_ratio_motor_rev_per_wheel_rev;
+  return n * n * p.motor_rotor_inertia_kg_m2 + p.wheel_inertia_kg_m2 +
+         p.wheel_mass_kg * p.wheel_radius_m * p.wheel_radius_m;
+}
+
+RelbotCoefficients MakeRelbotCoefficients(const RelbotParams& p) noexcept {
+  const double n = p.gear_ratio_motor_rev_per_wheel_rev;
+  const double j_eq = EquivalentWheelInertiaKgM2(p);
+  RelbotCoefficients c;
+  c.supply_voltage_v = p.supply_voltage_v;
+  c.drive_per_volt = n * p.motor_torque_constant_n_m_per_a / (p.motor_resistance_ohm * j_eq);
+  c.drive_damping_per_s = n * n *
+                          (p.motor_torque_constant_n_m_per_a *
+                               p.motor_back_emf_constant_v_s_per_rad / p.motor_resistance_ohm +
+                           p.motor_viscous_friction_n_m_s_per_rad) /
+                          j_eq;
+  c.force_to_wheel_accel = p.wheel_radius_m / j_eq;
+  c.wheel_radius_m = p.wheel_radius_m;
+  c.half_track_m = 0.5 * p.track_width_m;
+  c.stiffness_n_per_m = p.contact_stiffness_n_per_m;
+  c.damping_n_s_per_m = p.contact_damping_n_s_per_m;
+  c.lateral_damping_n_s_per_m = p.contact_lateral_damping_n_s_per_m;
+  c.inv_body_mass_per_kg = 1.0 / p.body_mass_kg;
+  c.inv_yaw_inertia_per_kg_m2 = 1.0 / p.body_yaw_inertia_kg_m2;
+  c.castor_offset_m = p.castor_offset_m;
+  c.castor_viscous_n_s_per_m = p.castor_viscous_friction_n_s_per_m;
+  c.castor_coulomb_n = p.castor_coulomb_friction_n;
+  c.castor_smoothing_sq_m2_per_s2 =
+      p.castor_smoothing_speed_m_per_s * p.castor_smoothing_speed_m_per_s;
+  return c;
+}
+
+double SaturateDuty(double duty) noexcept {
+  if (std::isnan(duty)) return 0.0;  // a corrupt input switches the motor off, never drives it
+  return duty > 1.0 ? 1.0 : (duty < -1.0 ? -1.0 : duty);
+}
+
+void RelbotDerivative(const RelbotCoefficients& c, const RelbotState& x, double duty_left,
+                      double duty_right, RelbotState& dxdt) noexcept {
+  namespace s = relbot_state;
+  const double wheel_speed_l = x[s::kWheelSpeedLeftRadPerS];
+  const double wheel_speed_r = x[s::kWheelSpeedRightRadPerS];
+  const double vx = x[s::kBodyVelocityXMPerS];
+  const double vy = x[s::kBodyVelocityYMPerS];
+  const double yaw_rate = x[s::kYawRateRadPerS];
+
+  // Wheel-to-body spring-damper in X (thesis §6.3.2/§6.3.3): the wheel centre against the body
+  // point above it; the left wheel sits at body Y = +track/2, the right at -track/2.
+  const double wheel_v_l = c.wheel_radius_m * wheel_speed_l;
+  const double wheel_v_r = c.wheel_radius_m * wheel_speed_r;
+  const double deflection_rate_l = wheel_v_l - (vx - c.half_track_m * yaw_rate);
+  const double deflection_rate_r = wheel_v_r - (vx + c.half_track_m * yaw_rate);
+  const double force_l = c.stiffness_n_per_m * x[s::kSpringDeflectionLeftM] +
+                         c.damping_n_s_per_m * deflection_rate_l;
+  const double force_r = c.stiffness_n_per_m * x[s::kSpringDeflectionRightM] +
+                         c.damping_n_s_per_m * deflection_rate_r;
+
+  // Drivetrain: motor without inductance, so current follows voltage and back-EMF at once.
+  const double volts_l = duty_left * c.supply_voltage_v;
+  const double volts_r = duty_right * c.supply_voltage_v;
+  const double wheel_accel_l = c.drive_per_volt * volts_l - c.drive_damping_per_s * wheel_speed_l -
+                               c.force_to_wheel_accel * force_l;
+  const double wheel_accel_r = c.drive_per_volt * volts_r - c.drive_damping_per_s * wheel_speed_r -
+                               c.force_to_wheel_accel * force_r;
+
+  // Castor at body (-offset, 0), swivelling so its friction opposes its velocity: viscous plus
+  // Coulomb rolling resistance, the Coulomb part smoothed near standstill so the equations
+  // stay continuous (no sign() the fixed-step integrators would chatter on).
+  const double castor_vx = vx;
+  const double castor_vy = vy - c.castor_offset_m * yaw_rate;
+  const double castor_gain =
+      c.castor_viscous_n_s_per_m +
+      c.castor_coulomb_n / std::sqrt(castor_vx * castor_vx + castor_vy * castor_vy +
+                                     c.castor_smoothing_sq_m2_per_s2);
+  const double castor_fx = -castor_gain * castor_vx;
+  const double castor_fy = -castor_gain * castor_vy;
+  const double lateral_f = -c.lateral_damping_n_s_per_m * vy;
+
+  // Rigid body split into X, Y and yaw parts (thesis §6.3.3), written in the body frame, hence
+  // the rotating-frame terms yaw_rate*vy and -yaw_rate*vx.
+  const double body_ax = (force_l + force_r + castor_fx) * c.inv_body_mass_per_kg + yaw_rate * vy;
+  const double body_ay = (lateral_f + castor_fy) * c.inv_body_mass_per_kg - yaw_rate * vx;
+  const double yaw_accel = (c.half_track_m * (force_r - force_l) -
+                            c.castor_offset_m * castor_fy) *
+                           c.inv_yaw_inertia_per_kg_m2;
+
+  const double heading = x[s::kHeadingRad];
+  const double cos_h = std::cos(heading);
+  const double sin_h = std::sin(heading);
+
+  dxdt[s::kWheelSpeedLeftRadPerS] = wheel_accel_l;
+  dxdt[s::kWheelSpeedRightRadPerS] = wheel_accel_r;
+  dxdt[s::kWheelPositionLeftM] = wheel_v_l;
+  dxdt[s::kWheelPositionRightM] = wheel_v_r;
+  dxdt[s::kSpringDeflectionLeftM] = deflection_rate_l;
+  dxdt[s::kSpringDeflectionRightM] = deflection_rate_r;
+  dxdt[s::kBodyVelocityXMPerS] = body_ax;
+  dxdt[s::kBodyVelocityYMPerS] = body_ay;
+  dxdt[s::kYawRateRadPerS] = yaw_accel;
+  dxdt[s::kWorldXM] = vx * cos_h - vy * sin_h;
+  dxdt[s::kWorldYM] = vx * sin_h + vy * cos_h;
+  dxdt[s::kHeadingRad] = yaw_rate;
+}
+
+RelbotOutputs OutputsOf(const RelbotState& x) noexcept {
+  namespace s = relbot_state;
+  return RelbotOutputs{x[s::kWheelPositionLeftM], x[s::kWheelPositionRightM], x[s::kWorldXM],
+                       x[s::kWorldYM], x[s::kHeadingRad]};
+}
+
+RelbotModel::RelbotModel(const RelbotParams& params, Integrator integrator, double step_s)
+    : params_(params), integrator_(integrator), step_s_(step_s) {
+  ValidateRelbotParams(params_, "RELbot parameters");
+  if (!std::isfinite(step_s) || !(step_s > 0.0) || step_s > 0.1) {
+    std::ostringstream message;
+    message << "RELbot model step " << step_s
+            << " s is out of range: it must be > 0 and <= 0.1 s; choose an update rate of at "
+               "least 10 Hz (the thesis runs the RELbot twin at 4 kHz)";
+    throw ConfigError(message.str());
+  }
+  coefficients_ = MakeRelbotCoefficients(params_);
+}
+
+void RelbotModel::Reset() noexcept {
+  state_.setZero();
+  steps_ = 0;
+}
+
+void RelbotModel::Step(double duty_left, double duty_right) noexcept {
+  const double left = SaturateDuty(duty_left);
+  const double right = SaturateDuty(duty_right);
+  const RelbotCoefficients& c = coefficients_;
+  const auto f = [&c, left, right](const State& x, State& dxdt) noexcept {
+    RelbotDerivative(c, x, left, right, dxdt);
+  };
+  IntegrateStep(integrator_, f, state_, step_s_);
+  ++steps_;
+}
+
+}  // namespace hiltwin::app

@@ -1,0 +1,221 @@
+#include "hiltwin/app_relbot/input_profile.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <unistd.h>
+
+#include "fakes/alloc_counter.h"
+
+namespace hiltwin::app {
+namespace {
+
+std::string ErrorOf(const std::string& csv) {
+  try {
+    (void)ParseCsvProfile(csv, "p.csv");
+  } catch (const ProfileError& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(OpenLoopProfile, LastsAbout36SecondsAndStaysWithinDutyRange) {
+  const InputProfile profile = OpenLoopProfile();
+  EXPECT_EQ(profile.name(), "openloop");
+  EXPECT_DOUBLE_EQ(profile.period_s(), 36.0);
+  double max_abs = 0.0;
+  for (double t = 0.0; t < profile.period_s(); t += 1e-3) {
+    const Duty d = profile.At(t);
+    max_abs = std::max({max_abs, std::abs(d.left), std::abs(d.right)});
+  }
+  EXPECT_LE(max_abs, 1.0);
+  EXPECT_EQ(max_abs, 1.0);  // it uses the full range
+}
+
+TEST(OpenLoopProfile, HasSuddenStepsAndGradualRampsOnBothWheels) {
+  const InputProfile profile = OpenLoopProfile();
+  const auto knots = profile.knots();
+  int steps = 0;
+  int ramps = 0;
+  int turns = 0;
+  for (std::size_t i = 1; i < knots.size(); ++i) {
+    const bool changes = knots[i].duty.left != knots[i - 1].duty.left ||
+                         knots[i].duty.right != knots[i - 1].duty.right;
+    if (changes && knots[i].time_s == knots[i - 1].time_s) ++steps;
+    if (changes && knots[i].time_s > knots[i - 1].time_s) ++ramps;
+    if (knots[i].duty.left != knots[i].duty.right) ++turns;
+  }
+  EXPECT_GE(steps, 5);
+  EXPECT_GE(ramps, 5);
+  EXPECT_GE(turns, 3);
+  EXPECT_EQ(knots.front().duty.left, 0.0);
+  EXPECT_EQ(knots.back().duty.right, 0.0);  // repeats without a jump
+}
+
+TEST(InputProfile, InterpolatesLinearlyBetweenKnots) {
+  const InputProfile profile = OpenLoopProfile();
+  // Ramp 3 s -> 6 s from 0.4 to 1.0 on both wheels.
+  EXPECT_NEAR(profile.At(4.5).left, 0.7, 1e-12);
+  EXPECT_NEAR(profile.At(3.75).right, 0.55, 1e-12);
+}
+
+TEST(InputProfile, StepsAreRightContinuous) {
+  const InputProfile profile = OpenLoopProfile();
+  EXPECT_EQ(profile.At(8.0).left, -0.5);
+  EXPECT_NEAR(profile.At(8.0 - 1e-9).left, 1.0, 1e-12);
+  EXPECT_EQ(profile.At(1.0).left, 0.4);
+  EXPECT_EQ(profile.At(0.999).left, 0.0);
+}
+
+TEST(InputProfile, RepeatsWithItsPeriod) {
+  const InputProfile profile = OpenLoopProfile();
+  for (double t = 0.0; t < 36.0; t += 0.137) {
+    for (int repeat : {1, 2, 17}) {
+      const Duty a = profile.At(t);
+      const Duty b = profile.At(t + 36.0 * repeat);
+      EXPECT_NEAR(a.left, b.left, 1e-9) << t << " + " << repeat << " periods";
+      EXPECT_NEAR(a.right, b.right, 1e-9);
+    }
+  }
+  // At a whole period the next repetition starts.
+  EXPECT_EQ(profile.At(36.0).left, 0.0);
+  EXPECT_NEAR(profile.At(36.0 + 4.5).left, 0.7, 1e-9);
+}
+
+TEST(InputProfile, OddTimesAreSafe) {
+  const InputProfile profile = OpenLoopProfile();
+  EXPECT_EQ(profile.At(std::numeric_limits<double>::quiet_NaN()).left, 0.0);
+  EXPECT_EQ(profile.At(std::numeric_limits<double>::infinity()).right, 0.0);
+  EXPECT_EQ(profile.At(-5.0).left, 0.0);
+  const InputProfile late = InputProfile::FromKnots(
+      "late", {{1.0, {0.5, -0.5}}, {2.0, {0.0, 0.0}}});
+  EXPECT_EQ(late.At(0.5).left, 0.5);  // before the first knot its duty holds
+}
+
+TEST(InputProfile, EvaluationAllocatesNothing) {
+  const InputProfile profile = OpenLoopProfile();
+  double sum = 0.0;
+  test::ScopedAllocationCount count;
+  for (int k = 0; k < 100000; ++k) sum += profile.At(k * 1e-3).left;
+  EXPECT_EQ(count.count(), 0U);
+  EXPECT_NE(sum, 0.0);
+}
+
+TEST(InputProfile, FromKnotsValidates) {
+  EXPECT_THROW((void)InputProfile::FromKnots("x", {{0.0, {0.0, 0.0}}}), ProfileError);
+  EXPECT_THROW((void)InputProfile::FromKnots("x", {{0.0, {0.0, 0.0}}, {0.0, {0.0, 0.0}}}),
+               ProfileError);
+  EXPECT_THROW((void)InputProfile::FromKnots("x", {{0.0, {1.5, 0.0}}, {1.0, {0.0, 0.0}}}),
+               ProfileError);
+  EXPECT_THROW((void)InputProfile::FromKnots("x", {{1.0, {0.0, 0.0}}, {0.5, {0.0, 0.0}}}),
+               ProfileError);
+  EXPECT_THROW(
+      (void)InputProfile::FromKnots(
+          "x", {{0.0, {0.0, 0.0}}, {1.0, {0.0, 0.0}}, {1.0, {0.5, 0.0}}, {1.0, {0.2, 0.0}}}),
+      ProfileError);
+  try {
+    (void)InputProfile::FromKnots(
+        "mine", {{0.0, {0.0, std::numeric_limits<double>::quiet_NaN()}}, {1.0, {0.0, 0.0}}});
+    FAIL();
+  } catch (const ProfileError& error) {
+    EXPECT_NE(std::string(error.what()).find("'mine', knot 0"), std::string::npos);
+  }
+}
+
+TEST(CsvProfile, ParsesWithCommentsBlankLinesCrLfAndSpaces) {
+  const InputProfile profile = ParseCsvProfile(
+      "# recorded on the bench\r\ntime_s, left, right\r\n\r\n0, 0, 0\r\n1.0,+0.5,-0.5\r\n"
+      "1.0,1,-1\n  2 ,1e-1, -1.0e-1 \n",
+      "p.csv");
+  EXPECT_EQ(profile.name(), "p.csv");
+  ASSERT_EQ(profile.knots().size(), 4U);
+  EXPECT_DOUBLE_EQ(profile.period_s(), 2.0);
+  EXPECT_NEAR(profile.At(0.5).left, 0.25, 1e-12);
+  EXPECT_EQ(profile.At(1.0).right, -1.0);
+  EXPECT_NEAR(profile.At(1.5).left, 0.55, 1e-12);
+}
+
+TEST(CsvProfile, AcceptsAUtf8ByteOrderMark) {
+  const InputProfile profile =
+      ParseCsvProfile("\xEF\xBB\xBFtime,left,right\n0,0.5,0.5\n1,0.5,0.5\n", "excel.csv");
+  EXPECT_EQ(profile.At(0.5).left, 0.5);
+}
+
+struct BadCsv {
+  const char* csv;
+  const char* where;  // "p.csv:line:column:"
+  const char* what;
+};
+
+TEST(CsvProfile, ErrorsGiveLineColumnWhatAndWhatToDo) {
+  const BadCsv cases[] = {
+      {"", "p.csv:1:1:", "empty"},
+      {"t,l,r\n0,0,0\n1,0,0\n", "p.csv:1:1:", "expected the header 'time,left,right'"},
+      {"time,left\n0,0\n1,0\n", "p.csv:1:10:", "expected the header"},
+      {"time,left,right,x\n", "p.csv:1:17:", "more than the three columns"},
+      {"time,left,right\n0,0,0\n1, abc,0\n", "p.csv:3:4:", "left duty 'abc' is not a number"},
+      {"time,left,right\n0,0,0\n1,0,\n", "p.csv:3:5:", "right duty '' is not a number"},
+      {"time,left,right\n0,nan,0\n1,0,0\n", "p.csv:2:3:", "not finite"},
+      {"time,left,right\n0,0,0\n1,0,inf\n", "p.csv:3:5:", "not finite"},
+      {"time,left,right\n0,0,0\n1,0,1.5\n", "p.csv:3:5:", "right duty 1.5 is outside [-1, 1]"},
+      {"time,left,right\n0,0,0\n2,0,0\n1,0,0\n", "p.csv:4:1:",
+       "earlier than the previous row's 2 s (line 3)"},
+      {"time,left,right\n0,0,0\n1,0,0\n1,0.5,0\n1,0.2,0\n", "p.csv:5:1:", "a third row"},
+      {"time,left,right\n0,0\n1,0,0\n", "p.csv:2:4:", "found 2"},
+      {"time,left,right\n0,0,0,0\n1,0,0\n", "p.csv:2:7:", "found 4"},
+      {"time,left,right\n-1,0,0\n1,0,0\n", "p.csv:2:1:", "negative"},
+      {"time,left,right\n0,0,0\n", "p.csv:", "at least two rows"},
+  };
+  for (const BadCsv& c : cases) {
+    const std::string message = ErrorOf(c.csv);
+    EXPECT_EQ(message.rfind(c.where, 0), 0U) << c.csv << " -> " << message;
+    EXPECT_NE(message.find(c.what), std::string::npos) << c.csv << " -> " << message;
+    EXPECT_NE(message.find("; "), std::string::npos) << "no advice in: " << message;
+  }
+}
+
+TEST(LoadInputProfile, BuiltInNameFileOrAClearError) {
+  EXPECT_EQ(LoadInputProfile("openloop").name(), "openloop");
+  ASSERT_EQ(BuiltinProfileNames().size(), 1U);
+  EXPECT_EQ(BuiltinProfileNames()[0], "openloop");
+
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("hiltwin_profile_test_" + std::to_string(::getpid()) + ".csv");
+  {
+    std::ofstream out(path);
+    out << "time,left,right\n0,0.1,0.2\n3,0.3,0.4\n";
+  }
+  const InputProfile from_file = LoadInputProfile(path.string());
+  EXPECT_EQ(from_file.name(), path.string());
+  EXPECT_DOUBLE_EQ(from_file.period_s(), 3.0);
+  {
+    std::ofstream out(path);
+    out << "time,left,right\n0,0.1,0.2\n3,0.3,x\n";
+  }
+  try {
+    (void)LoadInputProfile(path.string());
+    FAIL();
+  } catch (const ProfileError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind(path.string() + ":3:7:", 0), 0U) << error.what();
+  }
+  std::filesystem::remove(path);
+
+  try {
+    (void)LoadInputProfile("openlop");
+    FAIL();
+  } catch (const ProfileError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("'openlop'"), std::string::npos);
+    EXPECT_NE(message.find("openloop"), std::string::npos);
+  }
+  EXPECT_THROW((void)LoadCsvProfile("/nonexistent/p.csv"), ProfileError);
+}
+
+}  // namespace
+}  // namespace hiltwin::app
