@@ -1,0 +1,96 @@
+#pragma once
+/// `hiltwin assess` without the command line: align two curves, score them in the time,
+/// performance and frequency domains (thesis §2.4, appendix C), estimate their delay, add
+/// the cross-checks, and report as text or JSON.
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hiltwin/analysis/credibility.h"
+#include "hiltwin/analysis/cross_checks.h"
+#include "hiltwin/analysis/csv.h"
+#include "hiltwin/analysis/delay.h"
+#include "hiltwin/analysis/spectral.h"
+
+namespace hiltwin::analysis {
+
+/// One curve taken from a CSV column, with where it came from for messages.
+struct Curve {
+  std::string path;
+  std::string label;                ///< e.g. "run.csv column 3 'y_e'"
+  std::size_t column = 0;           ///< 0-based
+  std::vector<double> t_s;
+  std::vector<double> y;
+  std::vector<std::size_t> lines;   ///< 1-based file line of each sample
+};
+
+/// Copies column `column` (0-based, not time) of `table`.
+[[nodiscard]] Curve ExtractCurve(const CsvTable& table, std::size_t column);
+
+/// Everything the user can choose (defaults: the thesis's choices, §3.9 and §5.6).
+struct AssessOptions {
+  CredibilityParams params;
+  std::array<double, 3> weights{1.0, 0.0, 0.0};  ///< time, performance, frequency
+  std::optional<std::pair<double, double>> segment;  ///< performance domain [t0, t1] s
+  std::optional<double> setpoint;       ///< for the steady-state error
+  std::optional<double> max_delay_s;    ///< delay search range (default 10 % of the overlap)
+  bool total_uses_compensated = false;  ///< put the delay-compensated time score in the total
+  std::size_t welch_segment = 0;        ///< 0: DefaultWelchSegment
+  double coherence_min = 0.8;
+  std::optional<std::pair<double, double>> band_hz;  ///< frequency domain band [lo, hi] Hz
+  std::size_t iso_max_samples = 2000;   ///< ISO/TS 18571 runs on at most this many points
+};
+
+/// The result of Assess, in the order it is printed.
+struct Assessment {
+  std::string sim_label;
+  std::string exp_label;
+  std::string input_label;  ///< empty without an input column
+  bool same_time_base = false;
+  double overlap_t0_s = 0.0;
+  double overlap_t1_s = 0.0;
+  std::size_t samples = 0;  ///< experiment samples in the overlap
+  double grid_step_s = 0.0;
+  bool uniform_time_base = false;
+  AssessOptions options;
+
+  TimeDomainScore time;
+  DelayEstimate delay;
+  TimeDomainScore time_compensated;
+  std::optional<PerformanceScore> performance;
+  std::string performance_note;  ///< why performance is null
+  std::optional<FrequencyScore> frequency;
+  std::string frequency_note;    ///< why frequency is null
+  TheilCoefficients theil;
+  IsoRating iso;
+  double total = 0.0;
+  bool pass = false;
+  std::vector<std::string> notes;
+
+  /// Aligned series on the experiment's time base over the overlap (for --plot).
+  std::vector<double> t_s;
+  std::vector<double> y_sim;
+  std::vector<double> y_exp;
+  std::vector<double> y_sim_compensated;  ///< NaN where the shifted simulation has no data
+};
+
+/// Runs the whole assessment. `input` (may be null) enables the frequency domain. Throws
+/// InputError for bad options or data (no overlap, constant experiment, a domain with
+/// weight > 0 that cannot be computed, ...), naming file, line, column or flag.
+[[nodiscard]] Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
+                                const AssessOptions& options);
+
+/// JSON report: time_domain {e_t, eps_t, k_e, eta}, delay_s, time_domain_compensated,
+/// performance_domain, frequency_domain (null when not computed), cross_checks, total, pass.
+[[nodiscard]] nlohmann::json ToJson(const Assessment& assessment);
+
+/// The text table printed by `hiltwin assess`.
+[[nodiscard]] std::string FormatText(const Assessment& assessment);
+
+}  // namespace hiltwin::analysis

@@ -1,0 +1,466 @@
+#include "hiltwin/analysis/assessment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+#include <span>
+#include <stdexcept>
+#include <tuple>
+
+#include "hiltwin/analysis/series.h"
+
+namespace hiltwin::analysis {
+namespace {
+
+[[gnu::format(printf, 1, 2)]] std::string Format(const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  va_list copy;
+  va_copy(copy, args);
+  const int size = std::vsnprintf(nullptr, 0, format, copy);
+  va_end(copy);
+  std::string out(static_cast<std::size_t>(std::max(size, 0)) + 1, '\0');
+  std::vsnprintf(out.data(), out.size(), format, args);
+  va_end(args);
+  out.resize(static_cast<std::size_t>(std::max(size, 0)));
+  return out;
+}
+
+std::string Num(double v) { return Format("%.6g", v); }
+
+void CheckOptions(const AssessOptions& o) {
+  const auto& p = o.params;
+  if (!(std::isfinite(p.kp) && p.kp > 0.0 && p.kp < 1.0)) {
+    throw InputError("--kp " + Num(p.kp) +
+                     ": the confidence interval must lie between 0 and 1 (thesis: 0.05)");
+  }
+  if (!(p.eta_pass > 0.0 && p.eta_pass < 1.0)) {
+    throw InputError("--eta-pass " + Num(p.eta_pass) +
+                     ": the passing score must lie strictly between 0 and 1 (thesis: 0.6)");
+  }
+  double sum = 0.0;
+  for (const double w : o.weights) {
+    if (!(std::isfinite(w) && w >= 0.0)) {
+      throw InputError("--weights: every weight must be a number >= 0 (thesis: 1,0,0)");
+    }
+    sum += w;
+  }
+  if (!(sum > 0.0)) throw InputError("--weights: at least one weight must be > 0 (thesis: 1,0,0)");
+  if (o.segment && !(o.segment->second > o.segment->first)) {
+    throw InputError("--segment " + Num(o.segment->first) + ":" + Num(o.segment->second) +
+                     ": the end must come after the start (seconds, e.g. --segment 2:5)");
+  }
+  if (o.max_delay_s && !(*o.max_delay_s >= 0.0)) {
+    throw InputError("--max-delay: give a search range in seconds >= 0");
+  }
+  if (o.band_hz && !(o.band_hz->first >= 0.0 && o.band_hz->second > o.band_hz->first)) {
+    throw InputError("--band: give LO:HI in Hz with 0 <= LO < HI, e.g. --band 0:20");
+  }
+  if (!(o.coherence_min >= 0.0 && o.coherence_min < 1.0)) {
+    throw InputError("--coherence: give a threshold in [0, 1) (default 0.8)");
+  }
+}
+
+// Indices [first, last) of the samples of `t` inside [lo, hi] (with a rounding allowance).
+std::pair<std::size_t, std::size_t> Inside(const std::vector<double>& t, double lo, double hi) {
+  const double slack = 1e-9 * std::max({std::abs(lo), std::abs(hi), 1.0});
+  const auto first = std::lower_bound(t.begin(), t.end(), lo - slack) - t.begin();
+  const auto last = std::upper_bound(t.begin(), t.end(), hi + slack) - t.begin();
+  return {static_cast<std::size_t>(first), static_cast<std::size_t>(std::max(first, last))};
+}
+
+std::string Range(const Curve& c) {
+  return "[" + Num(c.t_s.front()) + ", " + Num(c.t_s.back()) + "] s";
+}
+
+nlohmann::json Opt(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json TimeJson(const TimeDomainScore& s) {
+  return {{"e_t", s.e_t}, {"eps_t", s.eps_t}, {"k_e", s.k_e}, {"eta", s.eta}, {"samples", s.samples}};
+}
+
+nlohmann::json DomainJson(const DomainScore& s) {
+  return {{"e", s.e}, {"eps", s.eps}, {"k_e", s.k_e}, {"eta", s.eta}};
+}
+
+std::string OptText(const std::optional<double>& v) { return v ? Format("%.6g", *v) : "-"; }
+
+}  // namespace
+
+Curve ExtractCurve(const CsvTable& table, std::size_t column) {
+  if (column == 0 || column >= table.columns.size()) {
+    throw std::invalid_argument("ExtractCurve: column out of range or time");
+  }
+  Curve c;
+  c.path = table.path;
+  c.column = column;
+  c.label = table.path + " " + table.ColumnLabel(column);
+  c.t_s = table.columns[0];
+  c.y = table.columns[column];
+  c.lines = table.lines;
+  return c;
+}
+
+Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
+                  const AssessOptions& options) {
+  CheckOptions(options);
+  Assessment a;
+  a.options = options;
+  a.sim_label = sim.label;
+  a.exp_label = exp.label;
+  if (input != nullptr) a.input_label = input->label;
+  a.same_time_base = sim.t_s == exp.t_s;
+
+  // Overlap, on the experiment's time base (the thesis compares at the logged samples).
+  const double lo = std::max(sim.t_s.front(), exp.t_s.front());
+  const double hi = std::min(sim.t_s.back(), exp.t_s.back());
+  const auto [first, last] = Inside(exp.t_s, lo, hi);
+  if (!(lo < hi) || last - first < 2) {
+    throw InputError("no overlap in time: " + sim.label + " covers " + Range(sim) + ", " +
+                     exp.label + " covers " + Range(exp) +
+                     (lo < hi ? " (fewer than two experiment samples in the common range)" : "") +
+                     "; both files need a common time range in seconds (check the time "
+                     "column and any start offset)");
+  }
+  a.overlap_t0_s = exp.t_s[first];
+  a.overlap_t1_s = exp.t_s[last - 1];
+  a.samples = last - first;
+  a.t_s.assign(exp.t_s.begin() + static_cast<std::ptrdiff_t>(first),
+               exp.t_s.begin() + static_cast<std::ptrdiff_t>(last));
+  a.y_exp.assign(exp.y.begin() + static_cast<std::ptrdiff_t>(first),
+                 exp.y.begin() + static_cast<std::ptrdiff_t>(last));
+  a.y_sim = a.same_time_base
+                ? std::vector<double>(sim.y.begin() + static_cast<std::ptrdiff_t>(first),
+                                      sim.y.begin() + static_cast<std::ptrdiff_t>(last))
+                : InterpolateAt(sim.t_s, sim.y, a.t_s);
+  if (!a.same_time_base) {
+    a.notes.push_back("simulation resampled by linear interpolation onto the experiment's " +
+                      std::to_string(a.samples) + " samples in the overlap [" +
+                      Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) + "] s");
+  }
+
+  const auto [lo_it, hi_it] = std::minmax_element(a.y_exp.begin(), a.y_exp.end());
+  if (!(*hi_it > *lo_it)) {
+    throw InputError(exp.path + ":" + std::to_string(exp.lines[first]) + "-" +
+                     std::to_string(exp.lines[last - 1]) + ":" + std::to_string(exp.column + 1) +
+                     ": the experiment curve (" + exp.label + ") is constant (" + Num(*lo_it) +
+                     ") over the compared range, so the error threshold eps_t = Kp*(max - min) "
+                     "is 0 and no score exists; pick the column that moves (--exp)");
+  }
+  a.time = ScoreTimeDomain(a.y_sim, a.y_exp, options.params);
+
+  // One uniform grid for the delay, the spectra and ISO 18571.
+  a.grid_step_s = MedianStep(a.t_s);
+  a.uniform_time_base = IsUniform(a.t_s);
+  std::vector<double> grid;
+  std::vector<double> grid_sim;
+  std::vector<double> grid_exp;
+  if (a.uniform_time_base) {
+    grid = a.t_s;
+    grid_sim = a.y_sim;
+    grid_exp = a.y_exp;
+  } else {
+    grid = UniformGrid(a.overlap_t0_s, a.overlap_t1_s, a.grid_step_s);
+    grid_sim = InterpolateAt(sim.t_s, sim.y, grid);
+    grid_exp = InterpolateAt(exp.t_s, exp.y, grid);
+    a.notes.push_back("time base not uniform: delay, spectra and ISO 18571 use a uniform grid of " +
+                      Num(a.grid_step_s) + " s (the median step)");
+  }
+
+  // Delay and the delay-compensated time-domain score.
+  const double duration_s = a.overlap_t1_s - a.overlap_t0_s;
+  const double max_delay_s = options.max_delay_s.value_or(0.1 * duration_s);
+  if (grid.size() >= 4) {
+    a.delay = EstimateDelay(grid_sim, grid_exp, a.grid_step_s, max_delay_s);
+  }
+  if (a.delay.at_search_limit) {
+    a.notes.push_back("the delay estimate sits at the edge of the search range (+-" +
+                      Num(max_delay_s) + " s); widen it with --max-delay");
+  }
+  {
+    std::vector<double> queries;
+    std::vector<double> y_exp_used;
+    a.y_sim_compensated.assign(a.samples, std::numeric_limits<double>::quiet_NaN());
+    const double s_lo = sim.t_s.front();
+    const double s_hi = sim.t_s.back();
+    std::size_t first_used = exp.t_s.size();
+    for (std::size_t i = 0; i < exp.t_s.size(); ++i) {
+      const double q = exp.t_s[i] - a.delay.delay_s;
+      if (q < s_lo || q > s_hi) continue;
+      if (first_used == exp.t_s.size()) first_used = i;
+      queries.push_back(q);
+      y_exp_used.push_back(exp.y[i]);
+    }
+    if (queries.size() < 2) {
+      a.time_compensated = a.time;
+    } else {
+      const std::vector<double> shifted = InterpolateAt(sim.t_s, sim.y, queries);
+      const auto [clo, chi] = std::minmax_element(y_exp_used.begin(), y_exp_used.end());
+      a.time_compensated = *chi > *clo ? ScoreTimeDomain(shifted, y_exp_used, options.params) : a.time;
+      for (std::size_t k = 0; k < shifted.size(); ++k) {
+        const std::size_t i = first_used + k;  // the used samples are contiguous
+        if (i >= first && i < last) a.y_sim_compensated[i - first] = shifted[k];
+      }
+    }
+  }
+
+  // Performance domain.
+  {
+    std::size_t p_first = 0;
+    std::size_t p_last = a.samples;
+    if (options.segment) {
+      std::tie(p_first, p_last) = Inside(a.t_s, options.segment->first, options.segment->second);
+      if (p_last - p_first < 3) {
+        throw InputError("--segment " + Num(options.segment->first) + ":" +
+                         Num(options.segment->second) + ": holds " +
+                         std::to_string(p_last - p_first) +
+                         " samples of the compared range [" + Num(a.overlap_t0_s) + ", " +
+                         Num(a.overlap_t1_s) + "] s; need at least 3 (start it at the step)");
+      }
+    }
+    const auto count = p_last - p_first;
+    const std::span<const double> t_seg(a.t_s.data() + p_first, count);
+    const std::span<const double> sim_seg(a.y_sim.data() + p_first, count);
+    const std::span<const double> exp_seg(a.y_exp.data() + p_first, count);
+    if (count >= 3) {
+      a.performance = ScorePerformance(t_seg, sim_seg, exp_seg, options.setpoint, options.params);
+    }
+    if (count < 3) {
+      a.performance_note = "fewer than 3 samples to compare";
+    } else if (!a.performance) {
+      a.performance_note = "the experiment shows no step in [" + Num(t_seg.front()) + ", " +
+                           Num(t_seg.back()) + "] s (final value equals initial value); " +
+                           "choose the step with --segment t0:t1";
+    }
+  }
+
+  // Frequency domain (needs the input the two systems were given).
+  if (input == nullptr) {
+    a.frequency_note = "no input column given (--input COL)";
+  } else {
+    const double f_lo = std::max(grid.front(), input->t_s.front());
+    const double f_hi = std::min(grid.back(), input->t_s.back());
+    const auto [g_first, g_last] = Inside(grid, f_lo, f_hi);
+    if (!(f_lo < f_hi) || g_last - g_first < 16) {
+      throw InputError("--input: " + input->label + " covers " + Range(*input) +
+                       ", which leaves fewer than 16 samples of the compared range [" +
+                       Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) +
+                       "] s; give the input that drove both runs");
+    }
+    const std::span<const double> g(grid.data() + g_first, g_last - g_first);
+    const std::vector<double> u = InterpolateAt(input->t_s, input->y, g);
+    const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
+    if (!(*uhi > *ulo)) {
+      throw InputError(input->path + ":" + std::to_string(input->lines.front()) + "-" +
+                       std::to_string(input->lines.back()) + ":" +
+                       std::to_string(input->column + 1) + ": the input curve (" +
+                       input->label + ") is constant, so it excites no frequency; give the "
+                       "column that drove both systems (--input)");
+    }
+    const std::size_t segment =
+        options.welch_segment > 0 ? options.welch_segment : DefaultWelchSegment(g.size());
+    if (segment < 8 || segment > g.size()) {
+      throw InputError("--welch-segment " + std::to_string(segment) + ": must lie in [8, " +
+                       std::to_string(g.size()) + "] (the samples available)");
+    }
+    const std::span<const double> gs(grid_sim.data() + g_first, g.size());
+    const std::span<const double> ge(grid_exp.data() + g_first, g.size());
+    a.frequency = ScoreFrequency(
+        u, gs, ge, a.grid_step_s, segment, options.coherence_min, options.params,
+        a.frequency_note, options.band_hz ? options.band_hz->first : 0.0,
+        options.band_hz ? options.band_hz->second : std::numeric_limits<double>::infinity());
+  }
+
+  // Cross-checks.
+  a.theil = TheilInequality(a.y_sim, a.y_exp);
+  if (grid.size() >= 20) {
+    if (grid.size() > options.iso_max_samples && options.iso_max_samples >= 20) {
+      const double step = (grid.back() - grid.front()) / static_cast<double>(options.iso_max_samples - 1);
+      std::vector<double> coarse(options.iso_max_samples);
+      for (std::size_t i = 0; i < coarse.size(); ++i) coarse[i] = grid.front() + static_cast<double>(i) * step;
+      coarse.back() = grid.back();
+      a.iso = Iso18571Rating(InterpolateAt(grid, grid_exp, coarse), InterpolateAt(grid, grid_sim, coarse));
+    } else {
+      a.iso = Iso18571Rating(grid_exp, grid_sim);
+    }
+  }
+
+  // Total: the weighted mean of the domains that carry weight.
+  const auto& w = options.weights;
+  if (w[1] > 0.0 && !a.performance) {
+    throw InputError("--weights gives the performance domain weight " + Num(w[1]) +
+                     " but it cannot be computed: " + a.performance_note);
+  }
+  if (w[2] > 0.0 && !a.frequency) {
+    throw InputError("--weights gives the frequency domain weight " + Num(w[2]) +
+                     " but it cannot be computed: " + a.frequency_note);
+  }
+  const double eta_time = options.total_uses_compensated ? a.time_compensated.eta : a.time.eta;
+  double sum = w[0] * eta_time;
+  double weight = w[0];
+  if (w[1] > 0.0) {
+    sum += w[1] * a.performance->eta;
+    weight += w[1];
+  }
+  if (w[2] > 0.0) {
+    sum += w[2] * a.frequency->eta;
+    weight += w[2];
+  }
+  a.total = sum / weight;
+  a.pass = a.total >= options.params.eta_pass;
+  return a;
+}
+
+nlohmann::json ToJson(const Assessment& a) {
+  nlohmann::json j;
+  j["inputs"] = {{"sim", a.sim_label},
+                 {"exp", a.exp_label},
+                 {"input", a.input_label.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.input_label)},
+                 {"same_time_base", a.same_time_base},
+                 {"overlap_s", {a.overlap_t0_s, a.overlap_t1_s}},
+                 {"samples", a.samples},
+                 {"step_s", a.grid_step_s},
+                 {"uniform_time_base", a.uniform_time_base}};
+  j["parameters"] = {{"kp", a.options.params.kp},
+                     {"eta_pass", a.options.params.eta_pass},
+                     {"weights", {{"time", a.options.weights[0]},
+                                  {"performance", a.options.weights[1]},
+                                  {"frequency", a.options.weights[2]}}},
+                     {"total_uses_compensated", a.options.total_uses_compensated}};
+  j["time_domain"] = TimeJson(a.time);
+  j["delay_s"] = a.delay.delay_s;
+  j["delay"] = {{"delay_s", a.delay.delay_s},
+                {"samples", a.delay.delay_samples},
+                {"search_range_samples", a.delay.max_lag_samples},
+                {"at_search_limit", a.delay.at_search_limit}};
+  j["time_domain_compensated"] = TimeJson(a.time_compensated);
+  if (a.performance) {
+    const PerformanceScore& p = *a.performance;
+    nlohmann::json metrics = nlohmann::json::object();
+    for (const MetricScore& m : p.metrics) {
+      metrics[m.name] = {{"sim", Opt(m.sim)},
+                         {"exp", Opt(m.exp)},
+                         {"scored", m.scored},
+                         {"error", m.scored && m.sim && m.exp ? nlohmann::json(m.error) : nlohmann::json(nullptr)},
+                         {"threshold", m.scored && m.sim && m.exp ? nlohmann::json(m.threshold) : nlohmann::json(nullptr)},
+                         {"eta", m.scored ? nlohmann::json(m.eta) : nlohmann::json(nullptr)}};
+    }
+    j["performance_domain"] = {{"segment_s", {p.t0_s, p.t1_s}},
+                               {"samples", p.samples},
+                               {"setpoint", p.setpoint},
+                               {"setpoint_given", p.setpoint_given},
+                               {"metrics", metrics},
+                               {"eta", p.eta}};
+  } else {
+    j["performance_domain"] = nullptr;
+  }
+  if (a.frequency) {
+    const FrequencyScore& f = *a.frequency;
+    j["frequency_domain"] = {{"welch_segment_samples", f.segment_samples},
+                             {"welch_segments", f.segments},
+                             {"coherence_min", f.coherence_min},
+                             {"bins_used", f.bins_used},
+                             {"bins_total", f.bins_total},
+                             {"band_hz", {f.f_min_hz, f.f_max_hz}},
+                             {"magnitude_db", DomainJson(f.magnitude)},
+                             {"phase_deg", DomainJson(f.phase)},
+                             {"eta", f.eta}};
+  } else {
+    j["frequency_domain"] = nullptr;
+  }
+  nlohmann::json why = nlohmann::json::object();
+  if (!a.performance) why["performance_domain"] = a.performance_note;
+  if (!a.frequency) why["frequency_domain"] = a.frequency_note;
+  j["not_computed"] = why;
+  j["cross_checks"] = {
+      {"theil", {{"u", a.theil.u}, {"bias", a.theil.bias}, {"variance", a.theil.variance},
+                 {"covariance", a.theil.covariance}}},
+      {"iso18571", {{"corridor", a.iso.corridor}, {"phase", a.iso.phase},
+                    {"magnitude", a.iso.magnitude}, {"slope", a.iso.slope},
+                    {"overall", a.iso.overall}, {"grade", a.iso.grade},
+                    {"phase_shift_samples", a.iso.phase_shift_samples},
+                    {"samples", a.iso.samples}}}};
+  j["notes"] = a.notes;
+  j["total"] = a.total;
+  j["pass"] = a.pass;
+  j["verdict"] = a.pass ? "PASS" : "FAIL";
+  return j;
+}
+
+std::string FormatText(const Assessment& a) {
+  std::string out;
+  out += "hiltwin assess: credibility of the simulation against the experiment (thesis 2.4)\n";
+  out += "  simulation  y_s: " + a.sim_label + "\n";
+  out += "  experiment  y_e: " + a.exp_label + "\n";
+  if (!a.input_label.empty()) out += "  input       u  : " + a.input_label + "\n";
+  out += Format("  compared over %.6g .. %.6g s, %zu samples%s (step %.6g s)\n", a.overlap_t0_s,
+                a.overlap_t1_s, a.samples, a.same_time_base ? ", one time base" : "", a.grid_step_s);
+  out += Format("  Kp = %.6g, eta_pass = %.6g, weights time,perf,freq = %.6g,%.6g,%.6g\n\n",
+                a.options.params.kp, a.options.params.eta_pass, a.options.weights[0],
+                a.options.weights[1], a.options.weights[2]);
+
+  out += "Time domain (appendix C)                          raw            delay-compensated\n";
+  out += Format("  e_t   = RMS(y_e - y_s)                      %-14.6g %-14.6g\n", a.time.e_t,
+                a.time_compensated.e_t);
+  out += Format("  eps_t = Kp * (max y_e - min y_e)            %-14.6g %-14.6g\n", a.time.eps_t,
+                a.time_compensated.eps_t);
+  out += Format("  K_e   = eta_pass / sqrt(1 - eta_pass^2)     %-14.6g %-14.6g\n", a.time.k_e,
+                a.time_compensated.k_e);
+  out += Format("  eta   = K_e*eps_t / sqrt((K_e*eps_t)^2 + e_t^2)\n"
+                "                                              %-8.6f %5.1f %%  %-8.6f %5.1f %%\n",
+                a.time.eta, 100.0 * a.time.eta, a.time_compensated.eta,
+                100.0 * a.time_compensated.eta);
+  out += Format("  delay d = %.6g s (%.3f samples), y_e(t) ~ y_s(t - d); search +-%zu samples\n\n",
+                a.delay.delay_s, a.delay.delay_samples, a.delay.max_lag_samples);
+
+  if (a.performance) {
+    const PerformanceScore& p = *a.performance;
+    out += Format("Performance domain (step response over %.6g .. %.6g s, setpoint %.6g%s)\n",
+                  p.t0_s, p.t1_s, p.setpoint, p.setpoint_given ? "" : " = experiment's final value");
+    out += "  metric                    sim            exp            |error|        threshold      eta\n";
+    for (const MetricScore& m : p.metrics) {
+      const bool both = m.sim && m.exp;
+      out += Format("  %-24s  %-14s %-14s %-14s %-14s %s\n", m.label.c_str(), OptText(m.sim).c_str(),
+                    OptText(m.exp).c_str(), both ? Num(m.error).c_str() : "-",
+                    both ? Num(m.threshold).c_str() : "-",
+                    m.scored ? Format("%.4f", m.eta).c_str() : "not scored");
+    }
+    out += Format("  domain score (mean)                                                                %.4f\n\n",
+                  p.eta);
+  } else {
+    out += "Performance domain: not computed: " + a.performance_note + "\n\n";
+  }
+
+  if (a.frequency) {
+    const FrequencyScore& f = *a.frequency;
+    out += Format("Frequency domain (Welch, %zu-sample Hann segments x %zu, coherence > %.2g: %zu of %zu bins, %.4g .. %.4g Hz)\n",
+                  f.segment_samples, f.segments, f.coherence_min, f.bins_used, f.bins_total,
+                  f.f_min_hz, f.f_max_hz);
+    out += Format("  magnitude  e = %-10.4g dB  eps = %-8.4g dB   eta = %.4f\n", f.magnitude.e,
+                  f.magnitude.eps, f.magnitude.eta);
+    out += Format("  phase      e = %-10.4g deg eps = %-8.4g deg  eta = %.4f\n", f.phase.e,
+                  f.phase.eps, f.phase.eta);
+    out += Format("  domain score (mean)                          %.4f\n\n", f.eta);
+  } else {
+    out += "Frequency domain: not computed: " + a.frequency_note + "\n\n";
+  }
+
+  out += "Cross-checks (not part of the total)\n";
+  out += Format("  Theil U = %.4g (0 = identical); MSE split: bias %.3f, variance %.3f, covariance %.3f\n",
+                a.theil.u, a.theil.bias, a.theil.variance, a.theil.covariance);
+  out += Format("  ISO/TS 18571: corridor %.3f, phase %.3f, magnitude %.3f, slope %.3f -> %.3f (%s)\n\n",
+                a.iso.corridor, a.iso.phase, a.iso.magnitude, a.iso.slope, a.iso.overall,
+                a.iso.grade.c_str());
+  for (const std::string& note : a.notes) out += "note: " + note + "\n";
+  if (!a.notes.empty()) out += "\n";
+  out += Format("Total = %.6f (%.1f %%)%s  %s eta_pass %.6g  ->  %s\n", a.total, 100.0 * a.total,
+                a.options.total_uses_compensated ? " [delay-compensated time score]" : "",
+                a.pass ? ">=" : "<", a.options.params.eta_pass, a.pass ? "PASS" : "FAIL");
+  return out;
+}
+
+}  // namespace hiltwin::analysis

@@ -1,0 +1,174 @@
+#include "hiltwin/analysis/plot.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+extern char** environ;
+
+namespace hiltwin::analysis {
+namespace {
+
+// gnuplot single-quoted strings: a quote is written twice.
+std::string GnuplotQuote(const std::string& s) {
+  std::string out = "'";
+  for (const char c : s) {
+    out += c;
+    if (c == '\'') out += '\'';
+  }
+  out += "'";
+  return out;
+}
+
+// Removes the temporary directory whatever happens.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    const char* base = std::getenv("TMPDIR");
+    std::string pattern = std::string(base != nullptr && *base != '\0' ? base : "/tmp") +
+                          "/hiltwin-assess-XXXXXX";
+    if (mkdtemp(pattern.data()) == nullptr) {
+      throw PlotError("cannot create a temporary directory for gnuplot's data (" +
+                      std::string(std::strerror(errno)) + "); set TMPDIR to a writable directory");
+    }
+    path = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
+// Rows to draw: all of them, or per bucket the rows with the smallest and largest difference
+// (in time order), so spikes in the error survive thinning.
+std::vector<std::size_t> RowsToDraw(const Assessment& a, std::size_t max_points) {
+  const std::size_t n = a.t_s.size();
+  std::vector<std::size_t> rows;
+  if (n <= max_points || max_points < 4) {
+    rows.resize(n);
+    for (std::size_t i = 0; i < n; ++i) rows[i] = i;
+    return rows;
+  }
+  const std::size_t buckets = max_points / 2;
+  for (std::size_t b = 0; b < buckets; ++b) {
+    const std::size_t begin = b * n / buckets;
+    const std::size_t end = (b + 1) * n / buckets;
+    if (begin >= end) continue;
+    std::size_t lo = begin;
+    std::size_t hi = begin;
+    for (std::size_t i = begin; i < end; ++i) {
+      const double d = a.y_sim[i] - a.y_exp[i];
+      if (d < a.y_sim[lo] - a.y_exp[lo]) lo = i;
+      if (d > a.y_sim[hi] - a.y_exp[hi]) hi = i;
+    }
+    rows.push_back(std::min(lo, hi));
+    if (lo != hi) rows.push_back(std::max(lo, hi));
+  }
+  return rows;
+}
+
+}  // namespace
+
+void WritePlot(const Assessment& a, const std::string& png_path, std::size_t max_points) {
+  const TempDir dir;
+  const std::filesystem::path data = dir.path / "curves.dat";
+  const std::filesystem::path script = dir.path / "plot.gp";
+  const std::filesystem::path log = dir.path / "gnuplot.log";
+  {
+    std::ofstream out(data);
+    out << "# time y_sim y_exp diff diff_compensated\n";
+    out.precision(12);
+    for (const std::size_t i : RowsToDraw(a, max_points)) {
+      const double comp = a.y_sim_compensated.size() > i ? a.y_sim_compensated[i]
+                                                             : std::numeric_limits<double>::quiet_NaN();
+      out << a.t_s[i] << ' ' << a.y_sim[i] << ' ' << a.y_exp[i] << ' ' << a.y_sim[i] - a.y_exp[i]
+          << ' ';
+      if (std::isfinite(comp)) {
+        out << comp - a.y_exp[i];
+      } else {
+        out << "NaN";
+      }
+      out << '\n';
+    }
+    if (!out) throw PlotError("cannot write gnuplot's data file " + data.string());
+  }
+  char delay[64];
+  std::snprintf(delay, sizeof delay, "%.4g ms", a.delay.delay_s * 1e3);
+  char title[160];
+  std::snprintf(title, sizeof title,
+                "time-domain score %.6f raw, %.6f delay-compensated    total %.6f: %s",
+                a.time.eta, a.time_compensated.eta, a.total, a.pass ? "PASS" : "FAIL");
+  {
+    std::ofstream gp(script);
+    const std::string d = GnuplotQuote(data.string());
+    gp << "set terminal pngcairo size 1280,860 font 'sans,11' noenhanced\n"
+       << "set output " << GnuplotQuote(png_path) << "\n"
+       << "set datafile missing 'NaN'\n"
+       << "set multiplot layout 2,1 title " << GnuplotQuote(title) << "\n"
+       << "set grid\nset key outside top center horizontal\nset autoscale xfix\n"
+       << "set lmargin 14\nset rmargin 4\n"
+       << "set ylabel 'value'\n"
+       << "plot " << d << " using 1:3 with lines lw 2 lc rgb '#2ca02c' title "
+       << GnuplotQuote("experiment y_e: " + a.exp_label) << ", \\\n     " << d
+       << " using 1:2 with lines lw 1 dt 2 lc rgb '#d62728' title "
+       << GnuplotQuote("simulation y_s: " + a.sim_label) << "\n"
+       << "set xlabel 'time [s]'\nset ylabel 'y_s - y_e'\n"
+       << "plot " << d << " using 1:4 with lines lw 1 lc rgb '#1f77b4' title 'difference', \\\n     "
+       << d << " using 1:5 with lines lw 1 lc rgb '#ff7f0e' title "
+       << GnuplotQuote("difference after delay compensation (d = " + std::string(delay) + ")")
+       << "\nunset multiplot\nset output\n";
+    if (!gp) throw PlotError("cannot write gnuplot's script " + script.string());
+  }
+
+  std::error_code ec;
+  std::filesystem::remove(png_path, ec);  // so an old picture cannot pass for a new one
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  const std::string log_path = log.string();
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::string program = "gnuplot";
+  std::string script_arg = script.string();
+  char* argv[] = {program.data(), script_arg.data(), nullptr};
+  pid_t pid = 0;
+  const int spawn_error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawn_error == ENOENT) {
+    throw InputError("--plot: gnuplot is not installed (not found on PATH); install the Debian "
+                     "package gnuplot-nox (apt-get install gnuplot-nox) or leave out --plot");
+  }
+  if (spawn_error != 0) {
+    throw PlotError("--plot: cannot start gnuplot: " + std::string(std::strerror(spawn_error)));
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw PlotError("--plot: lost track of gnuplot: " + std::string(std::strerror(errno)));
+  }
+  std::ifstream log_in(log);
+  std::stringstream output;
+  output << log_in.rdbuf();
+  const bool written = std::filesystem::exists(png_path, ec) && std::filesystem::file_size(png_path, ec) > 0;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !written) {
+    throw PlotError("--plot " + png_path + ": gnuplot failed" +
+                    (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")" : "") +
+                    ": " + output.str() + "check that the directory exists and is writable");
+  }
+}
+
+}  // namespace hiltwin::analysis

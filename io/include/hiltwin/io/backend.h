@@ -1,0 +1,60 @@
+#pragma once
+/// Choosing a backend at run time from a string: `mock`, `wire:NAME`, `spidev:/dev/spidevB.C`.
+
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/io/frame.h"
+#include "hiltwin/io/spi_bus.h"
+#include "hiltwin/io/spidev_bus.h"
+
+namespace hiltwin::io {
+
+/// A configuration mistake (bad backend string, bad name); the message says what and how to fix.
+class ConfigError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// The accepted backend forms, for help texts and error messages.
+constexpr const char* kBackendForms =
+    "mock, wire:NAME (NAME: 1-64 of letters, digits, '_', '-', '.'), "
+    "spidev:/dev/spidevB.C (e.g. spidev:/dev/spidev0.0)";
+
+/// A parsed backend string.
+struct BackendSpec {
+  enum class Kind { kMock, kWire, kSpidev };
+  Kind kind = Kind::kMock;
+  std::string argument;  ///< wire name or device path
+};
+
+/// Parses `text`; throws ConfigError naming the text, the problem and kBackendForms.
+[[nodiscard]] BackendSpec ParseBackendSpec(std::string_view text);
+
+/// How to open a backend.
+struct BackendOptions {
+  Image side = Image::kIcoboardInverse;     ///< the image this side's driver needs
+  std::optional<Image> mock_board_image;    ///< mock: image the emulated board carries (default: side)
+  SpidevConfig spidev{};
+};
+
+/// An opened backend: owns its bus and, for mock and wire, the local emulated board.
+class IoBackend {
+ public:
+  virtual ~IoBackend() = default;
+  [[nodiscard]] virtual SpiBus& bus() noexcept = 0;
+  /// The local board model (mock, wire) for sources and fault injection; null for spidev.
+  [[nodiscard]] virtual EmulatedFpga* emulated_board() noexcept = 0;
+  [[nodiscard]] virtual BackendSpec::Kind kind() const noexcept = 0;
+};
+
+/// Opens the backend named by `spec`. Throws ConfigError for a bad string or option, and
+/// std::runtime_error when the OS refuses (no such SPI device, /dev/shm unusable).
+[[nodiscard]] std::unique_ptr<IoBackend> OpenBackend(std::string_view spec,
+                                                     const BackendOptions& options);
+
+}  // namespace hiltwin::io

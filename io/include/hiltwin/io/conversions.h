@@ -1,0 +1,77 @@
+#pragma once
+/// Signal conversions between the models and the FPGA (thesis §6.5.1 and appendix G), in one
+/// place: PWM value <-> duty, wheel metres <-> encoder counts, absolute <-> relative encoder
+/// position, and the PWM reader's quantisation. All noexcept and allocation-free.
+
+#include <cstdint>
+
+#include "hiltwin/io/frame.h"
+
+namespace hiltwin::io {
+
+/// PWM value of duty 1.0: the generator takes integers in [-2048, 2047] (thesis §6.5.1).
+constexpr std::int32_t kPwmResolution = 2048;
+constexpr std::int32_t kPwmValueMin = -2048;
+constexpr std::int32_t kPwmValueMax = 2047;
+/// Encoder counts per turn of the 14-bit relative position (thesis appendix G: [-8192, 8191]).
+constexpr std::int32_t kEncoderResolution = 16384;
+/// The FPGA clock (thesis §2.2.2).
+constexpr std::int64_t kFpgaClockHz = 100'000'000;
+constexpr std::int64_t kNsPerFpgaClock = 10;
+/// The PWM reader's 12-bit period counter: 4096 clocks per PWM period (24.4 kHz).
+constexpr std::int32_t kPwmPeriodClocks = 4096;
+
+/// Duty in [-1, 1] to a PWM value: duty · 2048 rounded to nearest, clamped to
+/// [-2048, 2047]. NaN maps to 0 so a broken model output cannot drive the motor.
+[[nodiscard]] std::int32_t DutyToPwm(double duty) noexcept;
+/// PWM value to duty: value / 2048 (appendix G, `channel / PWM_RESOLUTION`).
+[[nodiscard]] double PwmToDuty(std::int32_t pwm_value) noexcept;
+/// Signed PWM value <-> frame word (magnitude + direction bit).
+[[nodiscard]] PwmWord PwmWordFromValue(std::int32_t pwm_value, bool pin = false) noexcept;
+[[nodiscard]] std::int32_t PwmValueFromWord(const PwmWord& word) noexcept;
+
+/// What the twin's PWM reader measures for an input of `duty` (thesis §2.2.2): the high time in
+/// clocks of a 4096-clock period, halved into an 11-bit value (so 2048 saturates at 2047), with
+/// the sign from the direction pin.
+[[nodiscard]] std::int32_t PwmReaderValue(double duty) noexcept;
+
+/// Wheel geometry for metres <-> counts (appendix G: metres / wheel radius / gear ratio ·
+/// counts per rotation; gear ratio = wheel turns per motor turn, as in the seed code).
+struct WheelGeometry {
+  double wheel_radius_m = 0.05;
+  double gear_ratio = 1.0;
+  double encoder_counts_per_rev = 4096.0;  ///< counts per motor revolution (quadrature, 4x)
+};
+
+/// Wheel travel in metres to absolute encoder counts, floored: appendix G truncates towards
+/// zero, which makes the count around zero two counts wide; flooring keeps every count equal.
+/// Non-finite inputs give 0; results are clamped to ±2^62.
+[[nodiscard]] std::int64_t MetresToCounts(double metres, const WheelGeometry& geometry) noexcept;
+/// Absolute encoder counts to wheel travel in metres (the inverse, for the ECS and tests).
+[[nodiscard]] double CountsToMetres(std::int64_t counts, const WheelGeometry& geometry) noexcept;
+
+/// Absolute position to the relative position in [-resolution/2, resolution/2) (appendix G
+/// `calc_value`, without its loops, and for any resolution that is a positive even number).
+[[nodiscard]] std::int32_t WrapToRelative(std::int64_t absolute_counts,
+                                          std::int32_t resolution = kEncoderResolution) noexcept;
+
+/// Rebuilds an absolute position from successive relative readings, assuming the position moved
+/// less than half a turn between two readings (the same assumption the encoder emulator makes).
+class EncoderUnwrapper {
+ public:
+  EncoderUnwrapper() noexcept = default;
+  explicit EncoderUnwrapper(std::int32_t resolution) noexcept : resolution_(resolution) {}
+  /// Feeds one relative reading; returns the absolute position.
+  std::int64_t Update(std::int32_t relative_counts) noexcept;
+  /// Forgets history: the next reading becomes the absolute position as is.
+  void Reset() noexcept { primed_ = false; absolute_ = 0; }
+  [[nodiscard]] std::int64_t absolute() const noexcept { return absolute_; }
+
+ private:
+  std::int32_t resolution_ = kEncoderResolution;
+  std::int32_t last_relative_ = 0;
+  std::int64_t absolute_ = 0;
+  bool primed_ = false;
+};
+
+}  // namespace hiltwin::io

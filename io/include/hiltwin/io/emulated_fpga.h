@@ -1,0 +1,167 @@
+#pragma once
+/// The emulated FPGA ("mock" backend): a device model of either image behind an emulated SPI
+/// bus, bus and device kept apart as in Zephyr's spi_emul, so the drivers run unchanged. The
+/// board's inputs come from signal-source interfaces (not owned); fault-injection hooks corrupt,
+/// drop or delay frames, stick the encoder and answer as the wrong image.
+///
+/// Time: with no clock, the board's time is (data frames since INIT) × (step from INIT): the
+/// k-th ALL frame after INIT happens at k·step, exactly as on the twin's virtual clock. With a
+/// clock (wire backend), the board reads that clock at every ALL frame.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "hiltwin/io/encoder_emulator.h"
+#include "hiltwin/io/frame.h"
+#include "hiltwin/io/spi_bus.h"
+#include "hiltwin/kernel_glue/clock.h"
+
+namespace hiltwin::io {
+
+/// Drives the twin board's PWM reader: the duty (in [-1, 1], sign = direction pin) of each
+/// channel's PWM input at board time `t_ns`. Called on the loop's thread, once per ALL frame.
+class PwmSignalSource {
+ public:
+  virtual ~PwmSignalSource() = default;
+  virtual void DutyAt(std::int64_t t_ns, std::array<double, kChannels>& duty_out) noexcept = 0;
+};
+
+/// Drives the ECS board's encoder reader: the count the reader has decoded by board time `t_ns`
+/// (relative, 14-bit), per channel. Called once per ALL frame.
+class EncoderLineSource {
+ public:
+  virtual ~EncoderLineSource() = default;
+  virtual void CountsAt(std::int64_t t_ns,
+                        std::array<std::int32_t, kChannels>& counts_out) noexcept = 0;
+};
+
+/// Fault-injection hooks; counts are consumed one per transfer (ros2_control mock_components).
+struct FaultInjection {
+  std::uint32_t corrupt_requests = 0;  ///< next N requests arrive with one bit flipped
+  std::uint32_t corrupt_answers = 0;   ///< next N answers leave with one bit flipped
+  std::uint32_t drop_answers = 0;      ///< next N transfers get no answer (MISO idles high)
+  std::uint32_t delay_answers = 0;     ///< next N transfers get the previous transfer's answer
+  bool stick_encoder = false;          ///< encoder lines freeze (emulator or reader)
+  std::optional<Image> answer_as_image;  ///< INIT answers this image's identity
+};
+
+/// Anything that answers SPI frames: the device side of an emulated bus.
+class SpiDevice {
+ public:
+  virtual ~SpiDevice() = default;
+  virtual void Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept = 0;
+};
+
+/// The board model. ECS image: PWM generator + quadrature encoder reader. Twin image: PWM
+/// reader + encoder emulator. Writes happen only in ALL frames; per-channel PWMc/ENCc frames
+/// read one channel back; TEST echoes its payload.
+class EmulatedFpga final : public SpiDevice {
+ public:
+  explicit EmulatedFpga(Image image, const kernel_glue::Clock* clock = nullptr) noexcept;
+
+  void Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept override;
+
+  /// Input sources (not owned; null = idle line: duty 0 / count held).
+  void SetPwmSource(PwmSignalSource* source) noexcept { pwm_source_ = source; }
+  void SetEncoderSource(EncoderLineSource* source) noexcept { encoder_source_ = source; }
+  /// Levels of the digital input pins (the other side's digital outputs).
+  void SetDigitalInputs(const std::array<bool, kChannels>& pins) noexcept { pins_in_ = pins; }
+  /// Fault-injection hooks, changed between transfers.
+  [[nodiscard]] FaultInjection& faults() noexcept { return faults_; }
+
+  [[nodiscard]] Image image() const noexcept { return image_; }
+  [[nodiscard]] bool initialised() const noexcept { return initialised_; }
+  [[nodiscard]] std::int64_t step_ns() const noexcept { return step_ns_; }
+  [[nodiscard]] std::uint32_t clock_divider() const noexcept { return divider_; }
+  /// Board time of the latest ALL frame.
+  [[nodiscard]] std::int64_t time_ns() const noexcept { return time_ns_; }
+  [[nodiscard]] std::uint64_t data_frames() const noexcept { return data_frames_; }
+  [[nodiscard]] std::uint64_t requests_rejected() const noexcept { return requests_rejected_; }
+
+  /// Twin image: the encoder emulator of channel c.
+  [[nodiscard]] const EncoderEmulator& encoder(std::size_t c) const noexcept { return emulators_[c]; }
+  /// Twin image: PWM values last measured by the reader.
+  [[nodiscard]] const std::array<std::int32_t, kChannels>& pwm_measured() const noexcept {
+    return pwm_values_;
+  }
+  /// ECS image: PWM values the generator outputs (from the latest ALL frame).
+  [[nodiscard]] const std::array<std::int32_t, kChannels>& pwm_output() const noexcept {
+    return pwm_values_;
+  }
+  /// ECS image: the reader's 14-bit counts from the latest ALL frame.
+  [[nodiscard]] const std::array<std::int32_t, kChannels>& encoder_counts() const noexcept {
+    return counts_;
+  }
+  /// Digital outputs set by the host in the latest ALL frame.
+  [[nodiscard]] const std::array<bool, kChannels>& pins_out() const noexcept { return pins_out_; }
+
+ private:
+  void HandleRequest(const Frame& request, Frame& answer) noexcept;
+  void HandleInit(const Frame& request, Frame& answer) noexcept;
+  void HandleAll(const Frame& request, Frame& answer) noexcept;
+  void FillReadback(Opcode opcode, Frame& answer) const noexcept;
+  void ResetState() noexcept;
+
+  Image image_;
+  const kernel_glue::Clock* clock_;
+  PwmSignalSource* pwm_source_ = nullptr;
+  EncoderLineSource* encoder_source_ = nullptr;
+  FaultInjection faults_{};
+
+  bool initialised_ = false;
+  bool pulse_limit_ = false;
+  std::int64_t step_ns_ = 0;
+  std::uint32_t divider_ = 0;
+  std::int64_t time_ns_ = 0;
+  std::uint64_t data_frames_ = 0;
+  std::uint64_t requests_rejected_ = 0;
+  std::uint32_t corrupt_bit_ = 0;
+
+  std::array<EncoderEmulator, kChannels> emulators_{};
+  std::array<std::int32_t, kChannels> pwm_values_{};
+  std::array<std::int32_t, kChannels> counts_{};
+  std::array<bool, kChannels> pins_in_{};
+  std::array<bool, kChannels> pins_out_{};
+  std::array<double, kChannels> duty_scratch_{};
+  FrameBytes previous_answer_{};
+};
+
+/// The emulated bus: forwards each transfer to a device (not owned).
+class EmulatedSpiBus final : public SpiBus {
+ public:
+  explicit EmulatedSpiBus(SpiDevice& device, const char* name = "mock") noexcept
+      : device_(device), name_(name) {}
+  BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept override {
+    device_.Exchange(mosi, miso);
+    return {};
+  }
+  [[nodiscard]] const char* Name() const noexcept override { return name_; }
+
+ private:
+  SpiDevice& device_;
+  const char* name_;
+};
+
+/// Wires a twin board's encoder emulator to an ECS board's reader in one process: the reader
+/// counts what the emulator has emitted by the time it is asked (pulses spread in time).
+class EmulatorToReaderLink final : public EncoderLineSource {
+ public:
+  explicit EmulatorToReaderLink(const EmulatedFpga& twin_board) noexcept : twin_(twin_board) {}
+  void CountsAt(std::int64_t t_ns, std::array<std::int32_t, kChannels>& counts_out) noexcept override;
+
+ private:
+  const EmulatedFpga& twin_;
+};
+
+/// Wires an ECS board's PWM generator to a twin board's PWM reader in one process.
+class GeneratorToReaderLink final : public PwmSignalSource {
+ public:
+  explicit GeneratorToReaderLink(const EmulatedFpga& ecs_board) noexcept : ecs_(ecs_board) {}
+  void DutyAt(std::int64_t t_ns, std::array<double, kChannels>& duty_out) noexcept override;
+
+ private:
+  const EmulatedFpga& ecs_;
+};
+
+}  // namespace hiltwin::io

@@ -1,0 +1,71 @@
+#pragma once
+/// The "wire" backend: the ECS process and the twin process each run their own emulated board;
+/// a POSIX shared-memory segment (/dev/shm/hiltwin-wire-NAME) carries the wires between them:
+/// the ECS board's PWM outputs drive the twin board's PWM reader, the twin board's encoder
+/// emulator drives the ECS board's reader with pulses spread over the twin's period (so the ECS
+/// sees the 1–2 period delay of thesis §3.7). Both boards read CLOCK_MONOTONIC, the clock both
+/// processes share.
+///
+/// Lock-free: PWM is one 64-bit atomic; the encoder lines are a single-writer seqlock that the
+/// reader tries a bounded number of times (then keeps its previous copy), so neither loop ever
+/// waits. Either side may start first or restart; each side beats a heartbeat on every transfer
+/// and a peer whose heartbeat stops is reported as kPeerLost.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/io/spi_bus.h"
+#include "hiltwin/kernel_glue/clock.h"
+
+namespace hiltwin::io {
+
+struct WireSegment;
+
+/// A peer counts as stopped when its heartbeat is older than max(this, 20 peer steps).
+constexpr std::int64_t kWireMinHeartbeatTimeoutNs = 100'000'000;
+
+class WireBus final : public SpiBus {
+ public:
+  /// Attaches to (or creates) the segment of `name` as the side that owns a board of `side`
+  /// (icoboard = ECS, icoboard_inverse = twin). Throws std::invalid_argument for a bad name
+  /// and std::runtime_error when the segment cannot be used or that side is already attached
+  /// by a live process.
+  WireBus(const std::string& name, Image side);
+  ~WireBus() override;
+  WireBus(const WireBus&) = delete;
+  WireBus& operator=(const WireBus&) = delete;
+
+  BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept override;
+  [[nodiscard]] const char* Name() const noexcept override { return label_.c_str(); }
+
+  /// This side's board model (fault injection, inspection).
+  [[nodiscard]] EmulatedFpga& board() noexcept { return board_; }
+  /// Heartbeat status of the other side right now (no transfer).
+  [[nodiscard]] BusStatus PeerStatus() const noexcept;
+  /// Seqlock reads that gave up and reused the previous copy (contention; should stay 0).
+  [[nodiscard]] std::uint64_t seqlock_fallbacks() const noexcept { return seqlock_fallbacks_; }
+
+  /// "/hiltwin-wire-NAME". Throws std::invalid_argument unless NAME is 1–64 of [A-Za-z0-9_.-].
+  static std::string SegmentName(const std::string& name);
+  /// Removes the segment (tests, clean-up after crashes). No error when absent.
+  static void Unlink(const std::string& name);
+
+ private:
+  class PwmWire;
+  class EncoderWire;
+  void Publish(std::int64_t now_ns) noexcept;
+
+  std::string label_;
+  std::string segment_name_;
+  Image side_;
+  kernel_glue::MonotonicClock clock_;
+  EmulatedFpga board_;
+  WireSegment* segment_ = nullptr;
+  std::unique_ptr<PwmWire> pwm_wire_;
+  std::unique_ptr<EncoderWire> encoder_wire_;
+  std::uint64_t seqlock_fallbacks_ = 0;
+};
+
+}  // namespace hiltwin::io

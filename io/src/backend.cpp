@@ -1,0 +1,105 @@
+#include "hiltwin/io/backend.h"
+
+#include "hiltwin/io/wire_bus.h"
+
+namespace hiltwin::io {
+namespace {
+
+bool AllDigits(std::string_view text) noexcept {
+  if (text.empty()) return false;
+  for (const char ch : text) {
+    if (ch < '0' || ch > '9') return false;
+  }
+  return true;
+}
+
+[[noreturn]] void Reject(std::string_view text, const std::string& problem) {
+  throw ConfigError("I/O backend '" + std::string(text) + "': " + problem +
+                    "; accepted forms: " + kBackendForms);
+}
+
+class MockBackend final : public IoBackend {
+ public:
+  explicit MockBackend(Image board_image) : board_(board_image), bus_(board_, "mock") {}
+  SpiBus& bus() noexcept override { return bus_; }
+  EmulatedFpga* emulated_board() noexcept override { return &board_; }
+  BackendSpec::Kind kind() const noexcept override { return BackendSpec::Kind::kMock; }
+
+ private:
+  EmulatedFpga board_;
+  EmulatedSpiBus bus_;
+};
+
+class WireBackend final : public IoBackend {
+ public:
+  WireBackend(const std::string& name, Image side) : bus_(name, side) {}
+  SpiBus& bus() noexcept override { return bus_; }
+  EmulatedFpga* emulated_board() noexcept override { return &bus_.board(); }
+  BackendSpec::Kind kind() const noexcept override { return BackendSpec::Kind::kWire; }
+
+ private:
+  WireBus bus_;
+};
+
+class SpidevBackend final : public IoBackend {
+ public:
+  SpidevBackend(const std::string& path, const SpidevConfig& config) : bus_(path, config) {}
+  SpiBus& bus() noexcept override { return bus_; }
+  EmulatedFpga* emulated_board() noexcept override { return nullptr; }
+  BackendSpec::Kind kind() const noexcept override { return BackendSpec::Kind::kSpidev; }
+
+ private:
+  SpidevBus bus_;
+};
+
+}  // namespace
+
+BackendSpec ParseBackendSpec(std::string_view text) {
+  if (text == "mock") return {BackendSpec::Kind::kMock, ""};
+  const auto colon = text.find(':');
+  if (colon == std::string_view::npos) {
+    Reject(text, text.empty() ? "empty" : "unknown backend");
+  }
+  const std::string_view kind = text.substr(0, colon);
+  const std::string_view argument = text.substr(colon + 1);
+  if (kind == "wire") {
+    try {
+      (void)WireBus::SegmentName(std::string(argument));
+    } catch (const std::invalid_argument& e) {
+      Reject(text, e.what());
+    }
+    return {BackendSpec::Kind::kWire, std::string(argument)};
+  }
+  if (kind == "spidev") {
+    constexpr std::string_view kPrefix = "/dev/spidev";
+    const bool prefixed = argument.substr(0, kPrefix.size()) == kPrefix;
+    const std::string_view numbers = prefixed ? argument.substr(kPrefix.size()) : std::string_view{};
+    const auto dot = numbers.find('.');
+    if (!prefixed || dot == std::string_view::npos || !AllDigits(numbers.substr(0, dot)) ||
+        !AllDigits(numbers.substr(dot + 1))) {
+      Reject(text, "the device must be /dev/spidevB.C with bus B and chip select C");
+    }
+    return {BackendSpec::Kind::kSpidev, std::string(argument)};
+  }
+  if (kind == "mock") Reject(text, "mock takes no argument");
+  Reject(text, "unknown backend '" + std::string(kind) + "'");
+}
+
+std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptions& options) {
+  const BackendSpec parsed = ParseBackendSpec(spec);
+  if (options.mock_board_image && parsed.kind != BackendSpec::Kind::kMock) {
+    throw ConfigError("a board image can only be chosen for the mock backend, not for '" +
+                      std::string(spec) + "': the real or wired board carries its own image");
+  }
+  switch (parsed.kind) {
+    case BackendSpec::Kind::kMock:
+      return std::make_unique<MockBackend>(options.mock_board_image.value_or(options.side));
+    case BackendSpec::Kind::kWire:
+      return std::make_unique<WireBackend>(parsed.argument, options.side);
+    case BackendSpec::Kind::kSpidev:
+      return std::make_unique<SpidevBackend>(parsed.argument, options.spidev);
+  }
+  throw ConfigError("unreachable backend kind");
+}
+
+}  // namespace hiltwin::io

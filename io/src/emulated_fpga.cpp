@@ -1,0 +1,168 @@
+#include "hiltwin/io/emulated_fpga.h"
+
+#include "hiltwin/io/conversions.h"
+
+namespace hiltwin::io {
+namespace {
+constexpr std::uint32_t kFrameBits = static_cast<std::uint32_t>(kFrameBytes * 8);
+}  // namespace
+
+EmulatedFpga::EmulatedFpga(Image image, const kernel_glue::Clock* clock) noexcept
+    : image_(image), clock_(clock) {}
+
+void EmulatedFpga::ResetState() noexcept {
+  initialised_ = false;
+  pulse_limit_ = false;
+  step_ns_ = 0;
+  divider_ = 0;
+  time_ns_ = 0;
+  data_frames_ = 0;
+  for (auto& emulator : emulators_) emulator.Reset();
+  pwm_values_.fill(0);
+  counts_.fill(0);
+  pins_out_.fill(false);
+}
+
+void EmulatedFpga::Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept {
+  FrameBytes request_bytes = mosi;
+  if (faults_.corrupt_requests > 0) {
+    --faults_.corrupt_requests;
+    const std::uint32_t bit = corrupt_bit_++ % kFrameBits;
+    request_bytes[bit / 8] = static_cast<std::uint8_t>(request_bytes[bit / 8] ^ (1U << (bit % 8)));
+  }
+
+  Frame request;
+  Frame answer;
+  const FrameError error = Decode(request_bytes, Direction::kRequest, image_, request);
+  if (error != FrameError::kOk) {
+    // Never act on a damaged request: hold every output, say so in the status byte.
+    ++requests_rejected_;
+    const std::uint8_t op = request_bytes[0];
+    answer.opcode = op <= static_cast<std::uint8_t>(Opcode::kTest) ? static_cast<Opcode>(op)
+                                                                   : Opcode::kNoop;
+    answer.sequence = request_bytes[1];
+    answer.status = kStatusRequestRejected;
+  } else {
+    HandleRequest(request, answer);
+  }
+  if (initialised_) answer.status = static_cast<std::uint8_t>(answer.status | kStatusInitialised);
+  if (pulse_limit_) answer.status = static_cast<std::uint8_t>(answer.status | kStatusPulseLimit);
+
+  FrameBytes answer_bytes;
+  if (Encode(answer, Direction::kAnswer, image_, answer_bytes) != FrameError::kOk) {
+    answer_bytes.fill(0xFF);  // cannot happen for values the model produces; fail visibly
+  }
+
+  if (faults_.delay_answers > 0) {
+    --faults_.delay_answers;
+    miso = previous_answer_;
+  } else if (faults_.drop_answers > 0) {
+    --faults_.drop_answers;
+    miso.fill(0xFF);
+  } else {
+    miso = answer_bytes;
+    if (faults_.corrupt_answers > 0) {
+      --faults_.corrupt_answers;
+      const std::uint32_t bit = corrupt_bit_++ % kFrameBits;
+      miso[bit / 8] = static_cast<std::uint8_t>(miso[bit / 8] ^ (1U << (bit % 8)));
+    }
+  }
+  previous_answer_ = answer_bytes;
+}
+
+void EmulatedFpga::HandleRequest(const Frame& request, Frame& answer) noexcept {
+  answer.opcode = request.opcode;
+  answer.sequence = request.sequence;
+  switch (request.opcode) {
+    case Opcode::kNoop: break;
+    case Opcode::kInit: HandleInit(request, answer); break;
+    case Opcode::kReset: ResetState(); break;
+    case Opcode::kAll: HandleAll(request, answer); break;
+    case Opcode::kTest: answer.raw = request.raw; break;
+    default: FillReadback(request.opcode, answer); break;
+  }
+}
+
+void EmulatedFpga::HandleInit(const Frame& request, Frame& answer) noexcept {
+  ResetState();
+  const auto step_ns = static_cast<std::int64_t>(request.init_request.step_ns);
+  const std::uint32_t divider = request.init_request.clock_divider;
+  bool accepted = step_ns >= kNsPerFpgaClock;
+  if (accepted && image_ == Image::kIcoboardInverse) {
+    for (auto& emulator : emulators_) accepted = accepted && emulator.Configure(step_ns, divider);
+  }
+  const Image identity_image = faults_.answer_as_image.value_or(image_);
+  answer.init_answer = InitAnswer{kProtocolVersion, static_cast<std::uint8_t>(kChannels),
+                                  IdentityOf(identity_image), 0};
+  if (!accepted) {
+    answer.status = kStatusInitRejected;
+    return;
+  }
+  initialised_ = true;
+  step_ns_ = step_ns;
+  divider_ = image_ == Image::kIcoboardInverse ? divider : 0;
+  answer.init_answer.clock_divider = divider_;
+  time_ns_ = clock_ != nullptr ? clock_->NowNs() : 0;
+  for (auto& emulator : emulators_) emulator.StartPeriod(0, time_ns_);
+}
+
+void EmulatedFpga::HandleAll(const Frame& request, Frame& answer) noexcept {
+  if (!initialised_) return;  // answer carries zeros and no kStatusInitialised
+  const std::int64_t t_ns =
+      clock_ != nullptr ? clock_->NowNs() : static_cast<std::int64_t>(data_frames_) * step_ns_;
+  ++data_frames_;
+  time_ns_ = t_ns;
+
+  if (image_ == Image::kIcoboardInverse) {
+    pulse_limit_ = false;
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      emulators_[c].SetStuck(faults_.stick_encoder);
+      if (!emulators_[c].StartPeriod(request.enc[c].counts, t_ns)) pulse_limit_ = true;
+      pins_out_[c] = request.enc[c].pin;
+    }
+    duty_scratch_.fill(0.0);
+    if (pwm_source_ != nullptr) pwm_source_->DutyAt(t_ns, duty_scratch_);
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      pwm_values_[c] = PwmReaderValue(duty_scratch_[c]);
+      answer.pwm[c] = PwmWordFromValue(pwm_values_[c], pins_in_[c]);
+    }
+  } else {
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      pwm_values_[c] = PwmValueFromWord(request.pwm[c]);
+      pins_out_[c] = request.pwm[c].pin;
+    }
+    if (encoder_source_ != nullptr && !faults_.stick_encoder) {
+      encoder_source_->CountsAt(t_ns, counts_);
+      for (auto& count : counts_) count = WrapToRelative(count);
+    }
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      answer.enc[c] = EncWord{static_cast<std::int16_t>(counts_[c]), pins_in_[c]};
+    }
+  }
+}
+
+void EmulatedFpga::FillReadback(Opcode opcode, Frame& answer) const noexcept {
+  const auto c = static_cast<std::size_t>(opcode) & 3U;
+  const bool twin = image_ == Image::kIcoboardInverse;
+  if (static_cast<unsigned>(opcode) < 8) {
+    answer.pwm[c] = PwmWordFromValue(pwm_values_[c], twin ? pins_in_[c] : pins_out_[c]);
+  } else if (twin) {
+    // Where the emulator will be at the end of the current period: the accepted target.
+    answer.enc[c] = EncWord{static_cast<std::int16_t>(emulators_[c].PositionAt(time_ns_ + step_ns_)),
+                            pins_out_[c]};
+  } else {
+    answer.enc[c] = EncWord{static_cast<std::int16_t>(counts_[c]), pins_in_[c]};
+  }
+}
+
+void EmulatorToReaderLink::CountsAt(std::int64_t t_ns,
+                                    std::array<std::int32_t, kChannels>& counts_out) noexcept {
+  for (std::size_t c = 0; c < kChannels; ++c) counts_out[c] = twin_.encoder(c).PositionAt(t_ns);
+}
+
+void GeneratorToReaderLink::DutyAt(std::int64_t /*t_ns*/,
+                                   std::array<double, kChannels>& duty_out) noexcept {
+  for (std::size_t c = 0; c < kChannels; ++c) duty_out[c] = PwmToDuty(ecs_.pwm_output()[c]);
+}
+
+}  // namespace hiltwin::io

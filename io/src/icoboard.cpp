@@ -1,0 +1,236 @@
+#include "hiltwin/io/icoboard.h"
+
+#include <stdexcept>
+
+#include "hiltwin/io/encoder_emulator.h"
+
+namespace hiltwin::io {
+namespace {
+
+bool IsIdle(const FrameBytes& bytes) noexcept {
+  // A board that does not drive MISO reads as all ones (pull-up) or all zeros.
+  bool all_ones = true;
+  bool all_zeros = true;
+  for (const std::uint8_t b : bytes) {
+    all_ones = all_ones && b == 0xFF;
+    all_zeros = all_zeros && b == 0x00;
+  }
+  return all_ones || all_zeros;
+}
+
+const char* DecodeReason(FrameError error) noexcept {
+  switch (error) {
+    case FrameError::kChecksum: return "answer failed its CRC-8 check";
+    case FrameError::kOpcode: return "answer carries an unknown opcode";
+    case FrameError::kReservedBits: return "answer has reserved bits set";
+    case FrameError::kOutOfRange: return "answer has a field out of range";
+    case FrameError::kOk: break;
+  }
+  return "";
+}
+
+const char* SideName(Image image) noexcept {
+  return image == Image::kIcoboard ? "the ECS" : "the twin";
+}
+
+}  // namespace
+
+const char* ToString(ExchangeStatus::Code code) noexcept {
+  switch (code) {
+    case ExchangeStatus::Code::kOk: return "ok";
+    case ExchangeStatus::Code::kCorrupted: return "corrupted";
+    case ExchangeStatus::Code::kMissed: return "missed";
+    case ExchangeStatus::Code::kFault: return "fault";
+  }
+  return "?";
+}
+
+IcoBoardLink::IcoBoardLink(SpiBus& bus, Image image, const kernel_glue::Clock* clock) noexcept
+    : spi_(bus, clock), image_(image) {}
+
+ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
+  ExchangeStatus status;
+  request.sequence = ++sequence_;
+  if (Encode(request, Direction::kRequest, image_, tx_) != FrameError::kOk) {
+    ++counters_.faults;
+    status.code = ExchangeStatus::Code::kFault;
+    status.reason = "request field out of range (driver bug)";
+    return status;
+  }
+  ++counters_.frames_sent;
+  const TransferStatus transfer = spi_.Transfer(tx_, rx_);
+  status.transfer_ns = transfer.duration_ns;
+  if (transfer.result == BusResult::kIoError || transfer.result == BusResult::kPeerLost) {
+    ++counters_.faults;
+    status.code = ExchangeStatus::Code::kFault;
+    status.reason = transfer.reason;
+    return status;
+  }
+  status.peer_absent = transfer.result == BusResult::kPeerAbsent;
+  if (IsIdle(rx_)) {
+    ++counters_.frames_missed;
+    status.code = ExchangeStatus::Code::kMissed;
+    status.reason = "no answer from the board (MISO idle)";
+    return status;
+  }
+  const FrameError error = Decode(rx_, Direction::kAnswer, image_, answer);
+  if (error != FrameError::kOk) {
+    ++counters_.frames_corrupted;
+    status.code = ExchangeStatus::Code::kCorrupted;
+    status.reason = DecodeReason(error);
+    return status;
+  }
+  if (answer.sequence != request.sequence) {
+    ++counters_.frames_missed;
+    status.code = ExchangeStatus::Code::kMissed;
+    status.reason = "stale answer (sequence number of an earlier request)";
+    return status;
+  }
+  if (answer.opcode != request.opcode) {
+    ++counters_.frames_corrupted;
+    status.code = ExchangeStatus::Code::kCorrupted;
+    status.reason = "answer to a different opcode";
+    return status;
+  }
+  if ((answer.status & kStatusRequestRejected) != 0) {
+    ++counters_.frames_corrupted;
+    status.code = ExchangeStatus::Code::kCorrupted;
+    status.reason = "the board rejected the request (damaged on the way)";
+    return status;
+  }
+  const bool data = request.opcode != Opcode::kInit && request.opcode != Opcode::kTest &&
+                    request.opcode != Opcode::kNoop && request.opcode != Opcode::kReset;
+  if (data && (answer.status & kStatusInitialised) == 0) {
+    ++counters_.faults;
+    status.code = ExchangeStatus::Code::kFault;
+    status.reason = "the board is not initialised (reset or power loss): run INIT again";
+    return status;
+  }
+  ++counters_.frames_received;
+  return status;
+}
+
+InitResult IcoBoardLink::Init(std::int64_t step_ns) {
+  if (step_ns < kNsPerFpgaClock || step_ns > 0xFFFF'FFFFLL) {
+    throw std::invalid_argument("INIT step " + std::to_string(step_ns) +
+                                " ns is outside [10 ns, 4294967295 ns]: choose a rate between "
+                                "0.24 Hz and 100 MHz");
+  }
+  counters_ = LinkCounters{};
+  initialised_ = false;
+  // The board starts from position 0 after INIT; so do the change checks and unwrappers.
+  last_counts_.fill(0);
+  for (auto& unwrapper : unwrappers_) unwrapper.Reset();
+  InitResult result;
+  const std::uint32_t divider =
+      image_ == Image::kIcoboardInverse ? ClockDividerForStep(step_ns) : 0;
+  ExchangeStatus status;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    request_ = Frame{};
+    request_.opcode = Opcode::kInit;
+    request_.init_request = InitRequest{static_cast<std::uint32_t>(step_ns), divider};
+    status = Transact(request_, answer_);
+    if (status.ok() || status.code == ExchangeStatus::Code::kFault) break;
+  }
+  if (!status.ok()) {
+    result.message = std::string("Failed to initialise FPGA: no valid answer to INIT over ") +
+                     spi_.bus().Name() + " (" + status.reason +
+                     "); check the cable, power and that the FPGA is programmed";
+    return result;
+  }
+  const InitAnswer& init = answer_.init_answer;
+  result.identity = init.identity;
+  const auto found = ImageOfIdentity(init.identity);
+  result.image_known = found.has_value();
+  if (found) result.found = *found;
+  if (!found || *found != image_) {
+    const std::string found_text =
+        found ? std::string(ToString(*found))
+              : "an unknown image (identity " + std::to_string(init.identity) + ")";
+    result.message = "Failed to initialise FPGA: found " + found_text + ", " + SideName(image_) +
+                     " needs " + ToString(image_) + " (program " + ToString(image_) +
+                     " onto this board, or swap the boards)";
+    return result;
+  }
+  if (init.protocol_version != kProtocolVersion || init.channels != kChannels) {
+    result.message = "Failed to initialise FPGA: protocol version " +
+                     std::to_string(init.protocol_version) + " with " +
+                     std::to_string(init.channels) + " channels, hiltwin speaks version " +
+                     std::to_string(kProtocolVersion) + " with 4; update the FPGA image";
+    return result;
+  }
+  if ((answer_.status & kStatusInitRejected) != 0 || (answer_.status & kStatusInitialised) == 0) {
+    result.message = "Failed to initialise FPGA: the board rejected step " +
+                     std::to_string(step_ns) + " ns with clock divider " +
+                     std::to_string(divider) + "; choose a longer step";
+    return result;
+  }
+  result.ok = true;
+  result.clock_divider = init.clock_divider;
+  initialised_ = true;
+  step_ns_ = step_ns;
+  clock_divider_ = init.clock_divider;
+  return result;
+}
+
+ExchangeStatus IcoBoardLink::Test(const std::array<std::uint8_t, 8>& pattern,
+                                  std::array<std::uint8_t, 8>& echo) noexcept {
+  request_.opcode = Opcode::kTest;
+  request_.raw = pattern;
+  const ExchangeStatus status = Transact(request_, answer_);
+  if (status.ok()) echo = answer_.raw;
+  return status;
+}
+
+ExchangeStatus IcoBoardInverse::Exchange(
+    const std::array<std::int32_t, kChannels>& encoder_counts_out, TwinInputs& in) noexcept {
+  const std::uint32_t limit = MaxCountsPerStep(step_ns_, clock_divider_);
+  bool over_limit = false;
+  request_.opcode = Opcode::kAll;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const std::int64_t counts = encoder_counts_out[c];
+    const std::int64_t change = counts - last_counts_[c];
+    if (change > limit || -change > limit) {
+      ++counters_.counts_over_limit;
+      over_limit = true;
+    }
+    last_counts_[c] = counts;
+    request_.enc[c] = EncWord{static_cast<std::int16_t>(WrapToRelative(counts)), pins_out_[c]};
+  }
+  ExchangeStatus status = Transact(request_, answer_);
+  status.pulse_limit = over_limit;
+  if (!status.ok()) return status;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    in.pwm[c] = PwmValueFromWord(answer_.pwm[c]);
+    in.duty[c] = PwmToDuty(in.pwm[c]);
+    in.pins[c] = answer_.pwm[c].pin;
+  }
+  in.board_status = answer_.status;
+  if ((answer_.status & kStatusPulseLimit) != 0) {
+    ++counters_.pulse_limit_events;
+    status.pulse_limit = true;
+  }
+  return status;
+}
+
+ExchangeStatus IcoBoard::Exchange(const std::array<std::int32_t, kChannels>& pwm_out,
+                                  EcsInputs& in) noexcept {
+  request_.opcode = Opcode::kAll;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    std::int32_t value = pwm_out[c];
+    if (value < kPwmValueMin) value = kPwmValueMin;
+    if (value > kPwmValueMax) value = kPwmValueMax;
+    request_.pwm[c] = PwmWordFromValue(value, pins_out_[c]);
+  }
+  const ExchangeStatus status = Transact(request_, answer_);
+  if (!status.ok()) return status;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    in.counts[c] = answer_.enc[c].counts;
+    in.absolute_counts[c] = unwrappers_[c].Update(in.counts[c]);
+    in.pins[c] = answer_.enc[c].pin;
+  }
+  in.board_status = answer_.status;
+  return status;
+}
+
+}  // namespace hiltwin::io

@@ -1,0 +1,218 @@
+// The whole assessment on synthetic curves: alignment, delay compensation, domains, total.
+#include "hiltwin/analysis/assessment.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace hiltwin::analysis {
+namespace {
+
+double Position(double t_s) {
+  return 0.3 * t_s + 0.2 * std::sin(2.1 * t_s) + 0.05 * std::sin(7.3 * t_s + 0.4);
+}
+
+Curve MakeCurve(const std::string& name, double t0_s, double step_s, std::size_t n,
+                double delay_s, double offset = 0.0) {
+  Curve c;
+  c.path = name + ".csv";
+  c.label = name;
+  c.column = 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = t0_s + static_cast<double>(i) * step_s;
+    c.t_s.push_back(t);
+    c.y.push_back(Position(t - delay_s) + offset);
+    c.lines.push_back(i + 2);
+  }
+  return c;
+}
+
+std::string ErrorOf(const Curve& sim, const Curve& exp, const AssessOptions& options,
+                    const Curve* input = nullptr) {
+  try {
+    (void)Assess(sim, exp, input, options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Assess, PureDelayScoresAboutOneAfterCompensation) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-3, 10000, 0.0);
+  const Curve exp = MakeCurve("exp", 0.0, 1e-3, 10000, 0.0123);  // 12.3 ms late
+  const Assessment a = Assess(sim, exp, nullptr, AssessOptions{});
+  EXPECT_TRUE(a.same_time_base);
+  EXPECT_NEAR(a.delay.delay_s, 0.0123, 2e-5);
+  EXPECT_LT(a.time.eta, 0.9999);
+  EXPECT_GT(a.time_compensated.eta, 0.999999);
+  EXPECT_LT(a.time_compensated.e_t, a.time.e_t / 100.0);
+  EXPECT_DOUBLE_EQ(a.total, a.time.eta);  // thesis weights 1,0,0 use the raw score
+  AssessOptions compensated;
+  compensated.total_uses_compensated = true;
+  EXPECT_DOUBLE_EQ(Assess(sim, exp, nullptr, compensated).total,
+                   Assess(sim, exp, nullptr, compensated).time_compensated.eta);
+}
+
+TEST(Assess, KnownOffsetGivesKnownErrorAndIdenticalGivesOne) {
+  const Curve exp = MakeCurve("exp", 0.0, 1e-2, 2000, 0.0);
+  const Curve offset = MakeCurve("sim", 0.0, 1e-2, 2000, 0.0, 0.004);
+  const Assessment a = Assess(offset, exp, nullptr, AssessOptions{});
+  EXPECT_NEAR(a.time.e_t, 0.004, 1e-12);
+  EXPECT_NEAR(a.delay.delay_s, 0.0, 1e-9);
+  EXPECT_NEAR(a.theil.bias, 1.0, 1e-6);
+  const Assessment same = Assess(exp, exp, nullptr, AssessOptions{});
+  EXPECT_EQ(same.time.eta, 1.0);
+  EXPECT_EQ(same.total, 1.0);
+  EXPECT_TRUE(same.pass);
+  EXPECT_DOUBLE_EQ(same.iso.overall, 1.0);
+}
+
+TEST(Assess, TwoFilesAreResampledOntoTheExperimentOverTheOverlap) {
+  // Simulation at 1 kHz from 0 s, experiment at 300 Hz from 1 s to beyond the simulation.
+  const Curve sim = MakeCurve("sim", 0.0, 1e-3, 8001, 0.0);    // 0 .. 8 s
+  const Curve exp = MakeCurve("exp", 1.0, 1.0 / 300.0, 3000, 0.0);  // 1 .. ~11 s
+  const Assessment a = Assess(sim, exp, nullptr, AssessOptions{});
+  EXPECT_FALSE(a.same_time_base);
+  EXPECT_NEAR(a.overlap_t0_s, 1.0, 1e-12);
+  EXPECT_LE(a.overlap_t1_s, 8.0);
+  EXPECT_GT(a.overlap_t1_s, 8.0 - 1.0 / 300.0);
+  EXPECT_EQ(a.samples, a.t_s.size());
+  // Linear interpolation of a smooth curve at 1 kHz: tiny error, score ~ 1.
+  EXPECT_LT(a.time.e_t, 1e-6);
+  EXPECT_GT(a.time.eta, 0.999999);
+  ASSERT_FALSE(a.notes.empty());
+  EXPECT_NE(a.notes.front().find("resampled"), std::string::npos);
+}
+
+TEST(Assess, ErrorThresholdUsesTheComparedRangeOnly) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 501, 0.0);   // 0 .. 5 s
+  const Curve exp = MakeCurve("exp", 0.0, 1e-2, 1001, 0.0);  // 0 .. 10 s
+  const Assessment a = Assess(sim, exp, nullptr, AssessOptions{});
+  double lo = 1e300;
+  double hi = -1e300;
+  for (std::size_t i = 0; i <= 500; ++i) {
+    lo = std::min(lo, exp.y[i]);
+    hi = std::max(hi, exp.y[i]);
+  }
+  EXPECT_NEAR(a.time.eps_t, 0.05 * (hi - lo), 1e-12);
+  EXPECT_EQ(a.samples, 501u);
+}
+
+TEST(Assess, NoOverlapIsAnInputError) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 100, 0.0);
+  const Curve exp = MakeCurve("exp", 5.0, 1e-2, 100, 0.0);
+  const std::string m = ErrorOf(sim, exp, AssessOptions{});
+  EXPECT_NE(m.find("no overlap"), std::string::npos) << m;
+  EXPECT_NE(m.find("[0, 0.99] s"), std::string::npos) << m;
+  EXPECT_NE(m.find("[5, 5.99] s"), std::string::npos) << m;
+}
+
+TEST(Assess, ConstantExperimentNamesFileLinesAndColumn) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 100, 0.0);
+  Curve exp = MakeCurve("exp", 0.0, 1e-2, 100, 0.0);
+  exp.y.assign(exp.y.size(), 1.5);
+  const std::string m = ErrorOf(sim, exp, AssessOptions{});
+  EXPECT_NE(m.find("exp.csv:2-101:2"), std::string::npos) << m;
+  EXPECT_NE(m.find("constant"), std::string::npos) << m;
+}
+
+TEST(Assess, WeightedDomainThatCannotBeComputedIsAnInputError) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 500, 0.0);
+  AssessOptions freq;
+  freq.weights = {1.0, 0.0, 1.0};
+  EXPECT_NE(ErrorOf(sim, sim, freq).find("--input"), std::string::npos);
+  AssessOptions bad;
+  bad.weights = {0.0, 0.0, 0.0};
+  EXPECT_NE(ErrorOf(sim, sim, bad).find("--weights"), std::string::npos);
+  AssessOptions kp;
+  kp.params.kp = 0.0;
+  EXPECT_NE(ErrorOf(sim, sim, kp).find("--kp"), std::string::npos);
+  AssessOptions seg;
+  seg.segment = std::pair{100.0, 200.0};
+  EXPECT_NE(ErrorOf(sim, sim, seg).find("--segment"), std::string::npos);
+}
+
+TEST(Assess, StepSegmentGivesPerformanceDomainAndWeightedTotal) {
+  Curve exp;
+  Curve sim;
+  exp.path = sim.path = "step.csv";
+  exp.label = "exp";
+  sim.label = "sim";
+  for (std::size_t i = 0; i < 4000; ++i) {
+    const double t = static_cast<double>(i) * 1e-3;  // step at 1 s
+    const double e = t < 1.0 ? 0.0 : 1.0 - std::exp(-(t - 1.0) / 0.1);
+    const double s = t < 1.0 ? 0.0 : 1.0 - std::exp(-(t - 1.0) / 0.102);
+    exp.t_s.push_back(t);
+    sim.t_s.push_back(t);
+    exp.y.push_back(e);
+    sim.y.push_back(s);
+    exp.lines.push_back(i + 2);
+    sim.lines.push_back(i + 2);
+  }
+  AssessOptions options;
+  options.segment = std::pair{1.0, 4.0};
+  options.weights = {1.0, 1.0, 0.0};
+  const Assessment a = Assess(sim, exp, nullptr, options);
+  ASSERT_TRUE(a.performance.has_value());
+  EXPECT_NEAR(a.performance->t0_s, 1.0, 1e-9);
+  const MetricScore& rise = a.performance->metrics.at(0);
+  ASSERT_TRUE(rise.exp.has_value());
+  EXPECT_NEAR(*rise.exp, 0.1 * std::log(9.0), 2e-3);
+  EXPECT_NEAR(a.total, 0.5 * (a.time.eta + a.performance->eta), 1e-12);
+  const nlohmann::json j = ToJson(a);
+  EXPECT_TRUE(j["performance_domain"].is_object());
+  EXPECT_TRUE(j["frequency_domain"].is_null());
+  EXPECT_DOUBLE_EQ(j["performance_domain"]["eta"].get<double>(), a.performance->eta);
+}
+
+TEST(Assess, InputColumnEnablesTheFrequencyDomain) {
+  Curve u;
+  Curve y;
+  u.path = y.path = "f.csv";
+  u.label = "u";
+  y.label = "y";
+  std::uint64_t s = 42;
+  double state = 0.0;
+  for (std::size_t i = 0; i < 16384; ++i) {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double v = static_cast<double>(s >> 11) / 9007199254740992.0 - 0.5;
+    state = 0.8 * state + 0.2 * v;
+    u.t_s.push_back(static_cast<double>(i) * 1e-3);
+    y.t_s.push_back(static_cast<double>(i) * 1e-3);
+    u.y.push_back(v);
+    y.y.push_back(state);
+    u.lines.push_back(i + 2);
+    y.lines.push_back(i + 2);
+  }
+  AssessOptions options;
+  options.weights = {1.0, 0.0, 1.0};
+  const Assessment a = Assess(y, y, &u, options);
+  ASSERT_TRUE(a.frequency.has_value()) << a.frequency_note;
+  EXPECT_DOUBLE_EQ(a.frequency->eta, 1.0);
+  EXPECT_DOUBLE_EQ(a.total, 1.0);
+}
+
+TEST(Assess, JsonHasTheContractKeys) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 600, 0.0, 0.01);
+  const Curve exp = MakeCurve("exp", 0.0, 1e-2, 600, 0.0);
+  const nlohmann::json j = ToJson(Assess(sim, exp, nullptr, AssessOptions{}));
+  for (const char* key : {"e_t", "eps_t", "k_e", "eta"}) {
+    EXPECT_TRUE(j["time_domain"][key].is_number()) << key;
+    EXPECT_TRUE(j["time_domain_compensated"][key].is_number()) << key;
+  }
+  EXPECT_TRUE(j["delay_s"].is_number());
+  EXPECT_TRUE(j.contains("performance_domain"));
+  EXPECT_TRUE(j["frequency_domain"].is_null());
+  EXPECT_TRUE(j["total"].is_number());
+  EXPECT_TRUE(j["pass"].is_boolean());
+  EXPECT_TRUE(j["cross_checks"]["theil"]["u"].is_number());
+  EXPECT_TRUE(j["cross_checks"]["iso18571"]["overall"].is_number());
+  const std::string text = FormatText(Assess(sim, exp, nullptr, AssessOptions{}));
+  EXPECT_NE(text.find("e_t"), std::string::npos);
+  EXPECT_NE(text.find("PASS"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hiltwin::analysis
