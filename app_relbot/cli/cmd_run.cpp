@@ -254,6 +254,8 @@ int RunTwin(RunOptions o) {
     log_config.path = o.log_path;
     log_config.columns = LogObserver::Columns();
     log_config.decimation = o.log_decimation;
+    // No deadline on the virtual clock: keep every row rather than drop when the writer lags.
+    log_config.wait_when_full = virtual_clock;
     try {
       logger = std::make_unique<tracing::CsvLogger>(std::move(log_config));
     } catch (const std::invalid_argument& e) {

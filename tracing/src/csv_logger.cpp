@@ -1,5 +1,7 @@
 #include "hiltwin/tracing/csv_logger.h"
 
+#include <thread>
+
 #include <pthread.h>
 #include <sched.h>
 
@@ -165,6 +167,7 @@ void CsvLogger::Start() {
     throw std::runtime_error("CsvLogger: writer thread for '" + config_.path + "': " + start_error);
   }
   started_ = true;
+  writer_ready_for_producer_.store(true, std::memory_order_release);
 }
 
 bool CsvLogger::TryLog(double time_s, std::span<const double> values) noexcept {
@@ -175,8 +178,16 @@ bool CsvLogger::TryLog(double time_s, std::span<const double> values) noexcept {
   }
   decimation_countdown_ = config_.decimation - 1;
   std::size_t slot = 0;
-  if (!accepting_.load(std::memory_order_relaxed) || values.size() + 1 != row_stride_ ||
-      !ring_.TryClaim(slot)) {
+  bool claimed = accepting_.load(std::memory_order_relaxed) && values.size() + 1 == row_stride_ &&
+                 ring_.TryClaim(slot);
+  if (!claimed && config_.wait_when_full && writer_ready_for_producer_.load(std::memory_order_acquire)) {
+    // Off-line mode: give the writer the CPU until it has made room (or the logger stops).
+    while (!claimed && accepting_.load(std::memory_order_relaxed) && values.size() + 1 == row_stride_) {
+      std::this_thread::yield();
+      claimed = ring_.TryClaim(slot);
+    }
+  }
+  if (!claimed) {
     producer_dropped_.store(producer_dropped_.load(std::memory_order_relaxed) + 1,
                             std::memory_order_relaxed);
     return false;

@@ -100,6 +100,25 @@ TEST_F(CsvLoggerTest, WritesHeaderThenOneRowPerLoggedCycle) {
   EXPECT_EQ(lines[2], "0.00025,-0.5,2");
 }
 
+TEST_F(CsvLoggerTest, WaitWhenFullLosesNothingThroughATinyQueue) {
+  auto config = Config(Path(), {"k"});
+  config.queue_capacity_rows = 4;
+  config.wait_when_full = true;  // off-line (virtual clock) mode
+  {
+    CsvLogger logger(config);
+    logger.Start();
+    for (int k = 0; k < 800; ++k) {
+      ASSERT_TRUE(logger.TryLog(k * 1e-3, std::array{static_cast<double>(k)}));
+    }
+    logger.Stop();
+    EXPECT_EQ(logger.rows_written(), 800U);
+    EXPECT_EQ(logger.rows_dropped(), 0U);
+  }
+  const auto lines = ReadLines(Path());
+  ASSERT_EQ(lines.size(), 801U);
+  EXPECT_EQ(lines.back(), "0.799,799");
+}
+
 TEST_F(CsvLoggerTest, HeaderIsOnDiskRightAfterConstruction) {
   CsvLogger logger(Config(Path(), {"a"}));
   const auto lines = ReadLines(Path());

@@ -36,6 +36,10 @@ struct CsvLoggerConfig {
   std::int64_t writer_poll_period_ns = 2'000'000;   ///< writer sleeps this long between drains
   std::int64_t file_flush_period_ns = 100'000'000;  ///< writer hands data to the OS this often
   std::vector<int> writer_cpus;  ///< CPUs for the writer thread; empty = inherit the starter's
+  /// Off-line runs only (virtual clock): when the queue is full the producer waits for the
+  /// started writer instead of dropping, so an as-fast-as-possible run logs every row. Never
+  /// set this for a real-time loop: it makes TryLog block.
+  bool wait_when_full = false;
 };
 
 /// Single-producer CSV logger. One thread (the loop) calls TryLog; one control thread calls
@@ -116,6 +120,7 @@ class CsvLogger {
   bool started_ = false;
   bool stopped_ = false;
   bool writer_ready_ = false;
+  std::atomic<bool> writer_ready_for_producer_{false};  ///< wait_when_full may wait on it
   bool stop_requested_ = false;
   std::uint64_t flush_requested_ = 0;
   std::uint64_t flush_completed_ = 0;
