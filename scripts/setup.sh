@@ -12,7 +12,7 @@ packages=(
   libfftw3-dev                                  # Welch spectra in `hiltwin assess`
   liblttng-ust-dev lttng-tools babeltrace2      # tracepoints and trace tests
   libgtest-dev libgmock-dev libbenchmark-dev    # tests and benchmarks
-  rt-tests valgrind                             # cyclictest peer, callgrind instruction counts
+  rt-tests valgrind bc                          # cyclictest peer, callgrind counts, bench arithmetic
   gnuplot-nox                                   # `hiltwin assess --plot`
 )
 

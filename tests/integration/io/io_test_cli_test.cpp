@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "hiltwin/io/wire_bus.h"
-#include "process.h"
+#include "fakes/process.h"
 
 namespace hiltwin {
 namespace {

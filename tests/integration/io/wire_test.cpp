@@ -17,7 +17,7 @@
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/clock.h"
-#include "process.h"
+#include "fakes/process.h"
 
 namespace hiltwin::io {
 namespace {
