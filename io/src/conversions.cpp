@@ -1,6 +1,7 @@
 #include "hiltwin/io/conversions.h"
 
 #include <cmath>
+#include <numbers>
 
 namespace hiltwin::io {
 
@@ -38,9 +39,13 @@ std::int32_t PwmReaderValue(double duty) noexcept {
   return duty < 0.0 ? -value : value;
 }
 
+double CountsPerMetre(const WheelGeometry& geometry) noexcept {
+  return geometry.motor_rev_per_wheel_rev * geometry.counts_per_motor_rev /
+         (2.0 * std::numbers::pi * geometry.wheel_radius_m);
+}
+
 std::int64_t MetresToCounts(double metres, const WheelGeometry& geometry) noexcept {
-  const double counts =
-      metres / geometry.wheel_radius_m / geometry.gear_ratio * geometry.encoder_counts_per_rev;
+  const double counts = metres * CountsPerMetre(geometry);
   if (!std::isfinite(counts)) return 0;
   constexpr double kLimit = 4.611686018427387904e18;  // 2^62
   if (counts >= kLimit) return static_cast<std::int64_t>(kLimit);
@@ -49,11 +54,11 @@ std::int64_t MetresToCounts(double metres, const WheelGeometry& geometry) noexce
 }
 
 double CountsToMetres(std::int64_t counts, const WheelGeometry& geometry) noexcept {
-  return static_cast<double>(counts) / geometry.encoder_counts_per_rev * geometry.gear_ratio *
-         geometry.wheel_radius_m;
+  return static_cast<double>(counts) / CountsPerMetre(geometry);
 }
 
 std::int32_t WrapToRelative(std::int64_t absolute_counts, std::int32_t resolution) noexcept {
+  if (resolution < 2) return 0;  // outside the precondition: no position can be represented
   const std::int64_t half = resolution / 2;
   if (resolution > 0 && (resolution & (resolution - 1)) == 0) {
     // Power of two (the usual 16384): a mask instead of a division, on the per-cycle path.

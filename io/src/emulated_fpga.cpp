@@ -21,6 +21,13 @@ void EmulatedFpga::ResetState() noexcept {
   pwm_values_.fill(0);
   counts_.fill(0);
   pins_out_.fill(false);
+  lines_.Reset();
+}
+
+void EmulatedFpga::PublishPeriod() noexcept {
+  if (encoder_sink_ == nullptr) return;
+  for (std::size_t c = 0; c < kChannels; ++c) period_scratch_[c] = emulators_[c].segment();
+  encoder_sink_->OnPeriod(period_scratch_);
 }
 
 void EmulatedFpga::Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept {
@@ -104,6 +111,7 @@ void EmulatedFpga::HandleInit(const Frame& request, Frame& answer) noexcept {
   answer.init_answer.clock_divider = divider_;
   time_ns_ = clock_ != nullptr ? clock_->NowNs() : 0;
   for (auto& emulator : emulators_) emulator.StartPeriod(0, time_ns_);
+  if (image_ == Image::kIcoboardInverse) PublishPeriod();
 }
 
 void EmulatedFpga::HandleAll(const Frame& request, Frame& answer) noexcept {
@@ -120,6 +128,7 @@ void EmulatedFpga::HandleAll(const Frame& request, Frame& answer) noexcept {
       if (!emulators_[c].StartPeriod(request.enc[c].counts, t_ns)) pulse_limit_ = true;
       pins_out_[c] = request.enc[c].pin;
     }
+    PublishPeriod();
     duty_scratch_.fill(0.0);
     if (pwm_source_ != nullptr) pwm_source_->DutyAt(t_ns, duty_scratch_);
     for (std::size_t c = 0; c < kChannels; ++c) {
@@ -131,9 +140,9 @@ void EmulatedFpga::HandleAll(const Frame& request, Frame& answer) noexcept {
       pwm_values_[c] = PwmValueFromWord(request.pwm[c]);
       pins_out_[c] = request.pwm[c].pin;
     }
-    if (encoder_source_ != nullptr && !faults_.stick_encoder) {
-      encoder_source_->CountsAt(t_ns, counts_);
-      for (auto& count : counts_) count = WrapToRelative(count);
+    if (encoder_source_ != nullptr) {
+      lines_.Update(*encoder_source_, t_ns, faults_.stick_encoder);
+      for (std::size_t c = 0; c < kChannels; ++c) counts_[c] = lines_.relative_counts(c);
     }
     for (std::size_t c = 0; c < kChannels; ++c) {
       answer.enc[c] = EncWord{static_cast<std::int16_t>(counts_[c]), pins_in_[c]};
@@ -153,11 +162,6 @@ void EmulatedFpga::FillReadback(Opcode opcode, Frame& answer) const noexcept {
   } else {
     answer.enc[c] = EncWord{static_cast<std::int16_t>(counts_[c]), pins_in_[c]};
   }
-}
-
-void EmulatorToReaderLink::CountsAt(std::int64_t t_ns,
-                                    std::array<std::int32_t, kChannels>& counts_out) noexcept {
-  for (std::size_t c = 0; c < kChannels; ++c) counts_out[c] = twin_.encoder(c).PositionAt(t_ns);
 }
 
 void GeneratorToReaderLink::DutyAt(std::int64_t /*t_ns*/,

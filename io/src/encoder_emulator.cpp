@@ -1,5 +1,7 @@
 #include "hiltwin/io/encoder_emulator.h"
 
+#include <limits>
+
 namespace hiltwin::io {
 
 std::uint32_t ClockDividerForStep(std::int64_t step_ns) noexcept {
@@ -127,6 +129,13 @@ void QuadratureReader::Reset(QuadratureLevels levels, std::int64_t counts,
   last_change_ns_ = t_ns;
   illegal_ = 0;
   too_fast_ = 0;
+}
+
+void QuadratureReader::Resync(QuadratureLevels levels, std::int64_t counts) noexcept {
+  levels_ = levels;
+  counts_ = counts;
+  // Held "forever": the next edge cannot count as too fast (no real state change happened).
+  last_change_ns_ = std::numeric_limits<std::int64_t>::min() / 2;
 }
 
 void QuadratureReader::OnLevels(QuadratureLevels levels, std::int64_t t_ns) noexcept {

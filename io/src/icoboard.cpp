@@ -80,6 +80,14 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     status.reason = DecodeReason(error);
     return status;
   }
+  // Rejection first: the board echoes the damaged request's opcode and sequence bytes, so a flip
+  // there must not read as a stale answer or an answer to another opcode.
+  if ((answer.status & kStatusRequestRejected) != 0) {
+    ++counters_.frames_corrupted;
+    status.code = ExchangeStatus::Code::kCorrupted;
+    status.reason = "the board rejected the request (damaged on the way)";
+    return status;
+  }
   if (answer.sequence != request.sequence) {
     ++counters_.frames_missed;
     status.code = ExchangeStatus::Code::kMissed;
@@ -90,12 +98,6 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     ++counters_.frames_corrupted;
     status.code = ExchangeStatus::Code::kCorrupted;
     status.reason = "answer to a different opcode";
-    return status;
-  }
-  if ((answer.status & kStatusRequestRejected) != 0) {
-    ++counters_.frames_corrupted;
-    status.code = ExchangeStatus::Code::kCorrupted;
-    status.reason = "the board rejected the request (damaged on the way)";
     return status;
   }
   const bool data = request.opcode != Opcode::kInit && request.opcode != Opcode::kTest &&
@@ -194,12 +196,14 @@ ExchangeStatus IcoBoardInverse::Exchange(
       ++counters_.counts_over_limit;
       over_limit = true;
     }
-    last_counts_[c] = counts;
     request_.enc[c] = EncWord{static_cast<std::int16_t>(WrapToRelative(counts)), pins_out_[c]};
   }
   ExchangeStatus status = Transact(request_, answer_);
   status.pulse_limit = over_limit;
   if (!status.ok()) return status;
+  // Only an acknowledged request is known to have moved the board's target; after a failed one
+  // the next change is still measured from the last position the board confirmed.
+  for (std::size_t c = 0; c < kChannels; ++c) last_counts_[c] = encoder_counts_out[c];
   for (std::size_t c = 0; c < kChannels; ++c) {
     in.pwm[c] = PwmValueFromWord(answer_.pwm[c]);
     in.duty[c] = PwmToDuty(in.pwm[c]);

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
@@ -19,11 +20,12 @@ namespace hiltwin::io {
 
 namespace {
 constexpr std::uint64_t kMagic = 0x6869'6C74'7769'7265ULL;  // "hiltwire"
-constexpr std::uint32_t kLayoutVersion = 1;
+constexpr std::uint32_t kLayoutVersion = 2;  // 2: encoder periods in a ring
 constexpr std::uint32_t kFresh = 0;
 constexpr std::uint32_t kInitialising = 1;
 constexpr std::uint32_t kReady = 2;
-constexpr int kSeqlockAttempts = 16;
+/// twin_sampling_ns when the twin is not inside a transfer.
+constexpr std::int64_t kNotSampling = std::numeric_limits<std::int64_t>::max();
 }  // namespace
 
 /// One process's presence on the wire.
@@ -34,6 +36,17 @@ struct WireSide {
   std::atomic<std::int32_t> pid;
   std::atomic<std::uint32_t> attached;
   std::atomic<std::uint32_t> sessions;
+};
+
+/// One encoder period in the ring; each slot is a single-writer seqlock of its own.
+struct WirePeriod {
+  std::atomic<std::uint64_t> sequence;  ///< 2·index when complete, 2·index + 1 while written
+  std::atomic<std::int64_t> start_ns;
+  std::atomic<std::uint32_t> subticks;
+  std::atomic<std::uint32_t> divider;
+  std::atomic<std::uint64_t> start_counts;  ///< 4 × 16-bit two's complement
+  std::atomic<std::uint64_t> pulses;        ///< 4 × 16 bits (at most 8192 each)
+  std::atomic<std::uint32_t> directions;    ///< 4 × 8-bit two's complement
 };
 
 /// The shared segment. Zero-filled memory is a valid initial state of every field.
@@ -47,15 +60,13 @@ struct WireSegment {
   WireSide twin;
   /// ECS -> twin: four packed PWM words (direction, pin, magnitude), 16 bits each.
   std::atomic<std::uint64_t> pwm_words;
-  /// Twin -> ECS encoder lines, guarded by a single-writer seqlock.
-  std::atomic<std::uint32_t> encoder_sequence;
-  std::atomic<std::int64_t> encoder_start_ns;
-  std::atomic<std::uint32_t> encoder_subticks;
-  std::atomic<std::uint32_t> encoder_divider;
-  std::atomic<std::uint64_t> encoder_start_counts;  ///< 4 × 16-bit two's complement
-  std::atomic<std::uint64_t> encoder_pulses;        ///< 4 × 16 bits
-  std::atomic<std::uint32_t> encoder_directions;    ///< 4 × 8-bit two's complement
-  std::atomic<std::uint32_t> twin_pins;             ///< bit c = digital output c of the twin
+  std::atomic<std::uint32_t> twin_pins;  ///< bit c = digital output c of the twin
+  /// Twin -> ECS encoder lines: the twin's emulator periods, newest index last published.
+  std::atomic<std::uint64_t> encoder_newest;
+  /// The twin's clock when it began the transfer in progress (kNotSampling outside one): a
+  /// period it is about to publish starts no earlier, so the ECS replays edges only up to here.
+  std::atomic<std::int64_t> twin_sampling_ns;
+  WirePeriod encoder_periods[kEncoderLineHistory];
 };
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&
                   std::atomic<std::int64_t>::is_always_lock_free &&
@@ -64,45 +75,14 @@ static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&
 
 namespace {
 
+/// kill(pid, 0) succeeds, or fails only for lack of permission: the process exists.
+bool ProcessAlive(std::int32_t pid) noexcept { return ::kill(pid, 0) == 0 || errno == EPERM; }
+
 std::uint64_t Pack16(std::size_t c, std::uint16_t value) noexcept {
   return std::uint64_t{value} << (16U * c);
 }
 std::uint16_t Unpack16(std::uint64_t packed, std::size_t c) noexcept {
   return static_cast<std::uint16_t>((packed >> (16U * c)) & 0xFFFFU);
-}
-
-/// The encoder lines as the ECS side last read them.
-struct EncoderSnapshot {
-  std::array<PulseSegment, kChannels> segments{};
-  std::uint32_t pins = 0;
-};
-
-bool ReadEncoder(const WireSegment& seg, EncoderSnapshot& out) noexcept {
-  for (int attempt = 0; attempt < kSeqlockAttempts; ++attempt) {
-    const std::uint32_t before = seg.encoder_sequence.load(std::memory_order_acquire);
-    if ((before & 1U) != 0) continue;  // writer inside
-    const std::int64_t start_ns = seg.encoder_start_ns.load(std::memory_order_relaxed);
-    const std::uint32_t subticks = seg.encoder_subticks.load(std::memory_order_relaxed);
-    const std::uint32_t divider = seg.encoder_divider.load(std::memory_order_relaxed);
-    const std::uint64_t starts = seg.encoder_start_counts.load(std::memory_order_relaxed);
-    const std::uint64_t pulses = seg.encoder_pulses.load(std::memory_order_relaxed);
-    const std::uint32_t directions = seg.encoder_directions.load(std::memory_order_relaxed);
-    const std::uint32_t pins = seg.twin_pins.load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
-    if (seg.encoder_sequence.load(std::memory_order_relaxed) != before) continue;
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      PulseSegment& s = out.segments[c];
-      s.start_counts = static_cast<std::int16_t>(Unpack16(starts, c));
-      s.pulses = Unpack16(pulses, c);
-      s.direction = static_cast<std::int8_t>((directions >> (8U * c)) & 0xFFU);
-      s.start_ns = start_ns;
-      s.subticks = subticks;
-      s.divider = divider;
-    }
-    out.pins = pins;
-    return true;
-  }
-  return false;
 }
 
 }  // namespace
@@ -121,20 +101,74 @@ class WireBus::PwmWire final : public PwmSignalSource {
   const WireSegment& seg_;
 };
 
-class WireBus::EncoderWire final : public EncoderLineSource {
+/// Twin side: publishes the board's emulator periods into the ring. ECS side: reads them.
+class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSource {
  public:
-  EncoderWire(const WireSegment& seg, std::uint64_t& fallbacks) noexcept
-      : seg_(seg), fallbacks_(fallbacks) {}
-  void CountsAt(std::int64_t t_ns, std::array<std::int32_t, kChannels>& counts_out) noexcept override {
-    if (!ReadEncoder(seg_, snapshot_)) ++fallbacks_;
-    for (std::size_t c = 0; c < kChannels; ++c) counts_out[c] = snapshot_.segments[c].PositionAt(t_ns);
+  explicit EncoderWire(WireSegment& seg) noexcept : seg_(seg) {}
+
+  void OnPeriod(const std::array<PulseSegment, kChannels>& channels) noexcept override {
+    const std::uint64_t index = seg_.encoder_newest.load(std::memory_order_relaxed) + 1;
+    WirePeriod& slot = seg_.encoder_periods[index % kEncoderLineHistory];
+    std::uint64_t starts = 0;
+    std::uint64_t pulses = 0;
+    std::uint32_t directions = 0;
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      starts |= Pack16(c, static_cast<std::uint16_t>(channels[c].start_counts));
+      pulses |= Pack16(c, static_cast<std::uint16_t>(channels[c].pulses));
+      directions |= static_cast<std::uint32_t>(static_cast<std::uint8_t>(channels[c].direction))
+                    << (8U * c);
+    }
+    slot.sequence.store(2 * index + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    slot.start_ns.store(channels[0].start_ns, std::memory_order_relaxed);
+    slot.subticks.store(channels[0].subticks, std::memory_order_relaxed);
+    slot.divider.store(channels[0].divider, std::memory_order_relaxed);
+    slot.start_counts.store(starts, std::memory_order_relaxed);
+    slot.pulses.store(pulses, std::memory_order_relaxed);
+    slot.directions.store(directions, std::memory_order_relaxed);
+    slot.sequence.store(2 * index, std::memory_order_release);
+    seg_.encoder_newest.store(index, std::memory_order_release);
   }
-  [[nodiscard]] std::uint32_t pins() const noexcept { return snapshot_.pins; }
+
+  LineView Lines(std::int64_t /*t_ns*/) noexcept override {
+    LineView view;
+    // seq_cst pairs with the twin's store: a sample that begins after this load reads its clock
+    // after the ECS read its own, so it cannot cancel edges the ECS replays now.
+    view.known_until_ns = seg_.twin_sampling_ns.load(std::memory_order_seq_cst);
+    view.newest = seg_.encoder_newest.load(std::memory_order_acquire);
+    return view;
+  }
+
+  bool Period(std::uint64_t index, EncoderPeriod& out) noexcept override {
+    if (index == 0) return false;
+    const WirePeriod& slot = seg_.encoder_periods[index % kEncoderLineHistory];
+    // Not 2·index: overwritten by a newer period (or being overwritten). No retry needed: an
+    // index the reader asks for was complete before encoder_newest named it.
+    const std::uint64_t before = slot.sequence.load(std::memory_order_acquire);
+    if (before != 2 * index) return false;
+    const std::int64_t start_ns = slot.start_ns.load(std::memory_order_relaxed);
+    const std::uint32_t subticks = slot.subticks.load(std::memory_order_relaxed);
+    const std::uint32_t divider = slot.divider.load(std::memory_order_relaxed);
+    const std::uint64_t starts = slot.start_counts.load(std::memory_order_relaxed);
+    const std::uint64_t pulses = slot.pulses.load(std::memory_order_relaxed);
+    const std::uint32_t directions = slot.directions.load(std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (slot.sequence.load(std::memory_order_relaxed) != before) return false;
+    out.index = index;
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      PulseSegment& s = out.channels[c];
+      s.start_counts = static_cast<std::int16_t>(Unpack16(starts, c));
+      s.pulses = Unpack16(pulses, c);
+      s.direction = static_cast<std::int8_t>((directions >> (8U * c)) & 0xFFU);
+      s.start_ns = start_ns;
+      s.subticks = subticks;
+      s.divider = divider;
+    }
+    return true;
+  }
 
  private:
-  const WireSegment& seg_;
-  std::uint64_t& fallbacks_;
-  EncoderSnapshot snapshot_{};
+  WireSegment& seg_;
 };
 
 std::string WireBus::SegmentName(const std::string& name) {
@@ -200,15 +234,28 @@ WireBus::WireBus(const std::string& name, Image side)
   }
 
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
+  WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
   const std::int32_t previous_pid = self.pid.load();
-  if (self.attached.load() != 0 && previous_pid > 0 &&
-      (::kill(previous_pid, 0) == 0 || errno == EPERM)) {
+  if (self.attached.load() != 0 && previous_pid > 0 && ProcessAlive(previous_pid)) {
     ::munmap(segment_, sizeof(WireSegment));
     segment_ = nullptr;
     throw std::runtime_error(label_ + " already has a" +
                              (side_ == Image::kIcoboard ? "n ECS" : " twin") +
                              " attached (pid " + std::to_string(previous_pid) +
                              "); stop it first or use another wire name");
+  }
+  // A peer that crashed never detached: its flags would make this process report "stopped
+  // updating its heartbeat" (or "detached") although no peer has been there since it started.
+  std::int32_t peer_pid = peer.pid.load();
+  if (peer_pid > 0 && !ProcessAlive(peer_pid) && peer.pid.compare_exchange_strong(peer_pid, 0)) {
+    peer.attached.store(0);
+    peer.sessions.store(0);
+    // A new peer stores its pid before its flags: if one arrived while these were cleared,
+    // give its presence back.
+    if (peer.pid.load() != 0) {
+      peer.attached.store(1);
+      peer.sessions.fetch_add(1);
+    }
   }
   self.pid.store(::getpid());
   self.step_ns.store(0);
@@ -219,9 +266,11 @@ WireBus::WireBus(const std::string& name, Image side)
   segment_->attach_count.fetch_add(1);
 
   pwm_wire_ = std::make_unique<PwmWire>(*segment_);
-  encoder_wire_ = std::make_unique<EncoderWire>(*segment_, seqlock_fallbacks_);
+  encoder_wire_ = std::make_unique<EncoderWire>(*segment_);
   if (side_ == Image::kIcoboardInverse) {
+    segment_->twin_sampling_ns.store(kNotSampling);  // a crashed twin may have left it set
     board_.SetPwmSource(pwm_wire_.get());
+    board_.SetEncoderSink(encoder_wire_.get());
   } else {
     board_.SetEncoderSource(encoder_wire_.get());
   }
@@ -236,8 +285,7 @@ WireBus::~WireBus() {
   // The last one out removes the segment. A peer that crashed never detached, so its pid is
   // checked too; a running peer keeps its mapping even if the name is removed under it.
   const std::int32_t peer_pid = peer.pid.load();
-  const bool peer_alive = peer.attached.load() != 0 && peer_pid > 0 &&
-                          (::kill(peer_pid, 0) == 0 || errno == EPERM);
+  const bool peer_alive = peer.attached.load() != 0 && peer_pid > 0 && ProcessAlive(peer_pid);
   if (!peer_alive) ::shm_unlink(segment_name_.c_str());
   ::munmap(segment_, sizeof(WireSegment));
 }
@@ -251,29 +299,11 @@ void WireBus::Publish(std::int64_t now_ns) noexcept {
     }
     seg.pwm_words.store(words, std::memory_order_release);
   } else {
-    std::uint64_t starts = 0;
-    std::uint64_t pulses = 0;
-    std::uint32_t directions = 0;
-    std::uint32_t pins = 0;
+    std::uint32_t pins = 0;  // the encoder periods went out through the sink already
     for (std::size_t c = 0; c < kChannels; ++c) {
-      const PulseSegment& s = board_.encoder(c).segment();
-      starts |= Pack16(c, static_cast<std::uint16_t>(s.start_counts));
-      pulses |= Pack16(c, static_cast<std::uint16_t>(s.pulses));
-      directions |= (static_cast<std::uint32_t>(static_cast<std::uint8_t>(s.direction))) << (8U * c);
       if (board_.pins_out()[c]) pins |= 1U << c;
     }
-    const PulseSegment& first = board_.encoder(0).segment();
-    const std::uint32_t sequence = seg.encoder_sequence.load(std::memory_order_relaxed);
-    seg.encoder_sequence.store(sequence + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
-    seg.encoder_start_ns.store(first.start_ns, std::memory_order_relaxed);
-    seg.encoder_subticks.store(first.subticks, std::memory_order_relaxed);
-    seg.encoder_divider.store(first.divider, std::memory_order_relaxed);
-    seg.encoder_start_counts.store(starts, std::memory_order_relaxed);
-    seg.encoder_pulses.store(pulses, std::memory_order_relaxed);
-    seg.encoder_directions.store(directions, std::memory_order_relaxed);
-    seg.twin_pins.store(pins, std::memory_order_relaxed);
-    seg.encoder_sequence.store(sequence + 2, std::memory_order_release);
+    seg.twin_pins.store(pins, std::memory_order_release);
   }
   WireSide& self = side_ == Image::kIcoboard ? seg.ecs : seg.twin;
   self.step_ns.store(board_.step_ns(), std::memory_order_relaxed);
@@ -319,9 +349,16 @@ BusStatus WireBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
     for (std::size_t c = 0; c < kChannels; ++c) pins[c] = ((bits >> c) & 1U) != 0;
   }
   board_.SetDigitalInputs(pins);
+  const bool twin = side_ == Image::kIcoboardInverse;
+  if (twin) seg.twin_sampling_ns.store(clock_.NowNs(), std::memory_order_seq_cst);
   board_.Exchange(mosi, miso);
+  if (twin) seg.twin_sampling_ns.store(kNotSampling, std::memory_order_seq_cst);
   Publish(clock_.NowNs());
   return PeerStatus();
+}
+
+bool WireBus::ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept {
+  return encoder_wire_->Period(index, out);
 }
 
 }  // namespace hiltwin::io

@@ -3,7 +3,8 @@
 //                                            channel (a static-gain plant), so the ECS sees its own
 //                                            PWM come back through the encoder path
 //   hiltwin_io_wire_peer ecs NAME RATE_HZ    ECS side: PWM channel c = 100·(c+1)
-// Runs until SIGTERM/SIGINT (or SIGKILL, which the tests use to simulate a crash).
+// Prints "ready" once attached and initialised, then runs until SIGTERM/SIGINT (or SIGKILL, which
+// the tests use to simulate a crash).
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -36,6 +37,8 @@ int main(int argc, char** argv) {
   if (image == io::Image::kIcoboardInverse) {
     io::IcoBoardInverse driver(bus);
     if (!driver.Init(period_ns).ok) return 5;
+    std::printf("ready\n");
+    std::fflush(stdout);
     io::TwinInputs in;
     std::array<std::int32_t, io::kChannels> out{};
     while (g_stop == 0) {
@@ -47,6 +50,8 @@ int main(int argc, char** argv) {
   } else {
     io::IcoBoard driver(bus);
     if (!driver.Init(period_ns).ok) return 5;
+    std::printf("ready\n");
+    std::fflush(stdout);
     io::EcsInputs in;
     while (g_stop == 0) {
       (void)driver.Exchange({100, 200, 300, 400}, in);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <limits>
 
 namespace hiltwin::io {
@@ -47,10 +48,16 @@ TEST(Conversions, PwmReaderHalvesTheHighTimeIntoElevenBits) {
   for (int v = -2047; v <= 2047; ++v) EXPECT_EQ(PwmReaderValue(PwmToDuty(v)), v) << v;
 }
 
-TEST(Conversions, MetresToCountsFollowsAppendixG) {
-  const WheelGeometry g{0.05, 1.0 / 15.0, 1024.0};
-  // 1 m / 0.05 m = 20 wheel radians / (1/15) = 300 motor radians... as the seed code computes it.
-  const double expected = 1.0 / 0.05 / (1.0 / 15.0) * 1024.0;
+TEST(Conversions, MetresToCountsCountsMotorTurns) {
+  // r = 0.05 m, 15 motor turns per wheel turn, 1024 counts per motor turn.
+  const WheelGeometry g{0.05, 15.0, 1024.0};
+  // One wheel turn is 2π·0.05 m of travel, 15 motor turns, 15 360 counts.
+  const double one_wheel_turn_m = 2.0 * std::numbers::pi * 0.05;
+  EXPECT_NEAR(CountsPerMetre(g), 15.0 * 1024.0 / one_wheel_turn_m, 1e-9);
+  EXPECT_EQ(MetresToCounts(one_wheel_turn_m * (1.0 + 1e-12), g), 15 * 1024);
+  EXPECT_EQ(MetresToCounts(-one_wheel_turn_m * (1.0 + 1e-12), g), -15 * 1024 - 1);
+  EXPECT_NEAR(CountsToMetres(15 * 1024, g), one_wheel_turn_m, 1e-15);
+  const double expected = 1.0 / one_wheel_turn_m * 15.0 * 1024.0;  // 48 892.9 counts in 1 m
   EXPECT_EQ(MetresToCounts(1.0, g), static_cast<std::int64_t>(std::floor(expected)));
   EXPECT_EQ(MetresToCounts(0.0, g), 0);
   EXPECT_EQ(MetresToCounts(-1e-12, g), -1);  // floor, not truncation: no double-width zero
@@ -73,7 +80,14 @@ TEST(Conversions, WrapToRelativeMatchesTheAppendixGLoops) {
   for (std::int64_t v = -40000; v <= 40000; v += 7) {
     EXPECT_EQ(WrapToRelative(v), reference(v, 16384)) << v;
     EXPECT_EQ(WrapToRelative(v, 4096), reference(v, 4096)) << v;
+    // Resolutions that are not powers of two take the remainder branch.
+    EXPECT_EQ(WrapToRelative(v, 1000), reference(v, 1000)) << v;
+    EXPECT_EQ(WrapToRelative(v, 4000), reference(v, 4000)) << v;
   }
+  EXPECT_EQ(WrapToRelative(std::numeric_limits<std::int64_t>::min(), 1000),
+            reference(std::numeric_limits<std::int64_t>::min() % 1000, 1000));
+  EXPECT_EQ(WrapToRelative(12345, 0), 0);  // outside the precondition, but no division by zero
+  EXPECT_EQ(WrapToRelative(12345, -16384), 0);
   EXPECT_EQ(WrapToRelative(8191), 8191);
   EXPECT_EQ(WrapToRelative(8192), -8192);
   EXPECT_EQ(WrapToRelative(-8192), -8192);

@@ -193,6 +193,47 @@ TEST(IcoBoardInverse, ChangesBeyondThePulseLimitAreReported) {
   EXPECT_NE(in.board_status & kStatusPulseLimit, 0);
 }
 
+TEST(IcoBoardLink, EveryDamagedRequestBitIsCountedAsCorruptedNotMissed) {
+  // The board echoes a damaged request's opcode and sequence bytes in its REQUEST_REJECTED answer:
+  // a flip in the sequence byte must not pass for a stale answer. The hook flips bit 0, 1, ... 95
+  // on successive corrupted requests.
+  TwinRig rig;
+  RampSource source;
+  rig.board.SetPwmSource(&source);
+  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  TwinInputs in;
+  ASSERT_TRUE(rig.driver.Exchange({10, 20, 30, 40}, in).ok());
+  ASSERT_TRUE(rig.driver.Exchange({10, 20, 30, 40}, in).ok());
+  const TwinInputs held = in;
+  for (std::uint32_t bit = 0; bit < kFrameBytes * 8; ++bit) {
+    rig.board.faults().corrupt_requests = 1;
+    const ExchangeStatus s = rig.driver.Exchange({5000, 20, 30, 40}, in);
+    EXPECT_EQ(s.code, ExchangeStatus::Code::kCorrupted) << "bit " << bit << ": " << s.reason;
+    EXPECT_EQ(in.pwm, held.pwm) << "bit " << bit;
+  }
+  EXPECT_EQ(rig.board.requests_rejected(), kFrameBytes * 8);
+  EXPECT_EQ(rig.driver.counters().frames_corrupted, kFrameBytes * 8);
+  EXPECT_EQ(rig.driver.counters().frames_missed, 0U);
+  // No damaged request was acted upon: the emulator still heads for the last accepted target.
+  EXPECT_EQ(rig.board.encoder(0).PositionAt(1'000'000'000), 10);
+}
+
+TEST(IcoBoardInverse, AFailedExchangeDoesNotMoveThePulseLimitReference) {
+  TwinRig rig;
+  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  const auto limit = static_cast<std::int32_t>(MaxCountsPerStep(kStepNs, ClockDividerForStep(kStepNs)));
+  TwinInputs in;
+  rig.board.faults().corrupt_requests = 1;
+  EXPECT_EQ(rig.driver.Exchange({limit, 0, 0, 0}, in).code, ExchangeStatus::Code::kCorrupted);
+  EXPECT_EQ(rig.driver.counters().counts_over_limit, 0U);
+  // The board never took `limit`: from its position 0, limit + 1 is over the limit.
+  const ExchangeStatus s = rig.driver.Exchange({limit + 1, 0, 0, 0}, in);
+  EXPECT_TRUE(s.ok()) << s.reason;
+  EXPECT_TRUE(s.pulse_limit);
+  EXPECT_EQ(rig.driver.counters().counts_over_limit, 1U);
+  EXPECT_EQ(rig.driver.counters().pulse_limit_events, 1U);  // and the board agrees
+}
+
 TEST(IcoBoardLink, TestFrameEchoes) {
   TwinRig rig;
   std::array<std::uint8_t, 8> echo{};
@@ -266,6 +307,8 @@ TEST(IcoBoard, PerCycleExchangeAllocatesNothing) {
   rig.board.SetPwmSource(&source);
   ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
   EmulatedFpga ecs_board(Image::kIcoboard);
+  EmulatorToReaderLink lines(rig.board);  // the ECS readers decode the twin's edges
+  ecs_board.SetEncoderSource(&lines);
   EmulatedSpiBus ecs_bus(ecs_board);
   IcoBoard ecs(ecs_bus);
   ASSERT_TRUE(ecs.Init(kStepNs).ok);
@@ -285,6 +328,7 @@ TEST(IcoBoard, PerCycleExchangeAllocatesNothing) {
   }
   EXPECT_EQ(allocations, 0U);
   EXPECT_GT(rig.driver.counters().frames_corrupted, 0U);
+  EXPECT_GT(ecs_board.encoder_lines().counters().edges, 1000U);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // Quadrature reliability (thesis §5.5, Table 5.2: 720,000 messages sent, 720,000 received, 0
-// missed): the twin image's encoder emulator turns random position changes into A/B edges at
-// their clock-accurate times; the ECS image's reader decodes them. After every period the reader
-// must hold exactly the position that was sent. Run at 1, 4, 8 and 16 kHz; changes include
+// missed), through the real board path: the twin's driver sends random positions to the twin
+// board, whose encoder emulator spreads the pulses over the next period; the ECS board's
+// quadrature readers decode those A/B edges at their clock-accurate times and the ECS driver
+// reads the counts back. One period later the ECS must hold exactly the position that was sent.
+// Run at 1, 4, 8 and 16 kHz on two channels with independent streams; changes include
 // wrap-arounds (all four cases of Table 4.1), direction reversals and jumps up to the pulse-rate
 // limit. Under the sanitizers the message count is cut tenfold to keep CI fast.
 #include <gtest/gtest.h>
@@ -9,7 +11,10 @@
 #include <array>
 #include <random>
 
+#include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_emulator.h"
+#include "hiltwin/io/icoboard.h"
+#include "board_pair.h"
 
 namespace hiltwin::io {
 namespace {
@@ -19,82 +24,113 @@ constexpr int kMessages = 72'000;
 #else
 constexpr int kMessages = 720'000;
 #endif
+constexpr std::size_t kRandomChannels = 2;
 
 struct Tally {
   int sent = 0;
   int received_ok = 0;
   std::uint64_t count_errors = 0;
+  std::uint64_t edges = 0;  ///< A/B edges the ECS readers decoded
   std::array<int, 5> cases{};
+};
+
+/// Random position changes as in the thesis' test: mostly small, some large, some at the limit,
+/// every tenth a hard reversal of the previous change.
+class ChangeStream {
+ public:
+  ChangeStream(std::uint64_t seed, std::int64_t limit) : rng_(seed), large_(-limit, limit) {}
+  std::int64_t Next() {
+    const int roll = kind_(rng_);
+    std::int64_t change = 0;
+    if (roll < 94) {
+      change = small_(rng_);
+    } else if (roll < 99) {
+      change = large_(rng_) / 4;
+    } else {
+      change = large_(rng_);
+    }
+    if (roll % 10 == 0) change = -previous_;
+    previous_ = change;
+    return change;
+  }
+
+ private:
+  std::mt19937_64 rng_;
+  std::uniform_int_distribution<std::int64_t> small_{-100, 100};
+  std::uniform_int_distribution<std::int64_t> large_;
+  std::uniform_int_distribution<int> kind_{0, 99};
+  std::int64_t previous_ = 0;
 };
 
 Tally RunReliability(double rate_hz, std::uint64_t seed) {
   const auto step_ns = static_cast<std::int64_t>(1e9 / rate_hz + 0.5);
-  const std::uint32_t divider = ClockDividerForStep(step_ns);
-  const auto limit = static_cast<std::int64_t>(MaxCountsPerStep(step_ns, divider));
-  EncoderEmulator emulator;
-  EXPECT_TRUE(emulator.Configure(step_ns, divider));
-  QuadratureReader reader;
-  reader.Reset(LevelsAt(0), 0, 0);
+  const auto limit = static_cast<std::int64_t>(MaxCountsPerStep(step_ns, ClockDividerForStep(step_ns)));
+  // Both boards on one virtual timeline: the k-th ALL frame of each happens at k·step.
+  BoardPair boards;
+  IcoBoardInverse& twin = boards.twin;
+  IcoBoard& ecs = boards.ecs;
+  EmulatedFpga& twin_board = boards.twin_board;
+  EmulatedFpga& ecs_board = boards.ecs_board;
+  EXPECT_TRUE(twin.Init(step_ns).ok);
+  EXPECT_TRUE(ecs.Init(step_ns).ok);
 
-  std::mt19937_64 rng(seed);
-  std::uniform_int_distribution<std::int64_t> small(-100, 100);
-  std::uniform_int_distribution<std::int64_t> large(-limit, limit);
-  std::uniform_int_distribution<int> kind(0, 99);
+  std::array<ChangeStream, kRandomChannels> streams = {ChangeStream(seed, limit),
+                                                        ChangeStream(seed + 1, limit)};
+  std::array<std::int32_t, kChannels> sent{};      // the twin's absolute positions
+  std::array<std::int32_t, kChannels> previous{};  // what the ECS must read one period later
+  TwinInputs twin_in;
+  EcsInputs ecs_in;
   Tally tally;
-  std::int64_t sent_absolute = 0;     // the twin's absolute position
-  std::int64_t emitted_absolute = 0;  // the emulator's lines, unwrapped
-  std::int64_t previous_change = 0;
-  for (int k = 0; k < kMessages; ++k) {
-    const std::int64_t t_ns = k * step_ns;
-    const int roll = kind(rng);
-    std::int64_t change = 0;
-    if (roll < 94) {
-      change = small(rng);
-    } else if (roll < 99) {
-      change = large(rng) / 4;
-    } else {
-      change = large(rng);
+  for (int k = 0; k <= kMessages; ++k) {
+    if (k < kMessages) {
+      for (std::size_t c = 0; c < kRandomChannels; ++c) {
+        sent[c] = static_cast<std::int32_t>(sent[c] + streams[c].Next());
+      }
+      const ExchangeStatus status = twin.Exchange(sent, twin_in);
+      if (!status.ok() || status.pulse_limit) ++tally.count_errors;
+      ++tally.sent;
+      tally.cases[static_cast<std::size_t>(twin_board.encoder(0).last_case())]++;
     }
-    if (roll % 10 == 0) change = -previous_change;  // a hard direction reversal
-    previous_change = change;
-    sent_absolute += change;
-    ++tally.sent;
-
-    if (!emulator.StartPeriod(WrapToRelative(sent_absolute), t_ns)) ++tally.count_errors;
-    tally.cases[static_cast<std::size_t>(emulator.last_case())]++;
-    const PulseSegment& s = emulator.segment();
-    for (std::uint32_t j = 1; j <= s.pulses; ++j) {
-      const std::int64_t edge_ns = s.EdgeTimeNs(j);
-      if (edge_ns > t_ns + step_ns) ++tally.count_errors;  // pulses must fit in the period
-      reader.OnLevels(LevelsAt(emitted_absolute + s.direction * std::int64_t{j}), edge_ns);
+    // The ECS samples at the same moment: the previous period's pulses are all out.
+    if (!ecs.Exchange({0, 0, 0, 0}, ecs_in).ok()) ++tally.count_errors;
+    if (k > 0) {
+      bool all = true;
+      for (std::size_t c = 0; c < kChannels; ++c) {
+        all = all && ecs_in.absolute_counts[c] == previous[c] &&
+              ecs_in.counts[c] == WrapToRelative(previous[c]);
+      }
+      if (all) {
+        ++tally.received_ok;
+      } else {
+        ++tally.count_errors;
+      }
     }
-    emitted_absolute += s.direction * std::int64_t{s.pulses};
-    if (reader.counts() == sent_absolute && reader.relative_counts() == WrapToRelative(sent_absolute)) {
-      ++tally.received_ok;
-    } else {
-      ++tally.count_errors;
-      reader.Reset(LevelsAt(emitted_absolute), sent_absolute, t_ns + step_ns);  // count each error once
-    }
+    previous = sent;
   }
-  tally.count_errors += reader.illegal_transitions() + reader.too_fast();
+  const EncoderLineCounters reader = ecs_board.encoder_lines().counters();
+  tally.count_errors += reader.illegal_transitions + reader.too_fast_edges + reader.resyncs;
+  tally.edges = reader.edges;
   return tally;
 }
 
 class QuadratureReliability : public ::testing::TestWithParam<double> {};
 
-TEST_P(QuadratureReliability, NoCountErrors) {
+TEST_P(QuadratureReliability, NoCountErrorsThroughTheBoards) {
   const double rate_hz = GetParam();
   const Tally tally = RunReliability(rate_hz, static_cast<std::uint64_t>(rate_hz));
   EXPECT_EQ(tally.sent, kMessages);
   EXPECT_EQ(tally.received_ok, kMessages);
   EXPECT_EQ(tally.count_errors, 0U);
+  EXPECT_GT(tally.edges, 100ULL * static_cast<std::uint64_t>(kMessages));  // the counts came from decoding edges
   // The run really crossed the wrap in both directions and reversed.
   EXPECT_GT(tally.cases[static_cast<std::size_t>(DifferenceCase::kA)], kMessages / 10);
   EXPECT_GT(tally.cases[static_cast<std::size_t>(DifferenceCase::kB)], kMessages / 10);
   EXPECT_GT(tally.cases[static_cast<std::size_t>(DifferenceCase::kC)], 0);
   EXPECT_GT(tally.cases[static_cast<std::size_t>(DifferenceCase::kD)], 0);
-  std::printf("rate %.0f Hz: %d messages sent, %d received correctly, %llu count errors\n", rate_hz,
-              tally.sent, tally.received_ok, static_cast<unsigned long long>(tally.count_errors));
+  std::printf("rate %.0f Hz: %d messages sent, %d received correctly, %llu count errors, %llu edges "
+              "decoded\n", rate_hz, tally.sent, tally.received_ok,
+              static_cast<unsigned long long>(tally.count_errors),
+              static_cast<unsigned long long>(tally.edges));
 }
 
 INSTANTIATE_TEST_SUITE_P(TableFiveTwo, QuadratureReliability,

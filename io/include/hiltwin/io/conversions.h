@@ -35,13 +35,19 @@ constexpr std::int32_t kPwmPeriodClocks = 4096;
 /// the sign from the direction pin.
 [[nodiscard]] std::int32_t PwmReaderValue(double duty) noexcept;
 
-/// Wheel geometry for metres <-> counts (appendix G: metres / wheel radius / gear ratio ·
-/// counts per rotation; gear ratio = wheel turns per motor turn, as in the seed code).
+/// Wheel geometry for metres <-> counts. Appendix G computes
+/// `metres / wheel_radius / gear_ratio * encoder_counts_per_rotation`, and its comment reads
+/// "meters to wheel_radians to motor_radians to encoder_counts": a radian count needs counts per
+/// *radian*. hiltwin names every quantity per revolution, so the 2π is explicit here:
+/// counts = metres / (2π · r) · motor turns per wheel turn · counts per motor turn.
 struct WheelGeometry {
   double wheel_radius_m = 0.05;
-  double gear_ratio = 1.0;
-  double encoder_counts_per_rev = 4096.0;  ///< counts per motor revolution (quadrature, 4x)
+  double motor_rev_per_wheel_rev = 1.0;     ///< gearbox reduction N
+  double counts_per_motor_rev = 4096.0;     ///< encoder counts per motor turn (quadrature, 4x)
 };
+
+/// Encoder counts per metre of wheel travel for `geometry`.
+[[nodiscard]] double CountsPerMetre(const WheelGeometry& geometry) noexcept;
 
 /// Wheel travel in metres to absolute encoder counts, floored: appendix G truncates towards
 /// zero, which makes the count around zero two counts wide; flooring keeps every count equal.
@@ -51,7 +57,8 @@ struct WheelGeometry {
 [[nodiscard]] double CountsToMetres(std::int64_t counts, const WheelGeometry& geometry) noexcept;
 
 /// Absolute position to the relative position in [-resolution/2, resolution/2) (appendix G
-/// `calc_value`, without its loops, and for any resolution that is a positive even number).
+/// `calc_value`, without its loops, and for any resolution that is a positive even number;
+/// a resolution below 2 gives 0).
 [[nodiscard]] std::int32_t WrapToRelative(std::int64_t absolute_counts,
                                           std::int32_t resolution = kEncoderResolution) noexcept;
 

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "hiltwin/io/encoder_emulator.h"
+#include "hiltwin/io/encoder_lines.h"
 #include "hiltwin/io/frame.h"
 #include "hiltwin/io/spi_bus.h"
 #include "hiltwin/kernel_glue/clock.h"
@@ -27,22 +28,13 @@ class PwmSignalSource {
   virtual void DutyAt(std::int64_t t_ns, std::array<double, kChannels>& duty_out) noexcept = 0;
 };
 
-/// Drives the ECS board's encoder reader: the count the reader has decoded by board time `t_ns`
-/// (relative, 14-bit), per channel. Called once per ALL frame.
-class EncoderLineSource {
- public:
-  virtual ~EncoderLineSource() = default;
-  virtual void CountsAt(std::int64_t t_ns,
-                        std::array<std::int32_t, kChannels>& counts_out) noexcept = 0;
-};
-
 /// Fault-injection hooks; counts are consumed one per transfer (ros2_control mock_components).
 struct FaultInjection {
   std::uint32_t corrupt_requests = 0;  ///< next N requests arrive with one bit flipped
   std::uint32_t corrupt_answers = 0;   ///< next N answers leave with one bit flipped
   std::uint32_t drop_answers = 0;      ///< next N transfers get no answer (MISO idles high)
   std::uint32_t delay_answers = 0;     ///< next N transfers get the previous transfer's answer
-  bool stick_encoder = false;          ///< encoder lines freeze (emulator or reader)
+  bool stick_encoder = false;          ///< twin: the emulator emits nothing; ECS: the readers see nothing
   std::optional<Image> answer_as_image;  ///< INIT answers this image's identity
 };
 
@@ -53,9 +45,11 @@ class SpiDevice {
   virtual void Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept = 0;
 };
 
-/// The board model. ECS image: PWM generator + quadrature encoder reader. Twin image: PWM
-/// reader + encoder emulator. Writes happen only in ALL frames; per-channel PWMc/ENCc frames
-/// read one channel back; TEST echoes its payload.
+/// The board model. ECS image: PWM generator + quadrature encoder readers, which decode the A/B
+/// edges of an EncoderLineSource (the twin's emulator) up to each ALL frame. Twin image: PWM
+/// reader + encoder emulator, which publishes every period to an EncoderLineSink. Writes happen
+/// only in ALL frames; per-channel PWMc/ENCc frames read one channel back; TEST echoes its
+/// payload.
 class EmulatedFpga final : public SpiDevice {
  public:
   explicit EmulatedFpga(Image image, const kernel_glue::Clock* clock = nullptr) noexcept;
@@ -65,6 +59,8 @@ class EmulatedFpga final : public SpiDevice {
   /// Input sources (not owned; null = idle line: duty 0 / count held).
   void SetPwmSource(PwmSignalSource* source) noexcept { pwm_source_ = source; }
   void SetEncoderSource(EncoderLineSource* source) noexcept { encoder_source_ = source; }
+  /// Twin image: where the emulator's periods go (not owned; null = nowhere).
+  void SetEncoderSink(EncoderLineSink* sink) noexcept { encoder_sink_ = sink; }
   /// Levels of the digital input pins (the other side's digital outputs).
   void SetDigitalInputs(const std::array<bool, kChannels>& pins) noexcept { pins_in_ = pins; }
   /// Fault-injection hooks, changed between transfers.
@@ -89,10 +85,12 @@ class EmulatedFpga final : public SpiDevice {
   [[nodiscard]] const std::array<std::int32_t, kChannels>& pwm_output() const noexcept {
     return pwm_values_;
   }
-  /// ECS image: the reader's 14-bit counts from the latest ALL frame.
+  /// ECS image: the readers' 14-bit counts from the latest ALL frame.
   [[nodiscard]] const std::array<std::int32_t, kChannels>& encoder_counts() const noexcept {
     return counts_;
   }
+  /// ECS image: the quadrature readers and their error counters.
+  [[nodiscard]] const EncoderLineReader& encoder_lines() const noexcept { return lines_; }
   /// Digital outputs set by the host in the latest ALL frame.
   [[nodiscard]] const std::array<bool, kChannels>& pins_out() const noexcept { return pins_out_; }
 
@@ -102,11 +100,14 @@ class EmulatedFpga final : public SpiDevice {
   void HandleAll(const Frame& request, Frame& answer) noexcept;
   void FillReadback(Opcode opcode, Frame& answer) const noexcept;
   void ResetState() noexcept;
+  /// Twin image: hands the periods just started to the sink.
+  void PublishPeriod() noexcept;
 
   Image image_;
   const kernel_glue::Clock* clock_;
   PwmSignalSource* pwm_source_ = nullptr;
   EncoderLineSource* encoder_source_ = nullptr;
+  EncoderLineSink* encoder_sink_ = nullptr;
   FaultInjection faults_{};
 
   bool initialised_ = false;
@@ -119,6 +120,8 @@ class EmulatedFpga final : public SpiDevice {
   std::uint32_t corrupt_bit_ = 0;
 
   std::array<EncoderEmulator, kChannels> emulators_{};
+  std::array<PulseSegment, kChannels> period_scratch_{};
+  EncoderLineReader lines_{};
   std::array<std::int32_t, kChannels> pwm_values_{};
   std::array<std::int32_t, kChannels> counts_{};
   std::array<bool, kChannels> pins_in_{};
@@ -143,15 +146,19 @@ class EmulatedSpiBus final : public SpiBus {
   const char* name_;
 };
 
-/// Wires a twin board's encoder emulator to an ECS board's reader in one process: the reader
-/// counts what the emulator has emitted by the time it is asked (pulses spread in time).
-class EmulatorToReaderLink final : public EncoderLineSource {
+/// Wires a twin board's encoder emulator to an ECS board's readers in one process: the twin
+/// board's periods are kept in a ring; pass the link to the ECS board's SetEncoderSource.
+class EmulatorToReaderLink final : public EncoderLineHistory {
  public:
-  explicit EmulatorToReaderLink(const EmulatedFpga& twin_board) noexcept : twin_(twin_board) {}
-  void CountsAt(std::int64_t t_ns, std::array<std::int32_t, kChannels>& counts_out) noexcept override;
+  explicit EmulatorToReaderLink(EmulatedFpga& twin_board) noexcept : twin_(twin_board) {
+    twin_.SetEncoderSink(this);
+  }
+  ~EmulatorToReaderLink() override { twin_.SetEncoderSink(nullptr); }
+  EmulatorToReaderLink(const EmulatorToReaderLink&) = delete;
+  EmulatorToReaderLink& operator=(const EmulatorToReaderLink&) = delete;
 
  private:
-  const EmulatedFpga& twin_;
+  EmulatedFpga& twin_;
 };
 
 /// Wires an ECS board's PWM generator to a twin board's PWM reader in one process.

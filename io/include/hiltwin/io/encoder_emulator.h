@@ -21,8 +21,9 @@ constexpr std::int64_t kReaderMinStateClocks = 2;
 /// Largest change per period the 14-bit relative position can express (half a turn).
 constexpr std::uint32_t kMaxRepresentablePulses = 8192;
 
-/// The divider the host sends in INIT: the smallest that still gives at least 8192 sub-ticks per
-/// period, but never below kMinClockDivider. 0 when the step is shorter than 4 clocks.
+/// The divider the host sends in INIT: floor(step_clocks / 8192), the largest that still gives
+/// at least 8192 sub-ticks per period (so any representable change fits), but never below
+/// kMinClockDivider. 0 when the step is shorter than 4 clocks.
 [[nodiscard]] std::uint32_t ClockDividerForStep(std::int64_t step_ns) noexcept;
 /// Sub-ticks per period S = step_clocks / divider (0 when the divider is 0).
 [[nodiscard]] std::uint32_t SubticksPerStep(std::int64_t step_ns, std::uint32_t divider) noexcept;
@@ -117,6 +118,9 @@ class QuadratureReader {
   void OnLevels(QuadratureLevels levels, std::int64_t t_ns) noexcept;
   /// Starts from `levels` at position `counts` (power-up / reset).
   void Reset(QuadratureLevels levels, std::int64_t counts, std::int64_t t_ns) noexcept;
+  /// The lines were loaded or jumped without edges (emulation: power-up, lost history): takes
+  /// `levels` as held since long ago and `counts` as the count, keeping the error counters.
+  void Resync(QuadratureLevels levels, std::int64_t counts) noexcept;
   [[nodiscard]] std::int64_t counts() const noexcept { return counts_; }
   /// The 14-bit register the ECS reads over SPI.
   [[nodiscard]] std::int32_t relative_counts() const noexcept { return WrapToRelative(counts_); }

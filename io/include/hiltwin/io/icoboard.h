@@ -107,7 +107,7 @@ class IcoBoardLink {
   std::uint8_t sequence_ = 0;
   LinkCounters counters_{};
   std::array<bool, kChannels> pins_out_{};
-  std::array<std::int64_t, kChannels> last_counts_{};         ///< twin: last positions sent
+  std::array<std::int64_t, kChannels> last_counts_{};         ///< twin: last positions the board acknowledged
   std::array<EncoderUnwrapper, kChannels> unwrappers_{};      ///< ECS: relative -> absolute
   Frame request_{};
   Frame answer_{};

@@ -6,10 +6,12 @@
 /// sees the 1–2 period delay of thesis §3.7). Both boards read CLOCK_MONOTONIC, the clock both
 /// processes share.
 ///
-/// Lock-free: PWM is one 64-bit atomic; the encoder lines are a single-writer seqlock that the
-/// reader tries a bounded number of times (then keeps its previous copy), so neither loop ever
-/// waits. Either side may start first or restart; each side beats a heartbeat on every transfer
-/// and a peer whose heartbeat stops is reported as kPeerLost.
+/// Lock-free: PWM is one 64-bit atomic; the encoder lines are a ring of the twin emulator's last
+/// kEncoderLineHistory periods, each slot a single-writer seqlock, which the ECS board's
+/// quadrature readers replay edge by edge (a slot overwritten before it was read is counted as a
+/// resync, never waited for), so neither loop ever waits. Either side may start first or
+/// restart; each side beats a heartbeat on every transfer and a peer whose heartbeat stops is
+/// reported as kPeerLost. A peer that crashed is forgotten when a new process attaches.
 
 #include <cstdint>
 #include <memory>
@@ -44,8 +46,9 @@ class WireBus final : public SpiBus {
   [[nodiscard]] EmulatedFpga& board() noexcept { return board_; }
   /// Heartbeat status of the other side right now (no transfer).
   [[nodiscard]] BusStatus PeerStatus() const noexcept;
-  /// Seqlock reads that gave up and reused the previous copy (contention; should stay 0).
-  [[nodiscard]] std::uint64_t seqlock_fallbacks() const noexcept { return seqlock_fallbacks_; }
+  /// The twin emulator's period `index` as published on the wire (tests, diagnostics); false
+  /// when it is not, or no longer, in the ring.
+  [[nodiscard]] bool ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept;
 
   /// "/hiltwin-wire-NAME". Throws std::invalid_argument unless NAME is 1–64 of [A-Za-z0-9_.-].
   static std::string SegmentName(const std::string& name);
@@ -65,7 +68,6 @@ class WireBus final : public SpiBus {
   WireSegment* segment_ = nullptr;
   std::unique_ptr<PwmWire> pwm_wire_;
   std::unique_ptr<EncoderWire> encoder_wire_;
-  std::uint64_t seqlock_fallbacks_ = 0;
 };
 
 }  // namespace hiltwin::io
