@@ -75,6 +75,13 @@ std::string Range(const Curve& c) {
   return "[" + Num(c.t_s.front()) + ", " + Num(c.t_s.back()) + "] s";
 }
 
+// "FILE:FIRSTLINE-LASTLINE:COLUMN" of samples [first, last] of `c` (column 0-based; 0 = time).
+std::string Lines(const Curve& c, std::size_t first, std::size_t last, std::size_t column) {
+  if (last >= c.lines.size() || first > last) return c.path;  // curve not read from a file
+  return c.path + ":" + std::to_string(c.lines[first]) + "-" + std::to_string(c.lines[last]) +
+         ":" + std::to_string(column + 1);
+}
+
 nlohmann::json Opt(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
@@ -120,11 +127,13 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
   const double hi = std::min(sim.t_s.back(), exp.t_s.back());
   const auto [first, last] = Inside(exp.t_s, lo, hi);
   if (!(lo < hi) || last - first < 2) {
-    throw InputError("no overlap in time: " + sim.label + " covers " + Range(sim) + ", " +
-                     exp.label + " covers " + Range(exp) +
+    throw InputError("no overlap in time: the simulation " + sim.label + " has its time at " +
+                     Lines(sim, 0, sim.t_s.size() - 1, 0) + ", covering " + Range(sim) +
+                     "; the experiment " + exp.label + " has its time at " +
+                     Lines(exp, 0, exp.t_s.size() - 1, 0) + ", covering " + Range(exp) +
                      (lo < hi ? " (fewer than two experiment samples in the common range)" : "") +
-                     "; both files need a common time range in seconds (check the time "
-                     "column and any start offset)");
+                     "; both need a common time range in seconds: check that both time columns "
+                     "start from the same origin in the same unit, and remove any start offset");
   }
   a.overlap_t0_s = exp.t_s[first];
   a.overlap_t1_s = exp.t_s[last - 1];
@@ -145,9 +154,8 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
 
   const auto [lo_it, hi_it] = std::minmax_element(a.y_exp.begin(), a.y_exp.end());
   if (!(*hi_it > *lo_it)) {
-    throw InputError(exp.path + ":" + std::to_string(exp.lines[first]) + "-" +
-                     std::to_string(exp.lines[last - 1]) + ":" + std::to_string(exp.column + 1) +
-                     ": the experiment curve (" + exp.label + ") is constant (" + Num(*lo_it) +
+    throw InputError(Lines(exp, first, last - 1, exp.column) + ": the experiment curve (" +
+                     exp.label + ") is constant (" + Num(*lo_it) +
                      ") over the compared range, so the error threshold eps_t = Kp*(max - min) "
                      "is 0 and no score exists; pick the column that moves (--exp)");
   }
@@ -255,11 +263,17 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
     const std::vector<double> u = InterpolateAt(input->t_s, input->y, g);
     const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
     if (!(*uhi > *ulo)) {
-      throw InputError(input->path + ":" + std::to_string(input->lines.front()) + "-" +
-                       std::to_string(input->lines.back()) + ":" +
-                       std::to_string(input->column + 1) + ": the input curve (" +
-                       input->label + ") is constant, so it excites no frequency; give the "
-                       "column that drove both systems (--input)");
+      // The input samples the interpolation used: from the last one at or before the range's
+      // start to the first one at or after its end.
+      const auto& ut = input->t_s;
+      const auto after_start = std::upper_bound(ut.begin(), ut.end(), g.front()) - ut.begin();
+      const auto at_end = std::lower_bound(ut.begin(), ut.end(), g.back()) - ut.begin();
+      const auto u_first = static_cast<std::size_t>(std::max<std::ptrdiff_t>(after_start - 1, 0));
+      const auto u_last = std::min(static_cast<std::size_t>(at_end), ut.size() - 1);
+      throw InputError(Lines(*input, u_first, u_last, input->column) + ": the input curve (" +
+                       input->label + ") is constant (" + Num(*ulo) + ") over the compared " +
+                       "range [" + Num(g.front()) + ", " + Num(g.back()) + "] s, so it excites " +
+                       "no frequency; give the column that drove both systems (--input)");
     }
     const std::size_t segment =
         options.welch_segment > 0 ? options.welch_segment : DefaultWelchSegment(g.size());
@@ -277,7 +291,11 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
 
   // Cross-checks.
   a.theil = TheilInequality(a.y_sim, a.y_exp);
-  if (grid.size() >= 20) {
+  if (grid.size() < 20) {
+    // The rating's phase shift and moving averages need a record; a number would mislead.
+    a.iso_note = "the compared range holds " + std::to_string(grid.size()) +
+                 " samples on the uniform grid; ISO/TS 18571 needs at least 20";
+  } else {
     if (grid.size() > options.iso_max_samples && options.iso_max_samples >= 20) {
       const double step = (grid.back() - grid.front()) / static_cast<double>(options.iso_max_samples - 1);
       std::vector<double> coarse(options.iso_max_samples);
@@ -362,8 +380,11 @@ nlohmann::json ToJson(const Assessment& a) {
     const FrequencyScore& f = *a.frequency;
     j["frequency_domain"] = {{"welch_segment_samples", f.segment_samples},
                              {"welch_segments", f.segments},
+                             {"welch_segments_total", f.segments_total},
                              {"coherence_min", f.coherence_min},
+                             {"input_power_min_fraction", kInputPowerFraction},
                              {"bins_used", f.bins_used},
+                             {"bins_low_input", f.bins_low_input},
                              {"bins_total", f.bins_total},
                              {"band_hz", {f.f_min_hz, f.f_max_hz}},
                              {"magnitude_db", DomainJson(f.magnitude)},
@@ -375,15 +396,20 @@ nlohmann::json ToJson(const Assessment& a) {
   nlohmann::json why = nlohmann::json::object();
   if (!a.performance) why["performance_domain"] = a.performance_note;
   if (!a.frequency) why["frequency_domain"] = a.frequency_note;
+  if (!a.iso) why["iso18571"] = a.iso_note;
   j["not_computed"] = why;
   j["cross_checks"] = {
       {"theil", {{"u", a.theil.u}, {"bias", a.theil.bias}, {"variance", a.theil.variance},
                  {"covariance", a.theil.covariance}}},
-      {"iso18571", {{"corridor", a.iso.corridor}, {"phase", a.iso.phase},
-                    {"magnitude", a.iso.magnitude}, {"slope", a.iso.slope},
-                    {"overall", a.iso.overall}, {"grade", a.iso.grade},
-                    {"phase_shift_samples", a.iso.phase_shift_samples},
-                    {"samples", a.iso.samples}}}};
+      {"iso18571", a.iso ? nlohmann::json{{"corridor", a.iso->corridor},
+                                          {"phase", a.iso->phase},
+                                          {"magnitude", a.iso->magnitude},
+                                          {"slope", a.iso->slope},
+                                          {"overall", a.iso->overall},
+                                          {"grade", a.iso->grade},
+                                          {"phase_shift_samples", a.iso->phase_shift_samples},
+                                          {"samples", a.iso->samples}}
+                         : nlohmann::json(nullptr)}};
   j["notes"] = a.notes;
   j["total"] = a.total;
   j["pass"] = a.pass;
@@ -437,9 +463,12 @@ std::string FormatText(const Assessment& a) {
 
   if (a.frequency) {
     const FrequencyScore& f = *a.frequency;
-    out += Format("Frequency domain (Welch, %zu-sample Hann segments x %zu, coherence > %.2g: %zu of %zu bins, %.4g .. %.4g Hz)\n",
-                  f.segment_samples, f.segments, f.coherence_min, f.bins_used, f.bins_total,
-                  f.f_min_hz, f.f_max_hz);
+    out += Format("Frequency domain (Welch, %zu-sample Hann segments: %zu of %zu carry input)\n",
+                  f.segment_samples, f.segments, f.segments_total);
+    out += Format("  bins used: %zu of %zu, %.4g .. %.4g Hz (input power >= %.3g of the peak: "
+                  "%zu below; then coherence > %.2g for both)\n",
+                  f.bins_used, f.bins_total, f.f_min_hz, f.f_max_hz, kInputPowerFraction,
+                  f.bins_low_input, f.coherence_min);
     out += Format("  magnitude  e = %-10.4g dB  eps = %-8.4g dB   eta = %.4f\n", f.magnitude.e,
                   f.magnitude.eps, f.magnitude.eta);
     out += Format("  phase      e = %-10.4g deg eps = %-8.4g deg  eta = %.4f\n", f.phase.e,
@@ -452,9 +481,14 @@ std::string FormatText(const Assessment& a) {
   out += "Cross-checks (not part of the total)\n";
   out += Format("  Theil U = %.4g (0 = identical); MSE split: bias %.3f, variance %.3f, covariance %.3f\n",
                 a.theil.u, a.theil.bias, a.theil.variance, a.theil.covariance);
-  out += Format("  ISO/TS 18571: corridor %.3f, phase %.3f, magnitude %.3f, slope %.3f -> %.3f (%s)\n\n",
-                a.iso.corridor, a.iso.phase, a.iso.magnitude, a.iso.slope, a.iso.overall,
-                a.iso.grade.c_str());
+  if (a.iso) {
+    out += Format("  ISO/TS 18571: corridor %.3f, phase %.3f, magnitude %.3f, slope %.3f"
+                  " -> %.3f (%s)\n\n",
+                  a.iso->corridor, a.iso->phase, a.iso->magnitude, a.iso->slope, a.iso->overall,
+                  a.iso->grade.c_str());
+  } else {
+    out += "  ISO/TS 18571: not computed: " + a.iso_note + "\n\n";
+  }
   for (const std::string& note : a.notes) out += "note: " + note + "\n";
   if (!a.notes.empty()) out += "\n";
   out += Format("Total = %.6f (%.1f %%)%s  %s eta_pass %.6g  ->  %s\n", a.total, 100.0 * a.total,

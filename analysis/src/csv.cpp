@@ -103,6 +103,10 @@ std::string CsvTable::ColumnLabel(std::size_t column) const {
 }
 
 CsvTable ParseCsv(std::string_view text, const std::string& path) {
+  // Excel and Windows editors save "CSV UTF-8" with a byte order mark, which would otherwise
+  // become part of the first header name (or make the first time cell "not a number").
+  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+  if (text.starts_with(kUtf8Bom)) text.remove_prefix(kUtf8Bom.size());
   CsvTable table;
   table.path = path;
   char separator = ',';

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
@@ -29,6 +30,12 @@ void Detrend(std::vector<double>& seg) {
   for (std::size_t i = 0; i < seg.size(); ++i) {
     seg[i] -= mean_v + slope * (static_cast<double>(i) - mean_i);
   }
+}
+
+std::string G(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
 }
 
 }  // namespace
@@ -63,6 +70,7 @@ FrequencyResponse EstimateFrequencyResponse(std::span<const double> u, std::span
   std::vector<std::complex<double>> puy(bins, {0.0, 0.0});
   std::vector<std::complex<double>> uf(bins);
   std::vector<double> seg(len);
+  std::vector<double> segment_input_energy;
   FrequencyResponse response;
   for (std::size_t start = 0; start + len <= u.size(); start += hop) {
     for (int pass = 0; pass < 2; ++pass) {
@@ -70,7 +78,12 @@ FrequencyResponse EstimateFrequencyResponse(std::span<const double> u, std::span
       std::copy(source.begin() + static_cast<std::ptrdiff_t>(start),
                 source.begin() + static_cast<std::ptrdiff_t>(start + len), seg.begin());
       Detrend(seg);
-      for (std::size_t i = 0; i < len; ++i) real[i] = seg[i] * window[i];
+      double energy = 0.0;
+      for (std::size_t i = 0; i < len; ++i) {
+        real[i] = seg[i] * window[i];
+        energy += real[i] * real[i];
+      }
+      if (pass == 0) segment_input_energy.push_back(energy);
       plan.Execute();
       for (std::size_t b = 0; b < bins; ++b) {
         const std::complex<double> value = detail::ToComplex(spec[b]);
@@ -85,6 +98,12 @@ FrequencyResponse EstimateFrequencyResponse(std::span<const double> u, std::span
     }
     ++response.segments;
   }
+  const double max_energy =
+      *std::max_element(segment_input_energy.begin(), segment_input_energy.end());
+  response.segments_with_input = static_cast<std::size_t>(std::count_if(
+      segment_input_energy.begin(), segment_input_energy.end(),
+      [&](double e) { return e > 0.0 && e >= kInputPowerFraction * max_energy; }));
+  response.input_power = puu;
   response.frequency_hz.resize(bins);
   response.h.resize(bins);
   response.coherence.resize(bins);
@@ -108,13 +127,38 @@ std::optional<FrequencyScore> ScoreFrequency(std::span<const double> u,
   const FrequencyResponse exp = EstimateFrequencyResponse(u, y_exp, step_s, segment_samples);
   FrequencyScore score;
   score.segment_samples = segment_samples;
-  score.segments = exp.segments;
+  score.segments = exp.segments_with_input;
+  score.segments_total = exp.segments;
   score.coherence_min = coherence_min;
   score.bins_total = exp.h.size() - 1;  // DC is never used
+  const std::string segments_text = std::to_string(score.segments) + " of " +
+                                    std::to_string(score.segments_total) + " Welch segments (" +
+                                    std::to_string(segment_samples) + " samples each)";
+  if (score.segments < kMinInputSegments) {
+    why = "only " + segments_text + " carry input power (>= " + G(kInputPowerFraction) +
+          " of the largest segment's); need at least " + std::to_string(kMinInputSegments) +
+          " for a coherence estimate; " +
+          (score.segments_total < kMinInputSegments
+               ? std::string("use a shorter --welch-segment or a longer record")
+               : std::string("give an input that keeps changing (noise, a chirp, or many "
+                             "steps: a step excites only the two segments around it, whatever "
+                             "--welch-segment)"));
+    return std::nullopt;
+  }
+  // Bins the input hardly excites are dropped before the coherence gate: on noise-free data
+  // their coherence is ~1 too, but their response is rounding or quantisation residue.
+  const double max_input =
+      *std::max_element(exp.input_power.begin() + 1, exp.input_power.end());
   double sum_mag = 0.0;
   double sum_phase = 0.0;
+  std::size_t in_band = 0;
   for (std::size_t b = 1; b < exp.h.size(); ++b) {
     if (exp.frequency_hz[b] < band_lo_hz || exp.frequency_hz[b] > band_hi_hz) continue;
+    ++in_band;
+    if (!(exp.input_power[b] >= kInputPowerFraction * max_input && max_input > 0.0)) {
+      ++score.bins_low_input;
+      continue;
+    }
     if (!(sim.coherence[b] > coherence_min && exp.coherence[b] > coherence_min)) continue;
     if (std::abs(sim.h[b]) == 0.0 || std::abs(exp.h[b]) == 0.0) continue;
     const std::complex<double> ratio = sim.h[b] / exp.h[b];
@@ -127,11 +171,12 @@ std::optional<FrequencyScore> ScoreFrequency(std::span<const double> u,
     ++score.bins_used;
   }
   if (score.bins_used == 0) {
-    why = "no frequency bin has coherence above " + std::to_string(coherence_min) +
-          " for both curves (" + std::to_string(exp.segments) +
-          " Welch segments, band " + std::to_string(band_lo_hz) + " .. " +
-          std::to_string(band_hi_hz) + " Hz); excite the system more broadly, record longer, or change "
-          "--welch-segment";
+    why = "no frequency bin has both input power (>= " + G(kInputPowerFraction) +
+          " of the largest bin's) and coherence above " + G(coherence_min) +
+          " for both curves (" + std::to_string(in_band) + " bins in the band " + G(band_lo_hz) +
+          " .. " + G(band_hi_hz) + " Hz, " + std::to_string(score.bins_low_input) +
+          " with too little input power; " + segments_text +
+          "); excite the system more broadly, record longer, or change --welch-segment or --band";
     return std::nullopt;
   }
   const auto used = static_cast<double>(score.bins_used);

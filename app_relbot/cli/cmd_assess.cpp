@@ -195,8 +195,9 @@ Command AddAssessCommand(CLI::App& parent) {
                   "LO:HI in Hz: frequency band scored in the frequency domain (default: all)");
   app->add_flag("--json", o->json,
                 "print the report as JSON: time_domain {e_t, eps_t, k_e, eta}, delay_s, "
-                "time_domain_compensated, performance_domain, frequency_domain (null when not "
-                "computed), cross_checks, total, pass, verdict");
+                "time_domain_compensated, performance_domain, frequency_domain, cross_checks "
+                "{theil, iso18571} (null when not computed, reason under not_computed), total, "
+                "pass, verdict");
   app->add_option("--plot", o->plot,
                   "write FILE.png: both curves and their difference over time (thesis fig. "
                   "5.3); needs gnuplot (Debian package gnuplot-nox)");

@@ -205,6 +205,8 @@ TEST_F(AssessCli, BadColumnsAndCurvesAreNamed) {
   ExpectUsageError(Run("'" + file + "' --exp robot"), {"h.csv:1", "--exp 'robot'", "no such column", "2='sim'"});
   ExpectUsageError(Run("'" + file + "' --sim 1"), {"h.csv:1", "time"});
   ExpectUsageError(Run("'" + file + "'"), {"h.csv:2-4:3", "constant"});
+  // Whatever the weights: a constant experiment has no step for the performance domain either.
+  ExpectUsageError(Run("'" + file + "' --weights 0,1,0"), {"h.csv:2-4:3", "constant"});
   ExpectUsageError(Run("'" + Path("missing.csv") + "'"), {"missing.csv", "cannot open"});
 }
 
@@ -212,7 +214,26 @@ TEST_F(AssessCli, FilesWithoutCommonTimeAreRefused) {
   const std::string a = Write("early.csv", "time,y\n0,0\n1,1\n2,0\n");
   const std::string b = Write("late.csv", "time,y\n5,0\n6,1\n7,0\n");
   ExpectUsageError(Run("--sim '" + a + ":y' --exp '" + b + ":y'"),
-                   {"no overlap", "early.csv", "[0, 2] s", "late.csv", "[5, 7] s"});
+                   {"no overlap", "early.csv:2-4:1", "[0, 2] s", "late.csv:2-4:1", "[5, 7] s",
+                    "start offset"});
+}
+
+TEST_F(AssessCli, ByteOrderMarkIsReadAndShortRecordLeavesIsoNotComputed) {
+  // Excel's "CSV UTF-8" starts with a byte order mark; 10 samples are too few for ISO 18571.
+  std::string csv = "\xEF\xBB\xBF" "time,sim,exp\n";
+  for (int i = 0; i < 10; ++i) {
+    csv += std::to_string(i * 0.1) + "," + std::to_string(i + 0.01) + "," + std::to_string(i);
+    csv += "\n";
+  }
+  const std::string file = Write("bom.csv", csv);
+  const Result j = Run("'" + file + "' --sim sim --exp exp --json");
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  const auto report = nlohmann::json::parse(j.out);
+  EXPECT_TRUE(report["cross_checks"]["iso18571"].is_null());
+  EXPECT_TRUE(report["not_computed"]["iso18571"].is_string());
+  EXPECT_TRUE(report["pass"].get<bool>());
+  const Result text = Run("'" + file + "' --sim sim --exp exp");
+  EXPECT_NE(text.out.find("ISO/TS 18571: not computed"), std::string::npos) << text.out;
 }
 
 TEST_F(AssessCli, BadFlagsAreNamed) {

@@ -66,7 +66,8 @@ TEST(Assess, KnownOffsetGivesKnownErrorAndIdenticalGivesOne) {
   EXPECT_EQ(same.time.eta, 1.0);
   EXPECT_EQ(same.total, 1.0);
   EXPECT_TRUE(same.pass);
-  EXPECT_DOUBLE_EQ(same.iso.overall, 1.0);
+  ASSERT_TRUE(same.iso.has_value());
+  EXPECT_DOUBLE_EQ(same.iso->overall, 1.0);
 }
 
 TEST(Assess, TwoFilesAreResampledOntoTheExperimentOverTheOverlap) {
@@ -107,6 +108,46 @@ TEST(Assess, NoOverlapIsAnInputError) {
   EXPECT_NE(m.find("no overlap"), std::string::npos) << m;
   EXPECT_NE(m.find("[0, 0.99] s"), std::string::npos) << m;
   EXPECT_NE(m.find("[5, 5.99] s"), std::string::npos) << m;
+  // Where each time column lies in its file (column 1 = time), and what to do.
+  EXPECT_NE(m.find("sim.csv:2-101:1"), std::string::npos) << m;
+  EXPECT_NE(m.find("exp.csv:2-101:1"), std::string::npos) << m;
+  EXPECT_NE(m.find("start offset"), std::string::npos) << m;
+}
+
+TEST(Assess, ConstantInputQuotesTheLinesOfTheComparedRange) {
+  // Curves over 0 .. 0.99 s; the input file runs to 2.99 s and moves only after 1.5 s, so the
+  // message must name the input lines the comparison used (2-101), not the whole file.
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 100, 0.0);
+  const Curve exp = MakeCurve("exp", 0.0, 1e-2, 100, 0.0, 0.001);
+  Curve u = MakeCurve("u", 0.0, 1e-2, 300, 0.0);
+  for (std::size_t i = 0; i < u.y.size(); ++i) u.y[i] = u.t_s[i] <= 1.5 ? 0.5 : u.t_s[i];
+  const std::string m = ErrorOf(sim, exp, AssessOptions{}, &u);
+  EXPECT_NE(m.find("u.csv:2-101:2:"), std::string::npos) << m;
+  EXPECT_NE(m.find("constant (0.5)"), std::string::npos) << m;
+  EXPECT_NE(m.find("[0, 0.99] s"), std::string::npos) << m;
+  EXPECT_NE(m.find("--input"), std::string::npos) << m;
+}
+
+TEST(Assess, IsoRatingNeedsTwentySamplesElseItIsNullWithAReason) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 19, 0.0, 0.001);
+  const Curve exp = MakeCurve("exp", 0.0, 1e-2, 19, 0.0);
+  const Assessment a = Assess(sim, exp, nullptr, AssessOptions{});
+  EXPECT_FALSE(a.iso.has_value());
+  const nlohmann::json j = ToJson(a);
+  EXPECT_TRUE(j["cross_checks"]["iso18571"].is_null()) << j["cross_checks"].dump();
+  ASSERT_TRUE(j["not_computed"]["iso18571"].is_string());
+  const std::string why = j["not_computed"]["iso18571"].get<std::string>();
+  EXPECT_NE(why.find("19 samples"), std::string::npos) << why;
+  EXPECT_NE(why.find("at least 20"), std::string::npos) << why;
+  const std::string text = FormatText(a);
+  EXPECT_NE(text.find("ISO/TS 18571: not computed: " + why), std::string::npos) << text;
+  EXPECT_TRUE(j["total"].is_number());  // the cross-check never blocks the score
+
+  const Assessment twenty = Assess(MakeCurve("sim", 0.0, 1e-2, 20, 0.0, 0.001),
+                                   MakeCurve("exp", 0.0, 1e-2, 20, 0.0), nullptr, AssessOptions{});
+  ASSERT_TRUE(twenty.iso.has_value());
+  EXPECT_TRUE(ToJson(twenty)["cross_checks"]["iso18571"]["overall"].is_number());
+  EXPECT_FALSE(ToJson(twenty)["not_computed"].contains("iso18571"));
 }
 
 TEST(Assess, ConstantExperimentNamesFileLinesAndColumn) {
@@ -192,6 +233,39 @@ TEST(Assess, InputColumnEnablesTheFrequencyDomain) {
   ASSERT_TRUE(a.frequency.has_value()) << a.frequency_note;
   EXPECT_DOUBLE_EQ(a.frequency->eta, 1.0);
   EXPECT_DOUBLE_EQ(a.total, 1.0);
+}
+
+TEST(Assess, StepInputLeavesTheFrequencyDomainNotComputed) {
+  // A single step at 1 s: after each Welch segment's line is removed only the 2 segments that
+  // hold the step carry input power, too few for a coherence estimate.
+  Curve u;
+  Curve y;
+  u.path = y.path = "step.csv";
+  u.label = "u";
+  y.label = "y";
+  double state = 0.0;
+  for (std::size_t i = 0; i < 4000; ++i) {
+    const double t = static_cast<double>(i) * 1e-3;
+    const double duty = i < 1000 ? 0.0 : 1.0;
+    state = 0.98 * state + 0.02 * duty;
+    u.t_s.push_back(t);
+    y.t_s.push_back(t);
+    u.y.push_back(duty);
+    y.y.push_back(state);
+    u.lines.push_back(i + 2);
+    y.lines.push_back(i + 2);
+  }
+  const Assessment a = Assess(y, y, &u, AssessOptions{});
+  EXPECT_FALSE(a.frequency.has_value());
+  EXPECT_NE(a.frequency_note.find("only 2 of 30 Welch segments"), std::string::npos)
+      << a.frequency_note;
+  EXPECT_TRUE(ToJson(a)["frequency_domain"].is_null());
+  EXPECT_NE(FormatText(a).find("Frequency domain: not computed: only 2 of 30"), std::string::npos);
+  AssessOptions weighted;
+  weighted.weights = {1.0, 0.0, 1.0};
+  const std::string m = ErrorOf(y, y, weighted, &u);
+  EXPECT_NE(m.find("frequency domain weight 1"), std::string::npos) << m;
+  EXPECT_NE(m.find("carry input power"), std::string::npos) << m;
 }
 
 TEST(Assess, JsonHasTheContractKeys) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace hiltwin::analysis {
@@ -209,6 +210,57 @@ TEST(Performance, MetricMissingInOneCurveScoresZero) {
   ASSERT_TRUE(s.has_value());
   EXPECT_TRUE(s->metrics.at(0).scored);
   EXPECT_EQ(s->metrics.at(0).eta, 0.0);
+}
+
+const MetricScore& Metric(const PerformanceScore& s, const std::string& name) {
+  for (const MetricScore& m : s.metrics) {
+    if (m.name == name) return m;
+  }
+  throw std::out_of_range(name);
+}
+
+TEST(Credibility, OvershootFloorGivesAFiniteScoreWhenTheExperimentHasNone) {
+  // Experiment: a ramp to 1 that stays there (overshoot exactly 0 %, so Kp*|0| = 0); the
+  // simulation peaks at 1.005 (0.5 %) and settles back to 1. Threshold = the 1-point floor.
+  const std::vector<double> t = Times(401, 0.25);
+  std::vector<double> exp(t.size(), 1.0);
+  std::vector<double> sim(t.size(), 1.0);
+  for (std::size_t i = 0; i <= 8; ++i) {
+    exp[i] = static_cast<double>(i) / 8.0;
+    sim[i] = 1.005 * static_cast<double>(i) / 8.0;
+  }
+  for (std::size_t i = 9; i < 12; ++i) sim[i] = 1.005 - 0.005 * static_cast<double>(i - 8) / 4.0;
+  const auto s = ScorePerformance(t, sim, exp, std::nullopt, CredibilityParams{});
+  ASSERT_TRUE(s.has_value());
+  const MetricScore& overshoot = Metric(*s, "overshoot_pct");
+  ASSERT_TRUE(overshoot.scored && overshoot.exp && overshoot.sim);
+  EXPECT_EQ(*overshoot.exp, 0.0);
+  EXPECT_NEAR(*overshoot.sim, 0.5, 1e-9);
+  EXPECT_EQ(overshoot.threshold, 1.0);
+  // eta = K_e*eps / sqrt((K_e*eps)^2 + e^2) with K_e = 0.6/sqrt(1 - 0.36) = 0.75, eps = 1, e = 0.5.
+  EXPECT_NEAR(overshoot.eta, 0.75 / std::sqrt(0.75 * 0.75 + 0.5 * 0.5), 1e-9);
+}
+
+TEST(Credibility, TimeMetricFloorIsOneSampleStep) {
+  // Experiment jumps in one 0.25 s step: rise time 0.8 steps = 0.2 s, so Kp*0.2 = 0.01 s is
+  // below the floor of one step. The simulation ramps over three steps: rise time 0.6 s.
+  const double step_s = 0.25;
+  const std::vector<double> t = Times(401, step_s);
+  std::vector<double> exp(t.size(), 1.0);
+  std::vector<double> sim(t.size(), 1.0);
+  exp[0] = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) sim[i] = static_cast<double>(i) / 3.0;
+  const auto s = ScorePerformance(t, sim, exp, std::nullopt, CredibilityParams{});
+  ASSERT_TRUE(s.has_value());
+  const MetricScore& rise = Metric(*s, "rise_time_s");
+  ASSERT_TRUE(rise.scored && rise.exp && rise.sim);
+  EXPECT_NEAR(*rise.exp, 0.8 * step_s, 1e-12);  // 10 % at 0.1 steps, 90 % at 0.9 steps
+  EXPECT_NEAR(*rise.sim, 2.4 * step_s, 1e-12);  // 10 % at 0.3 steps, 90 % at 2.7 steps
+  EXPECT_EQ(rise.threshold, step_s);
+  const double scaled = 0.75 * step_s;
+  EXPECT_NEAR(rise.eta, scaled / std::sqrt(scaled * scaled + 0.4 * 0.4), 1e-9);
+  // Settling (exp 0.98 steps, sim 2.94 steps) is below the floor too.
+  EXPECT_EQ(Metric(*s, "settling_time_s").threshold, step_s);
 }
 
 }  // namespace

@@ -47,6 +47,19 @@ TEST(Csv, AcceptsSemicolonsTabsCommentsBlankLinesAndNoHeader) {
   EXPECT_EQ(ResolveColumn(bare, "3", "--exp"), 2u);
 }
 
+TEST(Csv, Utf8ByteOrderMarkIsSkipped) {
+  // "CSV UTF-8" from Excel starts with EF BB BF; the first name must still be "time".
+  const CsvTable t = ParseCsv("\xEF\xBB\xBFtime,sim,exp\n0,1,2\n1,2,3\n", "bom.csv");
+  ASSERT_EQ(t.names.size(), 3u);
+  EXPECT_EQ(t.names[0], "time");
+  EXPECT_EQ(ResolveColumn(t, "sim", "--sim"), 1u);
+  EXPECT_EQ(t.lines[0], 2u);
+  const CsvTable bare = ParseCsv("\xEF\xBB\xBF" "0,1\n1,2\n", "bom.csv");  // no header
+  EXPECT_FALSE(bare.has_header);
+  EXPECT_DOUBLE_EQ(bare.columns[0][0], 0.0);
+  EXPECT_EQ(bare.rows(), 2u);
+}
+
 TEST(Csv, NonNumericCellNamesFileLineColumn) {
   ExpectError("time,a,b\n0,1,2\n1,abc,3\n", {"in.csv:3:2", "'a'", "'abc' is not a number"});
   ExpectError("time,a,b\n0,1,2\n1,,3\n", {"in.csv:3:2", "empty cell"});

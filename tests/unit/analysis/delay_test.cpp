@@ -91,5 +91,23 @@ TEST(Delay, ConstantOffsetIsNotMistakenForADelay) {
   EXPECT_NEAR(EstimateDelay(sim, exp, 1e-3, 0.5).delay_s, 0.0042, 2e-5);
 }
 
+TEST(Delay, NoShiftReportsExactlyZero) {
+  // Offset curves without a shift: rounding in the parabola's three spreads used to leave a
+  // "delay" of ~1e-17 s (printed as 6.2e-17 s); the estimate must say 0.
+  for (const double offset : {0.004, 0.05, 1000.0}) {
+    for (const double step_s : {2.5e-4, 1e-3, 1e-2}) {
+      std::vector<double> sim(2000);
+      std::vector<double> exp(2000);
+      for (std::size_t i = 0; i < exp.size(); ++i) {
+        exp[i] = Position(static_cast<double>(i) * step_s);
+        sim[i] = exp[i] + offset;
+      }
+      const DelayEstimate d = EstimateDelay(sim, exp, step_s, 200 * step_s);
+      EXPECT_EQ(d.delay_samples, 0.0) << "offset " << offset << ", step " << step_s;
+      EXPECT_EQ(d.delay_s, 0.0) << "offset " << offset << ", step " << step_s;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hiltwin::analysis

@@ -95,6 +95,100 @@ TEST(FrequencyScore, UncorrelatedOutputHasNoCoherentBin) {
   EXPECT_NE(why.find("coherence"), std::string::npos);
 }
 
+// A wheel driven through a first-order drivetrain (time constant 60 ms, as the RELbot's,
+// docs/relbot-model.md): v' = (u - v)/tau, x' = v, integrated at 4 kHz with Euler or RK4.
+// The duty follows steps and ramps set by a 1 kHz controller and quantised to 1/2048, as
+// `hiltwin run` logs it: almost all input power lies below a few Hz, and the quantisation
+// leaves a faint broadband floor where the two integrators differ most.
+struct WheelRun {
+  std::vector<double> duty;
+  std::vector<double> euler;
+  std::vector<double> rk4;
+};
+
+double DutyProfile(double t_s) {
+  // Knots (time, duty) joined by ramps; equal times make a step.
+  static constexpr double kKnots[][2] = {
+      {0.0, 0.0}, {1.0, 0.0}, {1.0, 0.4}, {3.0, 0.4}, {6.0, 1.0}, {8.0, 1.0}, {8.0, -0.5},
+      {10.0, -0.5}, {12.0, 0.0}, {13.0, 0.0}, {13.0, 0.6}, {15.0, 0.6}, {15.0, -0.3},
+      {17.0, -0.3}, {20.0, 0.8}, {23.0, 0.8}, {23.0, 0.2}, {27.0, -1.0}, {29.0, -1.0},
+      {29.0, 0.3}, {32.0, 0.3}, {34.0, 0.0}, {34.5, 0.0}, {34.5, 0.1}, {35.5, 0.1},
+      {35.5, 0.0}, {36.0, 0.0}};
+  double duty = 0.0;
+  for (std::size_t k = 1; k < std::size(kKnots); ++k) {
+    const double t0 = kKnots[k - 1][0];
+    const double t1 = kKnots[k][0];
+    if (t_s >= t0 && t_s < t1) {
+      duty = kKnots[k - 1][1] + (kKnots[k][1] - kKnots[k - 1][1]) * (t_s - t0) / (t1 - t0);
+    }
+  }
+  return std::round(duty * 2048.0) / 2048.0;
+}
+
+WheelRun SimulateWheel(double step_s, std::size_t n) {
+  constexpr double kTau = 0.06;
+  auto f = [](double u, double v) { return (u - v) / kTau; };
+  WheelRun run;
+  double v_e = 0.0;
+  double x_e = 0.0;
+  double v_r = 0.0;
+  double x_r = 0.0;
+  double u = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % 4 == 0) u = DutyProfile(static_cast<double>(i) * step_s);  // 1 kHz controller
+    run.duty.push_back(u);
+    run.euler.push_back(x_e);
+    run.rk4.push_back(x_r);
+    x_e += step_s * v_e;
+    v_e += step_s * f(u, v_e);
+    const double k1 = f(u, v_r);
+    const double k2 = f(u, v_r + 0.5 * step_s * k1);
+    const double k3 = f(u, v_r + 0.5 * step_s * k2);
+    const double k4 = f(u, v_r + step_s * k3);
+    x_r += step_s * (v_r + step_s / 6.0 * (k1 + k2 + k3));
+    v_r += step_s / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+  return run;
+}
+
+TEST(Spectral, EulerAgainstRk4OfOneSmoothModelScoresHigh) {
+  const double step_s = 2.5e-4;
+  const WheelRun run = SimulateWheel(step_s, 144000);  // 36 s at 4 kHz
+  std::string why;
+  const auto s = ScoreFrequency(run.duty, run.euler, run.rk4, step_s, DefaultWelchSegment(144000),
+                                0.8, CredibilityParams{}, why);
+  ASSERT_TRUE(s.has_value()) << why;
+  // Noise-free data keep the coherence ~1 in every bin; only the input-power gate leaves out
+  // the quantisation floor, where Euler's phase lag and gain error grow with frequency.
+  EXPECT_GT(s->bins_low_input, s->bins_total / 2);
+  EXPECT_LT(s->f_max_hz, 50.0);
+  EXPECT_EQ(s->segments, s->segments_total);  // the duty keeps moving over the whole record
+  EXPECT_GE(s->eta, 0.9) << "magnitude e " << s->magnitude.e << " dB, phase e " << s->phase.e
+                         << " deg over " << s->bins_used << " bins up to " << s->f_max_hz << " Hz";
+}
+
+TEST(Spectral, SingleStepExcitesTooFewSegmentsForAScore) {
+  // A step at 1 s in a 10 s record: after each segment's line is removed, only the two
+  // segments holding the step carry input power, and two averages give no coherence estimate.
+  const std::size_t n = 10000;
+  std::vector<double> u(n);
+  for (std::size_t i = 0; i < n; ++i) u[i] = i < 1000 ? 0.0 : 1.0;
+  const std::vector<double> y = LowPass(u, 0.95);
+  const FrequencyResponse r = EstimateFrequencyResponse(u, y, 1e-3, 1024);
+  EXPECT_EQ(r.segments, 18u);  // (10000 - 1024) / 512 + 1
+  EXPECT_EQ(r.segments_with_input, 2u);
+  std::string why;
+  const auto s = ScoreFrequency(u, y, y, 1e-3, 1024, 0.8, CredibilityParams{}, why);
+  EXPECT_FALSE(s.has_value());
+  EXPECT_NE(why.find("only 2 of 18 Welch segments"), std::string::npos) << why;
+  EXPECT_NE(why.find("keeps changing"), std::string::npos) << why;
+  // With fewer than 4 segments in all, shorter segments are what helps.
+  const auto one = ScoreFrequency(u, y, y, 1e-3, 8192, 0.8, CredibilityParams{}, why);
+  EXPECT_FALSE(one.has_value());
+  EXPECT_NE(why.find("only 1 of 1 Welch segments"), std::string::npos) << why;
+  EXPECT_NE(why.find("shorter --welch-segment"), std::string::npos) << why;
+}
+
 TEST(Welch, DefaultSegment) {
   EXPECT_EQ(DefaultWelchSegment(100), 16u);
   EXPECT_EQ(DefaultWelchSegment(8192), 1024u);

@@ -68,7 +68,8 @@ struct Assessment {
   std::optional<FrequencyScore> frequency;
   std::string frequency_note;    ///< why frequency is null
   TheilCoefficients theil;
-  IsoRating iso;
+  std::optional<IsoRating> iso;
+  std::string iso_note;          ///< why iso is null
   double total = 0.0;
   bool pass = false;
   std::vector<std::string> notes;
@@ -87,7 +88,8 @@ struct Assessment {
                                 const AssessOptions& options);
 
 /// JSON report: time_domain {e_t, eps_t, k_e, eta}, delay_s, time_domain_compensated,
-/// performance_domain, frequency_domain (null when not computed), cross_checks, total, pass.
+/// performance_domain, frequency_domain, cross_checks {theil, iso18571} (each null when not
+/// computed, with the reason under not_computed), total, pass.
 [[nodiscard]] nlohmann::json ToJson(const Assessment& assessment);
 
 /// The text table printed by `hiltwin assess`.

@@ -13,13 +13,26 @@
 
 namespace hiltwin::analysis {
 
+/// A bin or Welch segment whose input power is below this fraction of the largest carries
+/// no usable input [hiltwin]: noise-free data keep the coherence near 1 even there, so the
+/// coherence gate alone would let rounding-level responses into the score.
+inline constexpr double kInputPowerFraction = 1e-3;
+
+/// Fewest Welch segments with input power for a frequency-domain score [hiltwin]: with one
+/// segment the coherence estimate is 1 whatever the data, and it stays biased upwards for few.
+inline constexpr std::size_t kMinInputSegments = 4;
+
 /// H1 estimate of the response from u to y with its magnitude-squared coherence, one value
 /// per frequency bin from 0 to the Nyquist frequency.
 struct FrequencyResponse {
   std::vector<double> frequency_hz;
   std::vector<std::complex<double>> h;  ///< P_uy / P_uu
   std::vector<double> coherence;        ///< |P_uy|² / (P_uu·P_yy), 0 where undefined
+  std::vector<double> input_power;      ///< P_uu (summed over segments, unscaled)
   std::size_t segments = 0;             ///< number of averaged segments
+  /// Segments whose windowed, detrended input energy is at least kInputPowerFraction of the
+  /// largest segment's (a step input moves only the few segments that hold the step).
+  std::size_t segments_with_input = 0;
 };
 
 /// Welch's method: Hann-windowed segments of `segment_samples` with 50 % overlap, each with
@@ -33,13 +46,16 @@ struct FrequencyResponse {
 /// Default Welch segment: the largest power of two ≤ n/8, clamped to [16, 65536].
 [[nodiscard]] std::size_t DefaultWelchSegment(std::size_t n);
 
-/// Frequency-domain score: magnitude (dB) and phase (degrees) errors over the bins where both
-/// coherences exceed the threshold, each mapped through the η function; η_f is their mean.
+/// Frequency-domain score: magnitude (dB) and phase (degrees) errors over the bins with input
+/// power (≥ kInputPowerFraction of the largest bin's) where both coherences exceed the
+/// threshold, each mapped through the η function; η_f is their mean.
 struct FrequencyScore {
   std::size_t segment_samples = 0;
-  std::size_t segments = 0;
+  std::size_t segments = 0;        ///< segments that carry input power (see FrequencyResponse)
+  std::size_t segments_total = 0;  ///< all Welch segments
   std::size_t bins_used = 0;
-  std::size_t bins_total = 0;
+  std::size_t bins_total = 0;      ///< bins above DC
+  std::size_t bins_low_input = 0;  ///< in the band, dropped for too little input power
   double f_min_hz = 0.0;
   double f_max_hz = 0.0;
   double coherence_min = 0.8;
@@ -48,8 +64,8 @@ struct FrequencyScore {
   double eta = 0.0;
 };
 
-/// Uses bins in [band_lo_hz, band_hi_hz] only. Returns nullopt (with `why` filled) when no
-/// bin passes the coherence threshold.
+/// Uses bins in [band_lo_hz, band_hi_hz] only. Returns nullopt (with `why` filled) when fewer
+/// than kMinInputSegments segments carry input power or no bin passes both gates.
 [[nodiscard]] std::optional<FrequencyScore> ScoreFrequency(
     std::span<const double> u, std::span<const double> y_sim, std::span<const double> y_exp,
     double step_s, std::size_t segment_samples, double coherence_min,
