@@ -167,6 +167,13 @@ ProbeCheck Make(std::string id, std::string name, std::string value, CheckStatus
 
 ProbeCheck Unknown(std::string id, std::string name, std::string_view why,
                    std::string advice = {}) {
+  // Every line that is not ok says what to do, unknown ones included.
+  if (advice.empty()) {
+    advice = why == "not tried"
+                 ? "run 'hiltwin doctor' without --no-try to try it for real (it is undone at once)"
+                 : "could not be read: check that /proc and /sys are mounted (or that --root "
+                   "holds a full copy), or check it by hand as docs/realtime-setup.md describes";
+  }
   return Make(std::move(id), std::move(name), "unknown (" + std::string(why) + ")",
               CheckStatus::kWarn, std::move(advice));
 }

@@ -297,4 +297,8 @@ std::string Summary(const RtSetupRecord& record) {
 
 std::uint64_t RtSetupWarningsLogged() noexcept { return g_warnings_logged.load(); }
 
+void ResetRtSetupWarningsForTest() noexcept {
+  for (auto& warned : g_warned) warned.store(false);
+}
+
 }  // namespace hiltwin::kernel_glue

@@ -1,6 +1,12 @@
 #include "hiltwin/kernel_glue/clock.h"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
 
 namespace hiltwin::kernel_glue {
 namespace {
@@ -28,6 +34,40 @@ TEST(MonotonicClock, AbsoluteSleepReachesDeadline) {
   clock.SleepUntilNs(deadline_ns);
   EXPECT_GE(clock.NowNs(), deadline_ns);  // never early; lateness is not asserted (noisy VM)
   EXPECT_FALSE(clock.IsVirtual());
+}
+
+std::atomic<int> g_interruptions{0};
+void CountInterruption(int /*signal*/) { g_interruptions.fetch_add(1); }
+
+TEST(MonotonicClock, AbsoluteSleepResumesAfterASignalInterruptsIt) {
+  // A handler without SA_RESTART makes clock_nanosleep return EINTR; the sleep must resume
+  // towards the same absolute deadline instead of returning early.
+  struct sigaction action {};
+  action.sa_handler = CountInterruption;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;
+  struct sigaction previous {};
+  ASSERT_EQ(sigaction(SIGUSR1, &action, &previous), 0);
+  g_interruptions = 0;
+
+  MonotonicClock clock;
+  const TimeNs deadline_ns = clock.NowNs() + 200 * kNsPerMs;
+  std::atomic<bool> asleep{false};
+  TimeNs woke_ns = 0;
+  std::thread sleeper([&] {
+    asleep = true;
+    clock.SleepUntilNs(deadline_ns);
+    woke_ns = clock.NowNs();
+  });
+  while (!asleep) std::this_thread::yield();
+  for (int i = 0; i < 5; ++i) {  // several interruptions, all well before the deadline
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    pthread_kill(sleeper.native_handle(), SIGUSR1);
+  }
+  sleeper.join();
+  sigaction(SIGUSR1, &previous, nullptr);
+  EXPECT_GE(g_interruptions.load(), 1);
+  EXPECT_GE(woke_ns, deadline_ns);
 }
 
 TEST(MonotonicClock, SpendBusyWaitsAtLeastTheDuration) {

@@ -83,5 +83,7 @@ class RtSession {
 /// How many set-up warnings this process has sent to the log so far. Each kind of refusal
 /// is logged only the first time; later sessions still list it in their record.
 [[nodiscard]] std::uint64_t RtSetupWarningsLogged() noexcept;
+/// Test hook: forgets which kinds of refusal were logged, so a test sees a first one again.
+void ResetRtSetupWarningsForTest() noexcept;
 
 }  // namespace hiltwin::kernel_glue

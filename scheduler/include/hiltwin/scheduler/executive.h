@@ -61,7 +61,8 @@ struct ExecutiveStats {
   std::uint64_t deadline_misses = 0;   ///< missed cycles + skipped releases
   std::uint64_t releases_skipped = 0;  ///< by the kSkip policy
   std::uint64_t max_consecutive_misses = 0;
-  TimingStats wake_latency;   ///< wake - release: the OS's share
+  TimingStats wake_latency;   ///< wake - release of cycles whose release found the loop
+                              ///< asleep: the OS's share (catch-up cycles are not in it)
   TimingStats compute;        ///< end - start: the step's share
   TimingStats response;       ///< end - release
   TimingStats period_jitter;  ///< (start_k - start_{k-1}) - period, consecutive cycles only
@@ -92,7 +93,8 @@ class Executive {
   [[nodiscard]] std::vector<TimingSample> RecentSamples() const;
 
  private:
-  void Account(TimingSample& sample, bool has_previous_start, TimeNs previous_start_ns) noexcept;
+  void Account(TimingSample& sample, bool has_previous_start, TimeNs previous_start_ns,
+               bool loop_was_idle) noexcept;
 
   kernel_glue::Clock& clock_;
   ExecutiveConfig config_;
