@@ -1,5 +1,7 @@
-// `hiltwin io-test`: bring-up test of the FPGA link. INIT, identity check, N data frames with a
-// known pattern, then a summary; exit 0 only without errors, 5 on an I/O error or the wrong image.
+// `hiltwin io-test`: bring-up test of the FPGA link. INIT, identity check, N frames with a known
+// pattern, then a summary; exit 0 only without errors, 5 on an I/O error, the wrong image or (wire)
+// no peer. Over a wire or a real link the inputs come from the other side, which is expected to run
+// io-test too: its pattern is checked by relations that hold whatever its frame index is.
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -10,6 +12,7 @@
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
+#include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/clock.h"
 
 namespace hiltwin::app {
@@ -21,6 +24,7 @@ struct IoTestOptions {
   std::string board_image;
   std::int64_t frames = 1000;
   double rate_hz = 1000.0;
+  double wait_peer_s = 0.0;
   bool json = false;
 };
 
@@ -42,25 +46,87 @@ std::array<std::uint8_t, 8> PatternBytes(std::int64_t i) {
   return bytes;
 }
 
-/// Mock only: drives the emulated board's inputs with the pattern, indexed by board time.
+/// Mock only: drives the emulated board's inputs with the pattern, indexed by board time. The
+/// encoder lines are an emulator whose period p (index p + 1) starts at p·step and moves from
+/// PatternCounts(p) to PatternCounts(p + 1); the ECS board's readers decode its edges.
 class PatternSource final : public io::PwmSignalSource, public io::EncoderLineSource {
  public:
-  explicit PatternSource(std::int64_t step_ns) : step_ns_(step_ns) {}
+  explicit PatternSource(std::int64_t step_ns)
+      : step_ns_(step_ns),
+        divider_(io::ClockDividerForStep(step_ns)),
+        subticks_(io::SubticksPerStep(step_ns, divider_)) {}
   void DutyAt(std::int64_t t_ns, std::array<double, io::kChannels>& duty_out) noexcept override {
     for (std::size_t c = 0; c < io::kChannels; ++c) duty_out[c] = io::PwmToDuty(PatternPwm(t_ns / step_ns_, c));
   }
-  void CountsAt(std::int64_t t_ns, std::array<std::int32_t, io::kChannels>& counts_out) noexcept override {
-    for (std::size_t c = 0; c < io::kChannels; ++c) counts_out[c] = PatternCounts(t_ns / step_ns_, c);
+  io::LineView Lines(std::int64_t t_ns) noexcept override {
+    io::LineView view;
+    view.newest = static_cast<std::uint64_t>(t_ns / step_ns_) + 1;
+    return view;
+  }
+  bool Period(std::uint64_t index, io::EncoderPeriod& out) noexcept override {
+    if (index == 0) return false;
+    const auto p = static_cast<std::int64_t>(index - 1);
+    out.index = index;
+    for (std::size_t c = 0; c < io::kChannels; ++c) {
+      const io::PulsePlan plan = io::PlanPulses(PatternCounts(p, c), PatternCounts(p + 1, c));
+      out.channels[c] = io::PulseSegment{PatternCounts(p, c), plan.pulses, plan.direction, p * step_ns_,
+                                         subticks_, divider_};
+    }
+    return true;
   }
 
  private:
   std::int64_t step_ns_;
+  std::uint32_t divider_;
+  std::uint32_t subticks_;
+};
+
+/// Residue of `value` modulo `modulus` in [0, modulus).
+std::int64_t Mod(std::int64_t value, std::int64_t modulus) {
+  return ((value % modulus) + modulus) % modulus;
+}
+
+/// Twin side over a wire or real link: PWM from the other side's io-test. Every channel must
+/// come from the same pattern frame (channel c is 511·c ahead of channel 0, modulo 4095), or an
+/// adjacent one: a real PWM reader measures each channel in its own PWM period, so one channel
+/// may still show the previous frame. All zero is the idle line before the first ALL frame.
+bool IsPeerPwmPattern(const std::array<std::int32_t, io::kChannels>& pwm) {
+  if (pwm == std::array<std::int32_t, io::kChannels>{}) return true;
+  for (std::size_t c = 1; c < io::kChannels; ++c) {
+    const std::int64_t r = Mod(pwm[c] - pwm[0] - 511 * static_cast<std::int64_t>(c), 4095);
+    if (r != 0 && r != 37 && r != 4095 - 37) return false;
+  }
+  return true;
+}
+
+/// ECS side over a wire or real link: counts from the other side's io-test, which sends channel
+/// c at (c+1)·13·k. The readers see the pulses spread over the twin's periods (channel c moves
+/// c+1 times as fast), so channel c stays within 3 twin periods' worth of (c+1) × channel 0,
+/// and channel 0 never moves backwards.
+class PeerCountsCheck {
+ public:
+  bool operator()(const io::EcsInputs& in) {
+    for (std::size_t c = 1; c < io::kChannels; ++c) {
+      const auto factor = static_cast<std::int64_t>(c + 1);
+      const std::int32_t deviation = io::WrapToRelative(in.counts[c] - factor * in.counts[0]);
+      if (deviation > 3 * 13 * factor || deviation < -3 * 13 * factor) return false;
+    }
+    const bool forward = !primed_ || in.absolute_counts[0] >= last_;
+    primed_ = true;
+    last_ = in.absolute_counts[0];
+    return forward;
+  }
+
+ private:
+  bool primed_ = false;
+  std::int64_t last_ = 0;
 };
 
 struct Summary {
   std::uint64_t count_errors = 0;
   const char* fault = nullptr;
-  bool peer_absent = false;
+  std::int64_t frames = 0;               ///< frames sent after INIT
+  std::int64_t frames_peer_absent = 0;   ///< wire: frames during which no peer was attached
 };
 
 template <typename Driver, typename Inputs, typename Send, typename Check>
@@ -74,6 +140,7 @@ Summary RunFrames(Driver& driver, const IoTestOptions& options, std::int64_t per
   for (std::int64_t i = 0; i < options.frames; ++i) {
     clock.SleepUntilNs(t0_ns + i * period_ns);
     io::ExchangeStatus status;
+    ++summary.frames;
     if (i % 4 == 3) {
       // Every fourth frame is a TEST loop-back: a known pattern on every backend.
       const auto pattern = PatternBytes(i);
@@ -83,15 +150,44 @@ Summary RunFrames(Driver& driver, const IoTestOptions& options, std::int64_t per
     } else {
       status = driver.Exchange(send(data_frames), in);
       ++data_frames;
-      if (status.ok() && !check(in)) ++summary.count_errors;
+      // With no peer the inputs are idle: nothing to check, and the run fails for that below.
+      if (status.ok() && !status.peer_absent && !check(in)) ++summary.count_errors;
     }
-    summary.peer_absent = summary.peer_absent || status.peer_absent;
+    if (status.peer_absent) ++summary.frames_peer_absent;
     if (status.code == io::ExchangeStatus::Code::kFault) {
       summary.fault = status.reason;
       break;
     }
   }
   return summary;
+}
+
+const char* SideName(io::Image image) { return image == io::Image::kIcoboard ? "ECS" : "twin"; }
+
+/// The way out when the other side of a wire is missing: the command that starts it.
+std::string NoPeerAdvice(const IoTestOptions& options, io::Image image, bool waited) {
+  return std::string("start the other side first, e.g. `hiltwin io-test --io ") + options.io +
+         " --image " + io::ToString(io::Counterpart(image)) + " --frames 100000` in another " +
+         "terminal, " + (waited ? "or wait longer with a larger --wait-peer" :
+                                  "or add --wait-peer SECONDS to wait for it");
+}
+
+/// Wire only: waits (start-up, not real-time) until the other process has attached.
+void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image image) {
+  const auto* wire = dynamic_cast<const io::WireBus*>(&backend.bus());
+  if (wire == nullptr) return;
+  kernel_glue::MonotonicClock clock;
+  const std::int64_t deadline = clock.NowNs() + static_cast<std::int64_t>(options.wait_peer_s * 1e9);
+  while (wire->PeerStatus().result == io::BusResult::kPeerAbsent) {
+    if (clock.NowNs() >= deadline) {
+      char seconds[32];
+      std::snprintf(seconds, sizeof seconds, "%g", options.wait_peer_s);
+      throw CommandError(ExitCode::kIo, std::string("no ") + SideName(io::Counterpart(image)) +
+                                            " process attached to " + options.io + " within " +
+                                            seconds + " s (--wait-peer); " + NoPeerAdvice(options, image, true));
+    }
+    clock.SleepUntilNs(clock.NowNs() + 10'000'000);
+  }
 }
 
 int RunIoTest(const IoTestOptions& options) {
@@ -111,6 +207,11 @@ int RunIoTest(const IoTestOptions& options) {
                        "--board-image " + options.board_image + " only applies to --io mock; a wired "
                        "or real board carries its own image (drop --board-image)");
   }
+  if (options.wait_peer_s > 0.0 && spec.kind != io::BackendSpec::Kind::kWire) {
+    throw CommandError(ExitCode::kUsage,
+                       "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a "
+                       "real board's peer cannot be seen from here (drop --wait-peer)");
+  }
   std::unique_ptr<io::IoBackend> backend;
   try {
     backend = io::OpenBackend(options.io, backend_options);
@@ -119,6 +220,7 @@ int RunIoTest(const IoTestOptions& options) {
   } catch (const std::exception& e) {
     throw CommandError(ExitCode::kIo, std::string(e.what()) + " (--io " + options.io + ")");
   }
+  if (options.wait_peer_s > 0.0) WaitForPeer(*backend, options, image);
   const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(options.rate_hz);
   const bool mock = backend->kind() == io::BackendSpec::Kind::kMock;
   PatternSource pattern(period_ns);
@@ -151,7 +253,7 @@ int RunIoTest(const IoTestOptions& options) {
           return out;
         },
         [&](const io::TwinInputs& in) {
-          if (!mock) return true;  // a real or wired board's PWM is not ours to predict
+          if (!mock) return IsPeerPwmPattern(in.pwm);
           const std::int64_t k = board->time_ns() / period_ns;
           for (std::size_t c = 0; c < io::kChannels; ++c) {
             if (in.pwm[c] != PatternPwm(k, c)) return false;
@@ -162,6 +264,7 @@ int RunIoTest(const IoTestOptions& options) {
     timing = driver.timing();
   } else {
     io::IcoBoard driver(backend->bus());
+    PeerCountsCheck peer_counts;
     std::tie(summary, init) = run(
         driver, io::EcsInputs{},
         [](std::int64_t k) {
@@ -170,7 +273,7 @@ int RunIoTest(const IoTestOptions& options) {
           return out;
         },
         [&](const io::EcsInputs& in) {
-          if (!mock) return true;
+          if (!mock) return peer_counts(in);
           const std::int64_t k = board->time_ns() / period_ns;
           for (std::size_t c = 0; c < io::kChannels; ++c) {
             if (in.counts[c] != PatternCounts(k, c)) return false;
@@ -181,7 +284,13 @@ int RunIoTest(const IoTestOptions& options) {
     timing = driver.timing();
   }
 
-  const bool ok = summary.fault == nullptr && summary.count_errors == 0 &&
+  // The ECS board model's readers: edges a real reader would miscount, and lines that jumped.
+  const io::EncoderLineCounters reader = board != nullptr && image == io::Image::kIcoboard
+                                             ? board->encoder_lines().counters()
+                                             : io::EncoderLineCounters{};
+  const std::uint64_t count_errors =
+      summary.count_errors + reader.illegal_transitions + reader.too_fast_edges + reader.resyncs;
+  const bool ok = summary.fault == nullptr && count_errors == 0 && summary.frames_peer_absent == 0 &&
                   counters.frames_corrupted == 0 && counters.frames_missed == 0 &&
                   counters.frames_received == counters.frames_sent;
   const double mean_ns =
@@ -196,12 +305,17 @@ int RunIoTest(const IoTestOptions& options) {
     j["frames_received"] = counters.frames_received;
     j["frames_corrupted"] = counters.frames_corrupted;
     j["frames_missed"] = counters.frames_missed;
-    j["count_errors"] = summary.count_errors;
+    j["count_errors"] = count_errors;
     j["faults"] = counters.faults;
     j["pulse_limit_events"] = counters.pulse_limit_events;
+    j["counts_over_limit"] = counters.counts_over_limit;
+    j["reader_illegal_transitions"] = reader.illegal_transitions;
+    j["reader_too_fast_edges"] = reader.too_fast_edges;
+    j["reader_resyncs"] = reader.resyncs;
     j["transfer_ns_mean"] = mean_ns;
     j["transfer_ns_max"] = timing.max_ns;
-    j["peer_absent"] = summary.peer_absent;
+    j["peer_absent"] = summary.frames_peer_absent > 0;
+    j["frames_peer_absent"] = summary.frames_peer_absent;
     j["ok"] = ok;
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -211,20 +325,40 @@ int RunIoTest(const IoTestOptions& options) {
     std::printf("  frames received   %llu\n", static_cast<unsigned long long>(counters.frames_received));
     std::printf("  frames corrupted  %llu\n", static_cast<unsigned long long>(counters.frames_corrupted));
     std::printf("  frames missed     %llu\n", static_cast<unsigned long long>(counters.frames_missed));
-    std::printf("  count errors      %llu\n", static_cast<unsigned long long>(summary.count_errors));
+    std::printf("  count errors      %llu (reader: %llu illegal, %llu too fast, %llu resyncs)\n",
+                static_cast<unsigned long long>(count_errors),
+                static_cast<unsigned long long>(reader.illegal_transitions),
+                static_cast<unsigned long long>(reader.too_fast_edges),
+                static_cast<unsigned long long>(reader.resyncs));
+    std::printf("  counts over limit %llu\n", static_cast<unsigned long long>(counters.counts_over_limit));
     std::printf("  transfer time     mean %.0f ns, max %lld ns\n", mean_ns,
                 static_cast<long long>(timing.max_ns));
-    if (summary.peer_absent) {
-      std::printf("  note: no peer was attached to %s; its inputs were idle\n", options.io.c_str());
+    if (summary.frames_peer_absent > 0) {
+      std::printf("  no peer           %lld of %lld frames\n", static_cast<long long>(summary.frames_peer_absent),
+                  static_cast<long long>(summary.frames));
     }
     std::printf("%s\n", ok ? "PASS" : "FAIL");
   }
   if (summary.fault != nullptr) {
     throw CommandError(ExitCode::kIo, std::string("link fault on ") + options.io + ": " + summary.fault);
   }
+  if (summary.frames_peer_absent > 0) {
+    const std::string other = SideName(io::Counterpart(image));
+    const std::string what =
+        summary.frames_peer_absent == summary.frames
+            ? "no " + other + " process was attached to " + options.io + " during the whole run, so " +
+                  "nothing crossed the wire"
+            : "no " + other + " process was attached to " + options.io + " for " +
+                  std::to_string(summary.frames_peer_absent) + " of " + std::to_string(summary.frames) +
+                  " frames, which tested nothing";
+    throw CommandError(ExitCode::kIo, what + "; " + NoPeerAdvice(options, image, options.wait_peer_s > 0.0));
+  }
   if (!ok) {
     throw CommandError(ExitCode::kIo, "the link had errors (see the summary above); check wiring, "
-                                      "cable length and SPI speed, then rerun");
+                                      "cable length and SPI speed, then rerun" +
+                                      std::string(mock ? "" : "; over a wire or real link the other "
+                                                              "side must run io-test too (its pattern "
+                                                              "is checked)"));
   }
   return static_cast<int>(ExitCode::kPass);
 }
@@ -232,13 +366,14 @@ int RunIoTest(const IoTestOptions& options) {
 Command AddIoTestCommand(CLI::App& parent) {
   auto options = std::make_shared<IoTestOptions>();
   CLI::App* app = parent.add_subcommand(
-      "io-test", "Bring-up test of the FPGA link: INIT, identity check, N data frames, errors counted");
+      "io-test", "Bring-up test of the FPGA link: INIT, identity check, N frames, errors counted");
   app->description(
       "Bring-up test of the FPGA link: sends INIT (with the step size from --rate), checks the\n"
       "board's identity (icoboard = ECS image, icoboard_inverse = twin image), then N frames with\n"
       "a known pattern (every 4th a TEST loop-back) and prints frames sent/received/corrupted/\n"
-      "missed and count errors. Exit 0 only without errors; 5 on an I/O error or the wrong image;\n"
-      "2 on bad usage. Frame layout: docs/spi-protocol.md.");
+      "missed and count errors. Over wire:NAME or spidev the other side must run io-test too:\n"
+      "its pattern is checked on arrival. Exit 0 only without errors; 5 on an I/O error, the\n"
+      "wrong image or a wire with no peer; 2 on bad usage. Frame layout: docs/spi-protocol.md.");
   app->add_option("--io", options->io, std::string("backend: ") + io::kBackendForms)
       ->capture_default_str();
   app->add_option("--image", options->image,
@@ -249,15 +384,21 @@ Command AddIoTestCommand(CLI::App& parent) {
                   "mock only: image the emulated board carries (default: the one --image needs); "
                   "a mismatch tests the wrong-image error")
       ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}));
-  app->add_option("--frames", options->frames, "data frames to send after INIT")
+  app->add_option("--frames", options->frames,
+                  "frames to send after INIT: every 4th is a TEST loop-back, the others data (ALL) "
+                  "frames")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{100'000'000}))
       ->capture_default_str();
   app->add_option("--rate", options->rate_hz, "frame rate in Hz; also the step size sent in INIT")
       ->check(CLI::Range(1.0, 100'000.0))
       ->capture_default_str();
+  app->add_option("--wait-peer", options->wait_peer_s,
+                  "wire only: wait up to SECONDS for the other process to attach before INIT "
+                  "(a run with no peer fails with exit 5)")
+      ->check(CLI::Range(0.0, 3600.0));
   app->add_flag("--json", options->json,
                 "print the summary as JSON (frames_sent, frames_received, frames_corrupted, "
-                "frames_missed, count_errors, ...)");
+                "frames_missed, count_errors, counts_over_limit, frames_peer_absent, ...)");
   return Command{app, [options] { return RunIoTest(*options); }};
 }
 

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -76,7 +78,8 @@ qos::QosConfig MakeQosConfig(const RunOptions& o, std::uint64_t planned_cycles) 
   config.grace_cycles = o.grace_cycles;
   try {
     config.policy = qos::ParseViolationPolicy(o.on_violation);
-    if (o.max_miss_pct > 0.0) config.rules.push_back(qos::MakeMissRatioRule(o.max_miss_pct));
+    // Exactly 0 switches the ratio rule off; anything else (negative, NaN) is validated.
+    if (o.max_miss_pct != 0.0) config.rules.push_back(qos::MakeMissRatioRule(o.max_miss_pct));
     if (o.mk_rules.empty()) {
       // The documented default (m,k) rule for this twin/controller rate pair (docs/qos.md).
       for (const qos::RuleSpec& rule : qos::DefaultRulesFor(o.rate_hz, o.controller_rate_hz)) {
@@ -112,7 +115,7 @@ void Validate(const RunOptions& o) {
     Usage("--input-rate: the controller rate must be positive and not above --rate (" +
           Num(o.rate_hz) + " Hz)");
   }
-  if (o.deadline_us < 0.0 || o.deadline_us * 1e3 > 1e9 / o.rate_hz) {
+  if (!std::isfinite(o.deadline_us) || o.deadline_us < 0.0 || o.deadline_us * 1e3 > 1e9 / o.rate_hz) {
     Usage("--deadline-us: must be between 0 (= the period) and the period (" +
           Num(1e6 / o.rate_hz) + " us)");
   }
@@ -121,6 +124,17 @@ void Validate(const RunOptions& o) {
     Usage("--clock '" + o.clock + "': use 'realtime' or 'virtual'");
   }
   if (o.priority < 0 || o.priority > 99) Usage("--priority: 0 (no SCHED_FIFO) .. 99");
+}
+
+/// The online CPUs not in `loop_cpus`; empty when the loop is not pinned or uses them all.
+std::vector<int> OtherCpus(const std::vector<int>& loop_cpus) {
+  std::vector<int> others;
+  if (loop_cpus.empty()) return others;
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  for (int cpu = 0; cpu < online; ++cpu) {
+    if (std::find(loop_cpus.begin(), loop_cpus.end(), cpu) == loop_cpus.end()) others.push_back(cpu);
+  }
+  return others;
 }
 
 /// Throttled one-line progress on a terminal, from a non-RT thread reading atomics only.
@@ -174,6 +188,20 @@ int RunTwin(RunOptions o) {
   const bool virtual_clock = o.clock == "virtual";
   const auto planned = static_cast<std::uint64_t>(std::llround(o.duration_s * o.rate_hz));
   if (planned == 0) Usage("--duration is shorter than one period at --rate");
+  if (o.grace_cycles >= planned) {
+    // A grace period that covers the whole run would judge nothing and always PASS.
+    Usage("--grace-cycles " + std::to_string(o.grace_cycles) + ": must be below the " +
+          std::to_string(planned) + " cycles of the run; lower it or lengthen --duration");
+  }
+  // Open the report now: a path that cannot be written fails before the run, not after it.
+  std::ofstream report_file;
+  if (!o.report_path.empty()) {
+    report_file.open(o.report_path, std::ios::out | std::ios::trunc);
+    if (!report_file) {
+      Usage("--report " + o.report_path + ": cannot create the file (" + std::strerror(errno) +
+            "); check that the folder exists and is writable");
+    }
+  }
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.rate_hz);
 
   // --- configuration (may throw: exit 2) ---
@@ -222,10 +250,12 @@ int RunTwin(RunOptions o) {
     throw CommandError(ExitCode::kIo, std::string("--io ") + o.io + ": " + e.what());
   }
   ProfilePwmSource pwm_source(*profile, o.controller_rate_hz);
-  if (io::EmulatedFpga* board = backend->emulated_board();
-      board != nullptr && backend->kind() == io::BackendSpec::Kind::kMock) {
+  // Only the mock board plays the profile; on a wire or real SPI the controller drives the PWM.
+  const bool profile_drives = backend->kind() == io::BackendSpec::Kind::kMock;
+  if (io::EmulatedFpga* board = backend->emulated_board(); board != nullptr && profile_drives) {
     board->SetPwmSource(&pwm_source);
   }
+  const std::string input_name = profile_drives ? profile->name() : "the controller on " + o.io;
   io::IcoBoardInverse driver(backend->bus(), &clock);
   const io::InitResult init = driver.Init(period_ns);
   if (!init.ok) {
@@ -239,8 +269,7 @@ int RunTwin(RunOptions o) {
     Usage(std::string("--rate ") + Num(o.rate_hz) + ": " + e.what());
   }
   RelbotModel& model = *model_storage;
-  const io::WheelGeometry geometry{params.wheel_radius_m, params.gear_ratio_motor_rev_per_wheel_rev,
-                                   params.encoder_counts_per_motor_rev};
+  const io::WheelGeometry geometry = WheelGeometryOf(params);
   qos::QosMonitor monitor(qos_config);
   scheduler::Executive executive(clock, exec_config);
   TwinTask task(driver, model, geometry, clock, injector, lifecycle);
@@ -256,20 +285,23 @@ int RunTwin(RunOptions o) {
     log_config.decimation = o.log_decimation;
     // No deadline on the virtual clock: keep every row rather than drop when the writer lags.
     log_config.wait_when_full = virtual_clock;
+    // Keep the writer off the loop's CPUs: it would inherit the pinning of this thread.
+    log_config.writer_cpus = OtherCpus(o.cpus);
     try {
       logger = std::make_unique<tracing::CsvLogger>(std::move(log_config));
     } catch (const std::invalid_argument& e) {
       Usage(std::string("--log: ") + e.what());
     } catch (const std::exception& e) {
-      throw CommandError(ExitCode::kIo, std::string("--log: ") + e.what());
+      Usage(std::string("--log: ") + e.what());
     }
     log_observer = std::make_unique<LogObserver>(*logger, task);
     executive.AddObserver(*log_observer);
-    logger->Start();
   }
   lifecycle.Handle(statemachine::Event::kConfigured);
 
-  // --- real-time set-up of this (the loop's) thread; refusals warn and the run goes on ---
+  // --- real-time set-up of this (the loop's) thread; refusals warn and the run goes on. It
+  // comes before the writer thread starts: mallopt is process-wide and not thread-safe, and
+  // a stop signal must find its handler before there is a log to lose. ---
   kernel_glue::RtSession rt_session;
   if (!virtual_clock) {
     kernel_glue::RtSetupRequest request;
@@ -279,10 +311,11 @@ int RunTwin(RunOptions o) {
   }
   kernel_glue::InstallStopSignalHandlers();
   executive.SetStopCheck(&kernel_glue::StopRequested);
+  if (logger) logger->Start();
 
   std::fprintf(stdout, "hiltwin run: RELbot twin at %.0f Hz for %.3f s (%llu cycles), io %s, input %s, %s clock\n",
                o.rate_hz, o.duration_s, static_cast<unsigned long long>(planned), o.io.c_str(),
-               profile->name().c_str(), o.clock.c_str());
+               input_name.c_str(), o.clock.c_str());
   if (!virtual_clock) std::fprintf(stdout, "real-time set-up: %s\n", kernel_glue::Summary(rt_session.record()).c_str());
   std::fflush(stdout);
 
@@ -309,18 +342,20 @@ int RunTwin(RunOptions o) {
   facts.stop_reason = statemachine::ToString(lifecycle.stop_reason());
   facts.clock = o.clock;
   facts.io = o.io;
-  facts.input = profile->name();
+  facts.input = input_name;
   facts.integrator = std::string(IntegratorName(integrator));
   facts.rate_hz = o.rate_hz;
   facts.cycles_planned = planned;
   facts.io_errors = task.io_errors();
+  facts.counts_over_limit = driver.counters().counts_over_limit;
+  facts.controller_absent_cycles = task.controller_absent_cycles();
   facts.wall_time_s = wall_time_s;
   if (logger) {
     facts.log_path = o.log_path;
     facts.log_rows_written = logger->rows_written();
     facts.log_rows_dropped = logger->rows_dropped();
   }
-  nlohmann::json report = BuildRunReport(facts, executive, monitor, rt_session.record());
+  nlohmann::ordered_json report = BuildRunReport(facts, executive, monitor, rt_session.record());
   report["outputs_safe"] = hold.code != io::ExchangeStatus::Code::kFault;
   report["final_state"] = statemachine::ToString(lifecycle.state());
   if (lifecycle.stop_reason() == statemachine::StopReason::kIoFault ||
@@ -329,10 +364,10 @@ int RunTwin(RunOptions o) {
   }
   if (logger && !logger->error().empty()) report["log_error"] = logger->error();
 
-  if (!o.report_path.empty()) {
-    std::ofstream out(o.report_path);
-    out << report.dump(2) << '\n';
-    if (!out) {
+  if (report_file.is_open()) {
+    report_file << report.dump(2) << '\n';
+    report_file.flush();
+    if (!report_file) {
       throw CommandError(ExitCode::kIo, "--report " + o.report_path +
                                             ": cannot write the run report; check the folder exists and is writable");
     }
@@ -351,6 +386,14 @@ int RunTwin(RunOptions o) {
                  "or check the parameters in --config\n",
                  static_cast<unsigned long long>(task.fault_cycle()), task.fault_reason());
     return static_cast<int>(ExitCode::kInternal);
+  }
+  if (task.controller_absent_cycles() > 0) {
+    std::fprintf(stderr,
+                 "hiltwin run: warning: no controller was attached to %s in %llu of %llu cycles; "
+                 "the twin saw zero duty then. Start the controller (ECS) process on the same "
+                 "wire before or during the run.\n",
+                 o.io.c_str(), static_cast<unsigned long long>(task.controller_absent_cycles()),
+                 static_cast<unsigned long long>(executive.stats().cycles_run));
   }
   if (logger && !logger->error().empty()) {
     std::fprintf(stderr, "hiltwin run: the log %s is incomplete: %s\n", o.log_path.c_str(),
@@ -388,7 +431,9 @@ Command AddRunCommand(CLI::App& parent) {
   app->add_option("--max-consecutive-misses", o->max_consecutive_misses, "rule: at most N consecutive misses");
   app->add_option("--max-miss-pct", o->max_miss_pct, "rule: overall miss ratio below P percent (0: off)")
       ->capture_default_str();
-  app->add_option("--grace-cycles", o->grace_cycles, "ignore the first N cycles (start-up)")->capture_default_str();
+  app->add_option("--grace-cycles", o->grace_cycles, "ignore the first N cycles (start-up); fewer than the run's cycles")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app->add_option("--on-violation", o->on_violation, "flag: finish and mark unreliable (exit 3); abort: stop at once (exit 4)")
       ->check(CLI::IsMember({"flag", "abort"}))
       ->capture_default_str();

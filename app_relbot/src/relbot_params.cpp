@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -180,9 +179,13 @@ RelbotParams LoadRelbotParams(const std::filesystem::path& path) {
   return ParseRelbotParams(text.str(), path.string());
 }
 
+io::WheelGeometry WheelGeometryOf(const RelbotParams& params) noexcept {
+  return io::WheelGeometry{params.wheel_radius_m, params.gear_ratio_motor_rev_per_wheel_rev,
+                           params.encoder_counts_per_motor_rev};
+}
+
 double EncoderCountsPerMetre(const RelbotParams& params) noexcept {
-  return params.gear_ratio_motor_rev_per_wheel_rev * params.encoder_counts_per_motor_rev /
-         (2.0 * std::numbers::pi * params.wheel_radius_m);
+  return io::CountsPerMetre(WheelGeometryOf(params));
 }
 
 }  // namespace hiltwin::app

@@ -5,21 +5,21 @@
 namespace hiltwin::app {
 namespace {
 
-nlohmann::json Timing(const scheduler::TimingStats& stats) {
+nlohmann::ordered_json Timing(const scheduler::TimingStats& stats) {
   const scheduler::TimingSummary s = stats.Summary();
   return {{"min", s.min_ns}, {"mean", s.mean_ns}, {"p50", s.p50_ns}, {"p99", s.p99_ns},
           {"p999", s.p999_ns}, {"max", s.max_ns}, {"count", s.count}};
 }
 
-nlohmann::json Constraint(const qos::RuleStatus& status) {
-  nlohmann::json parameters;
+nlohmann::ordered_json Constraint(const qos::RuleStatus& status) {
+  nlohmann::ordered_json parameters;
   switch (status.spec.kind) {
     case qos::RuleKind::kMkFirm: parameters = {{"m", status.spec.m}, {"k", status.spec.k}}; break;
     case qos::RuleKind::kMissesInWindow: parameters = {{"n", status.spec.n}, {"k", status.spec.k}}; break;
     case qos::RuleKind::kConsecutiveMisses: parameters = {{"n", status.spec.n}}; break;
     case qos::RuleKind::kMissRatio: parameters = {{"max_miss_pct", status.spec.max_miss_pct}}; break;
   }
-  nlohmann::json c = {{"kind", qos::ToString(status.spec.kind)},
+  nlohmann::ordered_json c = {{"kind", qos::ToString(status.spec.kind)},
                       {"description", qos::Describe(status.spec)},
                       {"parameters", parameters},
                       {"violated", status.violated},
@@ -35,17 +35,17 @@ nlohmann::json Constraint(const qos::RuleStatus& status) {
 
 }  // namespace
 
-nlohmann::json BuildRunReport(const RunFacts& facts, const scheduler::Executive& executive,
+nlohmann::ordered_json BuildRunReport(const RunFacts& facts, const scheduler::Executive& executive,
                               const qos::QosMonitor& monitor, const kernel_glue::RtSetupRecord& rt) {
   const scheduler::ExecutiveStats& stats = executive.stats();
   const double miss_pct =
       stats.releases == 0 ? 0.0
                           : 100.0 * static_cast<double>(stats.deadline_misses) /
                                 static_cast<double>(stats.releases);
-  nlohmann::json constraints = nlohmann::json::array();
+  nlohmann::ordered_json constraints = nlohmann::ordered_json::array();
   for (const qos::RuleStatus& status : monitor.rules()) constraints.push_back(Constraint(status));
 
-  nlohmann::json report = {
+  nlohmann::ordered_json report = {
       {"verdict", qos::ToString(monitor.verdict())},
       {"stop_reason", facts.stop_reason},
       {"rate_hz", facts.rate_hz},
@@ -73,21 +73,23 @@ nlohmann::json BuildRunReport(const RunFacts& facts, const scheduler::Executive&
         {"cycles_judged", monitor.cycles_recorded()},
         {"misses_judged", monitor.misses()},
         {"miss_pct_judged", monitor.miss_pct()},
-        {"abort_cycle", monitor.abort_cycle() ? nlohmann::json(*monitor.abort_cycle()) : nlohmann::json(nullptr)}}},
+        {"abort_cycle", monitor.abort_cycle() ? nlohmann::ordered_json(*monitor.abort_cycle()) : nlohmann::ordered_json(nullptr)}}},
       {"clock", facts.clock},
       {"io", facts.io},
       {"io_errors", facts.io_errors},
+      {"encoder_counts_over_limit", facts.counts_over_limit},
+      {"controller_absent_cycles", facts.controller_absent_cycles},
       {"input", facts.input},
       {"integrator", facts.integrator},
-      {"log_path", facts.log_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(facts.log_path)},
+      {"log_path", facts.log_path.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(facts.log_path)},
       {"wall_time_s", facts.wall_time_s},
       {"rt_setup", kernel_glue::ToJson(rt)},
   };
   return report;
 }
 
-std::string FormatRunSummary(const nlohmann::json& r) {
-  auto us = [](const nlohmann::json& t, const char* key) {
+std::string FormatRunSummary(const nlohmann::ordered_json& r) {
+  auto us = [](const nlohmann::ordered_json& t, const char* key) {
     return t.at(key).get<double>() / 1000.0;
   };
   std::string out;
@@ -117,6 +119,16 @@ std::string FormatRunSummary(const nlohmann::json& r) {
                   c.at("description").get<std::string>().c_str(),
                   c.at("violated").get<bool>() ? "VIOLATED" : "ok",
                   c.at("violations").get<unsigned long long>(), first.c_str());
+    out += line;
+  }
+  const auto io_errors = r.at("io_errors").get<unsigned long long>();
+  const auto over_limit = r.at("encoder_counts_over_limit").get<unsigned long long>();
+  const auto absent = r.at("controller_absent_cycles").get<unsigned long long>();
+  if (io_errors + over_limit + absent > 0) {
+    std::snprintf(line, sizeof line,
+                  "io         %llu frames corrupted or missed (inputs held), %llu encoder changes "
+                  "over the pulse limit, no controller in %llu cycles\n",
+                  io_errors, over_limit, absent);
     out += line;
   }
   if (!r.at("log_path").is_null()) {

@@ -42,6 +42,7 @@ scheduler::CycleAction TwinTask::Step(const scheduler::CycleContext& context) no
     return scheduler::CycleAction::kStop;
   }
   if (!status.ok()) ++io_errors_;  // inputs_ untouched: the previous duty holds
+  if (status.peer_absent) ++controller_absent_cycles_;
 
   const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(context.cycle);
   if (extra_ns > 0) clock_.SpendNs(extra_ns);

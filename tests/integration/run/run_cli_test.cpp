@@ -86,6 +86,25 @@ TEST_F(RunCli, VirtualClockWithoutInjectionPassesWithExactCycleCounts) {
   ASSERT_GE(report["constraints"].size(), 2U);
   for (const auto& c : report["constraints"]) EXPECT_FALSE(c["violated"].get<bool>());
   EXPECT_NE(r.out.find("verdict    PASS"), std::string::npos) << r.out;
+  // The emulated board plays the profile: a controller is always there, the link is clean,
+  // and the openloop profile never asks for more pulses than one period can carry.
+  EXPECT_EQ(report["input"], "openloop");
+  EXPECT_EQ(report["io_errors"], 0);
+  EXPECT_EQ(report["controller_absent_cycles"], 0);
+  EXPECT_EQ(report["encoder_counts_over_limit"], 0);
+}
+
+TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
+  const std::string wire = "wire:hiltwin_run_solo_" + std::to_string(getpid());
+  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "0.1", "--io", wire,
+                               "--report", Path("r.json")}));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const auto report = ReadJson(Path("r.json"));
+  EXPECT_EQ(report["controller_absent_cycles"], 400);
+  EXPECT_EQ(report["input"], "the controller on " + wire);
+  EXPECT_NE(r.err.find("no controller was attached to " + wire + " in 400 of 400 cycles"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST_F(RunCli, VirtualRunIsDeterministic) {
@@ -171,6 +190,14 @@ TEST_F(RunCli, SigtermMidRunStopsCleanlyWithReportAndCompleteLog) {
   EXPECT_TRUE(code == 0 || code == 3) << "exit " << code;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["stop_reason"], "stop_requested");
+  // The RT set-up record is in the report whatever was granted; --priority 0 asked for no
+  // SCHED_FIFO, so none may be claimed. Memory locking depends on the machine's limits.
+  const auto& rt = report["rt_setup"];
+  EXPECT_FALSE(rt["sched_fifo"].get<bool>());
+  EXPECT_EQ(rt["fifo_priority"], 0);
+  EXPECT_TRUE(rt["memory_locked"].is_boolean());
+  EXPECT_TRUE(rt["cpu_dma_latency_held"].is_boolean());
+  EXPECT_TRUE(rt["warnings"].is_array());
   const auto cycles = report["cycles_run"].get<std::uint64_t>();
   EXPECT_GT(cycles, 100U);
   EXPECT_LT(cycles, 60'000U);
@@ -192,6 +219,7 @@ TEST_F(RunCli, BadInputOnEveryEntryPointExitsTwoWithAHelpfulMessage) {
   WriteFile("nan.csv", "time,left,right\n0,0,0\n1,nan,0\n");
   WriteFile("back.csv", "time,left,right\n0,0,0\n2,0.5,0.5\n1,0,0\n");
   WriteFile("bad.toml", "supply_voltage_v = \"twelve\"\n");
+  WriteFile("badvalue.toml", "[supply]\nvoltage_v = \"twelve\"\n");
   const std::vector<BadInput> cases = {
       {{"--no-such-flag"}, "no-such-flag"},
       {{"--rate", "0"}, "--rate"},
@@ -202,6 +230,14 @@ TEST_F(RunCli, BadInputOnEveryEntryPointExitsTwoWithAHelpfulMessage) {
       {{"--input", Path("back.csv")}, "back.csv:4:"},
       {{"--input", Path("missing.csv")}, "missing.csv"},
       {{"--config", Path("bad.toml")}, "supply_voltage_v"},
+      {{"--config", Path("badvalue.toml")}, "voltage_v"},
+      {{"--grace-cycles", "-1"}, "--grace-cycles"},
+      {{"--grace-cycles", "40"}, "--grace-cycles"},  // the whole 40-cycle run: would judge nothing
+      {{"--max-miss-pct", "-5"}, "miss-ratio"},
+      {{"--max-miss-pct", "nan"}, "miss-ratio"},
+      {{"--deadline-us", "nan"}, "--deadline-us"},
+      {{"--report", Path("no/such/folder/r.json")}, "--report"},
+      {{"--log", Path("no/such/folder/l.csv")}, "--log"},
       {{"--io", "carrier-pigeon"}, "--io"},
       {{"--qos", "11:10"}, "11:10"},
       {{"--inject-overrun", "at=5"}, "extra-us"},
@@ -209,8 +245,11 @@ TEST_F(RunCli, BadInputOnEveryEntryPointExitsTwoWithAHelpfulMessage) {
   };
   for (const auto& c : cases) {
     auto args = c.args;
-    args.insert(args.end(), {"--clock", "virtual", "--duration", "0.01"});
+    args.insert(args.end(), {"--clock", "virtual"});
+    // Every case but the --duration one runs 0.01 s (40 cycles), so only its own flag is bad.
+    if (args[0] != "--duration") args.insert(args.end(), {"--duration", "0.01"});
     const auto r = Hiltwin(Args(args));
+    EXPECT_EQ(r.out.find("verdict"), std::string::npos) << "stopped before the run: " << r.out;
     EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << (c.args.size() > 1 ? c.args[1] : "") << "\n" << r.err;
     EXPECT_NE(r.err.find(c.expect_in_message), std::string::npos)
         << "message for " << c.args[0] << " should mention '" << c.expect_in_message << "': " << r.err;

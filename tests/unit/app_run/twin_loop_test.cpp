@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 
@@ -26,8 +27,7 @@ struct TwinRig {
         driver(backend->bus(), &clock),
         params(DefaultRelbotParams()),
         model(params, Integrator::kRk4, 2.5e-4),
-        geometry{params.wheel_radius_m, params.gear_ratio_motor_rev_per_wheel_rev,
-                 params.encoder_counts_per_motor_rev},
+        geometry(WheelGeometryOf(params)),
         monitor(MakeQos()),
         executive(clock, MakeExecutive()),
         task(driver, model, geometry, clock, injector, lifecycle),
@@ -103,15 +103,26 @@ TEST(TwinLoop, EncoderPositionsReachTheBoardAndHoldOutputsStopsThePulses) {
   TwinRig rig(log_path);
   rig.executive.Run(rig.task);
   const auto& sent = rig.task.last().encoder_counts;
-  EXPECT_NE(sent[kLeftChannel], 0);
+  // The counts are the wheel travel at the encoder's scale: counts per motor turn times motor
+  // turns per wheel turn over the wheel's circumference (about 12 732 counts/m by default).
+  const RelbotOutputs& wheels = rig.task.last().outputs;
+  const RelbotParams& p = rig.params;
+  const double counts_per_m = p.gear_ratio_motor_rev_per_wheel_rev *
+                              p.encoder_counts_per_motor_rev /
+                              (2.0 * 3.14159265358979323846 * p.wheel_radius_m);
+  ASSERT_GT(counts_per_m, 1000.0);
+  ASSERT_GT(std::abs(wheels.wheel_left_m), 0.05);  // the profile moved the wheel
+  EXPECT_NEAR(sent[kLeftChannel], wheels.wheel_left_m * counts_per_m, 1.0);
+  EXPECT_NEAR(sent[kRightChannel], wheels.wheel_right_m * counts_per_m, 1.0);
   const io::ExchangeStatus hold = rig.task.HoldOutputs();
   EXPECT_TRUE(hold.ok()) << hold.reason;
-  // After holding, the emulator sits at the last position sent and emits no more pulses.
+  // After holding, the emulator settles on the last position sent and emits no more pulses.
   const io::EmulatedFpga& board = *rig.backend->emulated_board();
   const io::EncoderEmulator& left = board.encoder(kLeftChannel);
   const std::int64_t now_ns = board.time_ns();
   EXPECT_EQ(left.PositionAt(now_ns + 10 * 250'000), io::WrapToRelative(sent[kLeftChannel]));
-  EXPECT_EQ(left.PositionAt(now_ns), left.PositionAt(now_ns + 10 * 250'000));
+  // Pulses already due finish within one period; after that the emulator is still.
+  EXPECT_EQ(left.PositionAt(now_ns + 250'000), left.PositionAt(now_ns + 10 * 250'000));
   rig.logger->Stop();
   std::filesystem::remove(log_path);
 }

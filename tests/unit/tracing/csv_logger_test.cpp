@@ -141,6 +141,19 @@ TEST_F(CsvLoggerTest, ValuesRoundTripBitExactly) {
   sent.push_back({-0.0, std::numeric_limits<double>::denorm_min(),
                   std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest()});
   sent.push_back({0.1, 1e-300, 123456789.123456789, -2.5e-7});
+  // Whole numbers take the integer path up to 2^53, the double path from there.
+  sent.push_back({100000.0, -9007199254740991.0, 9007199254740992.0, 4503599627370495.5});
+  // Values with at most 6 decimals below 10^6 take the fixed-point path; near misses do not.
+  sent.push_back({999999.999999, -0.000001, 0.0000005, 123.4567891});
+  // Multiples of 2^-11 (PWM duty) take the dyadic path; 2^-12 steps do not.
+  sent.push_back({1638.0 / 2048.0, -2047.0 / 2048.0, 999999.0 + 2047.0 / 2048.0, 1.0 / 4096.0});
+  std::uniform_int_distribution<std::int64_t> micros(-999'999'999'999, 999'999'999'999);
+  for (int i = 0; i < 2000; ++i) {
+    std::array<double, 4> row{};
+    for (double& v : row) v = static_cast<double>(micros(rng)) / 1e6;
+    row[3] = static_cast<double>(i) * 0.00025;  // time stamps of a 4 kHz run
+    sent.push_back(row);
+  }
   CsvLogger logger(Config(Path(), {"a", "b", "c", "d"}));
   logger.Start();
   for (std::size_t i = 0; i < sent.size(); ++i) {
@@ -159,6 +172,19 @@ TEST_F(CsvLoggerTest, ValuesRoundTripBitExactly) {
           << "row " << i << " column " << c << " sent " << sent[i][c] << " got " << rows[i][c + 1];
     }
   }
+}
+
+TEST_F(CsvLoggerTest, WholeAndSixDecimalNumbersArePrintedPlainly) {
+  CsvLogger logger(Config(Path(), {"a", "b", "c", "d"}));
+  ASSERT_TRUE(logger.TryLog(2.0, std::array{100000.0, -3.0, 0.25, -0.0}));
+  ASSERT_TRUE(logger.TryLog(4.99975, std::array{-0.5, 1e7, 12.000001, 1e-7}));
+  ASSERT_TRUE(logger.TryLog(5.0, std::array{1638.0 / 2048.0, -1.0 / 2048.0, 1.0 / 4096.0, 0.1}));
+  logger.Stop();
+  const auto lines = ReadLines(Path());
+  ASSERT_EQ(lines.size(), 4U);
+  EXPECT_EQ(lines[1], "2,100000,-3,0.25,-0");  // not 1e+05; the sign of -0 kept
+  EXPECT_EQ(lines[2], "4.99975,-0.5,10000000,12.000001,1e-07");
+  EXPECT_EQ(lines[3], "5,0.7998046875,-0.00048828125,0.000244140625,0.1");
 }
 
 TEST_F(CsvLoggerTest, NonFiniteValuesUseMatlabSpelling) {

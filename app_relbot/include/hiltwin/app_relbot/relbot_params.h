@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "hiltwin/io/conversions.h"
+
 namespace hiltwin::app {
 
 /// A bad or missing configuration value; the message names the file, the key (and line), and
@@ -72,7 +74,10 @@ void ValidateRelbotParams(const RelbotParams& params, std::string_view source_na
 /// Reads and parses a TOML parameter file. Throws ConfigError (also when it cannot be read).
 [[nodiscard]] RelbotParams LoadRelbotParams(const std::filesystem::path& path);
 
-/// Encoder counts per metre of wheel travel (thesis appendix G: m / radius * N * counts / 2pi).
+/// The wheel geometry the FPGA conversions need (radius, gearbox, encoder), from `params`.
+[[nodiscard]] io::WheelGeometry WheelGeometryOf(const RelbotParams& params) noexcept;
+
+/// Encoder counts per metre of wheel travel (m / (2π radius) · N · counts per motor turn).
 [[nodiscard]] double EncoderCountsPerMetre(const RelbotParams& params) noexcept;
 
 }  // namespace hiltwin::app

@@ -25,16 +25,18 @@ struct RunFacts {
   std::uint64_t log_rows_dropped = 0;
   std::string log_path;          ///< empty: no log
   std::uint64_t io_errors = 0;   ///< corrupted or missed frames
+  std::uint64_t counts_over_limit = 0;  ///< encoder changes above what one period can emit
+  std::uint64_t controller_absent_cycles = 0;  ///< wire: cycles with no controller attached
   double wall_time_s = 0.0;      ///< how long the run took on the monotonic clock
 };
 
 /// Builds the JSON report. Keys of DESIGN.md's contract come first and keep their names.
-[[nodiscard]] nlohmann::json BuildRunReport(const RunFacts& facts,
+[[nodiscard]] nlohmann::ordered_json BuildRunReport(const RunFacts& facts,
                                             const scheduler::Executive& executive,
                                             const qos::QosMonitor& monitor,
                                             const kernel_glue::RtSetupRecord& rt);
 
 /// A short human summary of a report for stdout (a few lines, ends with the verdict).
-[[nodiscard]] std::string FormatRunSummary(const nlohmann::json& report);
+[[nodiscard]] std::string FormatRunSummary(const nlohmann::ordered_json& report);
 
 }  // namespace hiltwin::app

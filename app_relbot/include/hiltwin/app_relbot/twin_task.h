@@ -64,6 +64,10 @@ class TwinTask final : public scheduler::CyclicTask {
   [[nodiscard]] const TwinCycleRecord& last() const noexcept { return last_; }
   /// Frames that were corrupted or missed (inputs held) over the run.
   [[nodiscard]] std::uint64_t io_errors() const noexcept { return io_errors_; }
+  /// Cycles in which no controller was attached to the wire (the twin saw idle PWM).
+  [[nodiscard]] std::uint64_t controller_absent_cycles() const noexcept {
+    return controller_absent_cycles_;
+  }
   /// Why the link failed, when the task stopped on an I/O fault (static text).
   [[nodiscard]] const char* fault_reason() const noexcept { return fault_reason_; }
   /// Cycle at which a fault stopped the task.
@@ -80,6 +84,7 @@ class TwinTask final : public scheduler::CyclicTask {
   std::array<std::int32_t, io::kChannels> encoder_out_{};
   TwinCycleRecord last_{};
   std::uint64_t io_errors_ = 0;
+  std::uint64_t controller_absent_cycles_ = 0;
   const char* fault_reason_ = "";
   std::uint64_t fault_cycle_ = 0;
 };
