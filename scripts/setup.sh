@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package hiltwin needs to build, test and benchmark.
-# Fast when everything is present (one dpkg query, no network); uses sudo when not root;
+# Fast when everything is present (one dpkg-query, no network); uses sudo when not root;
 # stops with a clear message when a package cannot be had.
 set -euo pipefail
 
@@ -11,15 +11,17 @@ packages=(
   libspdlog-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libfftw3-dev                                  # Welch spectra in `hiltwin assess`
   liblttng-ust-dev lttng-tools babeltrace2      # tracepoints and trace tests
-  libgtest-dev libgmock-dev libbenchmark-dev    # tests and benchmarks
+  libgtest-dev libgmock-dev                     # tests
   rt-tests valgrind bc                          # cyclictest peer, callgrind counts, bench arithmetic
   gnuplot-nox                                   # `hiltwin assess --plot`
 )
 
+# One dpkg-query for all: names it does not know at all are missing too.
+installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null |
+            awk '$4 == "installed" { print $1 }' || true)
 missing=()
 for p in "${packages[@]}"; do
-  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
-  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+  grep -qx "$p" <<<"$installed" || missing+=("$p")
 done
 
 if ((${#missing[@]} == 0)); then
@@ -44,8 +46,16 @@ if ! "${sudo[@]}" apt-get update -q; then
   exit 1
 fi
 if ! "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"; then
+  unavailable=()
+  for p in "${missing[@]}"; do
+    candidate=$(apt-cache policy "$p" 2>/dev/null | awk '/Candidate:/ { print $2 }')
+    [[ -n "$candidate" && "$candidate" != "(none)" ]] || unavailable+=("$p")
+  done
   echo "setup: could not install: ${missing[*]}" >&2
-  echo "setup: hiltwin needs Debian 12 (bookworm); check 'apt-cache policy <package>' for each" >&2
+  if ((${#unavailable[@]} > 0)); then
+    echo "setup: no installable version of: ${unavailable[*]} (not in the configured apt sources)" >&2
+  fi
+  echo "setup: hiltwin needs Debian 12 (bookworm) with its main archive in /etc/apt/sources.list" >&2
   exit 1
 fi
 echo "setup: done"
