@@ -60,13 +60,19 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   ++counters_.frames_sent;
   const TransferStatus transfer = spi_.Transfer(tx_, rx_);
   status.transfer_ns = transfer.duration_ns;
-  if (transfer.result == BusResult::kIoError || transfer.result == BusResult::kPeerLost) {
+  // INIT configures this side's own board, which answered; a wire peer whose heartbeat is stale
+  // right now (hung, or just restarting) does not make that answer invalid. The first data
+  // exchange reports the peer as a fault if it is still gone, so nothing is hidden.
+  const bool peer_lost_at_init =
+      transfer.result == BusResult::kPeerLost && request.opcode == Opcode::kInit;
+  if (transfer.result == BusResult::kIoError ||
+      (transfer.result == BusResult::kPeerLost && !peer_lost_at_init)) {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;
     status.reason = transfer.reason;
     return status;
   }
-  status.peer_absent = transfer.result == BusResult::kPeerAbsent;
+  status.peer_absent = transfer.result == BusResult::kPeerAbsent || peer_lost_at_init;
   if (IsIdle(rx_)) {
     ++counters_.frames_missed;
     status.code = ExchangeStatus::Code::kMissed;

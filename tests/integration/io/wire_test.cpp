@@ -300,5 +300,34 @@ TEST(WireBackend, TheTwinSideSeesTheEcsPwmAndASecondTwinIsRefused) {
   test::KillAndWait(peer, SIGTERM);
 }
 
+TEST(WireBackend, ATwinStartingWhileTheEcsIsStaleInitialisesAndThenReportsTheEcs) {
+  const std::string name = UniqueName("stale");
+  WireBus::Unlink(name);
+  WireBus ecs_bus(name, Image::kIcoboard);
+  IcoBoard ecs(ecs_bus);
+  ASSERT_TRUE(ecs.Init(kEcsPeriodNs).ok);
+  EcsInputs ecs_in;
+  ASSERT_TRUE(ecs.Exchange({0, 0, 0, 0}, ecs_in).ok());
+  // The ECS's timeout is the 100 ms floor (20 × 200 µs is less): after 150 ms it counts as hung.
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+
+  WireBus twin_bus(name, Image::kIcoboardInverse);
+  IcoBoardInverse twin(twin_bus);
+  EXPECT_EQ(twin_bus.PeerStatus().result, BusResult::kPeerLost);
+  const InitResult init = twin.Init(kTwinPeriodNs);
+  EXPECT_TRUE(init.ok) << init.message;  // its own board answered INIT
+  TwinInputs twin_in;
+  ExchangeStatus status = twin.Exchange({0, 0, 0, 0}, twin_in);  // the stale ECS is a fault here
+  EXPECT_EQ(status.code, ExchangeStatus::Code::kFault);
+  EXPECT_NE(std::string(status.reason).find("ECS process stopped updating its heartbeat"),
+            std::string::npos)
+      << status.reason;
+  EXPECT_EQ(twin.counters().faults, 1U);
+
+  ASSERT_TRUE(ecs.Exchange({0, 0, 0, 0}, ecs_in).ok());  // the ECS beats again
+  status = twin.Exchange({0, 0, 0, 0}, twin_in);
+  EXPECT_TRUE(PeerAlive(status)) << status.reason;
+}
+
 }  // namespace
 }  // namespace hiltwin::io
