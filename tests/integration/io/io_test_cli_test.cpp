@@ -107,14 +107,16 @@ std::vector<std::string> IoTestPeer(const std::string& name, const char* image) 
           "1000000", "--rate", "1000", "--wait-peer", "30"};
 }
 
+/// io-test as `image` over a fresh wire, against io-test as `peer_image` in another process.
+test::RunResult IoTestAgainstIoTestPeer(const char* tag, const char* image, const char* peer_image) {
+  const std::string name = WireName(tag);
+  const Peer peer(IoTestPeer(name, peer_image));
+  return IoTest({"--io", "wire:" + name, "--image", image, "--frames", "400", "--rate", "2000",
+                 "--wait-peer", "20", "--json"});
+}
+
 TEST(IoTestCli, EcsSideOverTheWireChecksTheTwinIoTestsPattern) {
-  const std::string name = WireName("ecs");
-  test::RunResult r;
-  {
-    const Peer twin(IoTestPeer(name, "icoboard_inverse"));
-    r = IoTest({"--io", "wire:" + name, "--image", "icoboard", "--frames", "400", "--rate", "2000",
-                "--wait-peer", "20", "--json"});
-  }
+  const test::RunResult r = IoTestAgainstIoTestPeer("ecs", "icoboard", "icoboard_inverse");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["frames_received"], 401);
@@ -126,13 +128,7 @@ TEST(IoTestCli, EcsSideOverTheWireChecksTheTwinIoTestsPattern) {
 }
 
 TEST(IoTestCli, TwinSideOverTheWireChecksTheEcsIoTestsPattern) {
-  const std::string name = WireName("twin");
-  test::RunResult r;
-  {
-    const Peer ecs(IoTestPeer(name, "icoboard"));
-    r = IoTest({"--io", "wire:" + name, "--image", "icoboard_inverse", "--frames", "400", "--rate",
-                "2000", "--wait-peer", "20", "--json"});
-  }
+  const test::RunResult r = IoTestAgainstIoTestPeer("twin", "icoboard_inverse", "icoboard");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["frames_received"], 401);
