@@ -1,5 +1,7 @@
 #include "hiltwin/app_relbot/relbot_model.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -119,6 +121,59 @@ RelbotOutputs OutputsOf(const RelbotState& x) noexcept {
                        x[s::kWorldYM], x[s::kHeadingRad]};
 }
 
+std::vector<std::complex<double>> RelbotModesAtRest(const RelbotCoefficients& c) {
+  // Central differences of f around rest; each state's scale is O(1), so 1e-6 is well
+  // inside the linear range and far above rounding.
+  constexpr double kDelta = 1e-6;
+  Eigen::Matrix<double, kRelbotStateSize, kRelbotStateSize> jacobian;
+  for (int i = 0; i < kRelbotStateSize; ++i) {
+    RelbotState up = RelbotState::Zero();
+    RelbotState down = RelbotState::Zero();
+    up[i] = kDelta;
+    down[i] = -kDelta;
+    RelbotState f_up;
+    RelbotState f_down;
+    RelbotDerivative(c, up, 0.0, 0.0, f_up);
+    RelbotDerivative(c, down, 0.0, 0.0, f_down);
+    jacobian.col(i) = (f_up - f_down) / (2.0 * kDelta);
+  }
+  const Eigen::EigenSolver<decltype(jacobian)> solver(jacobian, false);
+  const auto& values = solver.eigenvalues();
+  return {values.data(), values.data() + values.size()};
+}
+
+double RelbotMaxStableStepS(const RelbotParams& params, Integrator integrator) {
+  return MaxStableStepS(integrator, RelbotModesAtRest(MakeRelbotCoefficients(params)));
+}
+
+namespace {
+
+void CheckStable(const RelbotCoefficients& c, Integrator integrator, double step_s) {
+  const std::vector<std::complex<double>> modes = RelbotModesAtRest(c);
+  const double max_step_s = MaxStableStepS(integrator, modes);
+  if (step_s <= max_step_s) return;
+  // Name the mode that sets the limit, so a user changing parameters knows which one bites.
+  std::complex<double> limiting{0.0, 0.0};
+  for (const auto& mode : modes) {
+    if (MaxStableStepS(integrator, std::span(&mode, 1)) == max_step_s) limiting = mode;
+  }
+  std::ostringstream message;
+  message.precision(3);
+  message << "the RELbot model diverges with " << IntegratorName(integrator) << " at a step of "
+          << step_s * 1e3 << " ms (" << 1.0 / step_s << " Hz): its mode at "
+          << limiting.real() << (limiting.imag() >= 0 ? " + " : " - ") << std::abs(limiting.imag())
+          << "i 1/s (linearised at rest) is integrated stably only up to a step of "
+          << max_step_s * 1e3 << " ms; choose an update rate of at least "
+          << std::ceil(1.0 / max_step_s) << " Hz";
+  if (integrator != Integrator::kRk4) {
+    message << " (rk4: at least " << std::ceil(1.0 / MaxStableStepS(Integrator::kRk4, modes))
+            << " Hz)";
+  }
+  throw ConfigError(message.str());
+}
+
+}  // namespace
+
 RelbotModel::RelbotModel(const RelbotParams& params, Integrator integrator, double step_s)
     : params_(params), integrator_(integrator), step_s_(step_s) {
   ValidateRelbotParams(params_, "RELbot parameters");
@@ -130,6 +185,7 @@ RelbotModel::RelbotModel(const RelbotParams& params, Integrator integrator, doub
     throw ConfigError(message.str());
   }
   coefficients_ = MakeRelbotCoefficients(params_);
+  CheckStable(coefficients_, integrator_, step_s_);
 }
 
 void RelbotModel::Reset() noexcept {

@@ -175,9 +175,13 @@ std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
 }
 
 bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
+  run_all_ = missed ? run_all_ + 1 : 0;
+  max_run_all_ = std::max(max_run_all_, run_all_);
   if (cycle < config_.grace_cycles) {
     ++grace_seen_;
     if (missed) ++grace_misses_;
+    live_releases_.store(releases_recorded(), std::memory_order_relaxed);
+    live_all_misses_.store(all_misses(), std::memory_order_relaxed);
     return aborted_;
   }
   const std::uint64_t t = judged_cycles_;  // judged index of this cycle
@@ -248,6 +252,8 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
   }
   SetBit(t, missed);
 
+  live_releases_.store(releases_recorded(), std::memory_order_relaxed);
+  live_all_misses_.store(all_misses(), std::memory_order_relaxed);
   live_cycles_.store(judged_cycles_, std::memory_order_relaxed);
   live_misses_.store(misses_, std::memory_order_relaxed);
   live_distance_.store(min_distance, std::memory_order_relaxed);
@@ -270,8 +276,16 @@ double QosMonitor::miss_pct() const noexcept {
   return static_cast<double>(misses_) * 100.0 / static_cast<double>(judged_cycles_);
 }
 
+double QosMonitor::all_miss_pct() const noexcept {
+  const std::uint64_t releases = releases_recorded();
+  if (releases == 0) return 0.0;
+  return static_cast<double>(all_misses()) * 100.0 / static_cast<double>(releases);
+}
+
 LiveQos QosMonitor::Live() const noexcept {
-  return LiveQos{.cycles_judged = live_cycles_.load(std::memory_order_relaxed),
+  return LiveQos{.releases = live_releases_.load(std::memory_order_relaxed),
+                 .deadline_misses = live_all_misses_.load(std::memory_order_relaxed),
+                 .cycles_judged = live_cycles_.load(std::memory_order_relaxed),
                  .misses = live_misses_.load(std::memory_order_relaxed),
                  .distance_to_failure = live_distance_.load(std::memory_order_relaxed),
                  .verdict = live_verdict_.load(std::memory_order_relaxed)};

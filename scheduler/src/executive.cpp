@@ -68,7 +68,8 @@ void Executive::Account(TimingSample& sample, bool has_previous_start,
   // that starts behind (catch-up after an overrun) is late because of the model, and that
   // lateness shows in its response time instead.
   if (loop_was_idle) stats_.wake_latency.Record(latency_ns);
-  stats_.compute.Record(sample.end_ns - sample.start_ns);
+  stats_.compute.Record(sample.end_ns - sample.start_ns - sample.io_ns);
+  stats_.io.Record(sample.io_ns);
   stats_.response.Record(response_ns);
   if (has_previous_start) {
     stats_.period_jitter.Record(sample.start_ns - previous_start_ns - config_.period_ns);
@@ -77,19 +78,11 @@ void Executive::Account(TimingSample& sample, bool has_previous_start,
   stats_.releases += 1 + sample.releases_skipped;
   stats_.releases_skipped += sample.releases_skipped;
 
-  const std::uint64_t misses = (sample.missed ? 1U : 0U) + sample.releases_skipped;
-  stats_.deadline_misses += misses;
-  // A skipped release implies this cycle ended after the next release, hence missed: the
-  // miss run continues through the skipped releases.
-  consecutive_misses_ = sample.missed ? consecutive_misses_ + misses : 0;
-  stats_.max_consecutive_misses = std::max(stats_.max_consecutive_misses, consecutive_misses_);
-
   recent_[recent_next_] = sample;
   recent_next_ = (recent_next_ + 1) % recent_.size();
   ++recent_count_;
 
   live_.cycles_run.store(stats_.cycles_run, std::memory_order_relaxed);
-  live_.deadline_misses.store(stats_.deadline_misses, std::memory_order_relaxed);
   if (loop_was_idle && latency_ns > live_.max_latency_ns.load(std::memory_order_relaxed)) {
     live_.max_latency_ns.store(latency_ns, std::memory_order_relaxed);
   }
@@ -121,6 +114,7 @@ StopCause Executive::Run(CyclicTask& task) noexcept {
                                static_cast<TimeNs>(k) * period_ns};
     const CycleAction task_action = task.Step(context);
     sample.end_ns = clock_.NowNs();
+    sample.io_ns = task.IoNsOfLastStep();
     sample.missed = sample.end_ns > sample.release_ns + deadline_ns_;
 
     std::uint64_t next = NextReleaseIndex(config_.overrun_policy, k, sample.end_ns, t0_ns_, period_ns);

@@ -56,7 +56,8 @@ Transition Next(State state, Event event) noexcept {
       if (Ending(state)) return Ignore(state);
       return To(state, State::kStopping);
     case Event::kFinishReached:
-      if (state == State::kRun) return To(state, State::kStopping);
+      // Paused cycles are still released, so the planned releases can run out while paused.
+      if (state == State::kRun || state == State::kPaused) return To(state, State::kStopping);
       return Ending(state) ? Ignore(state) : Reject(state);
     case Event::kQosAbort:
       if (state == State::kRun) return To(state, State::kError);

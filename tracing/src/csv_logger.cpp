@@ -194,19 +194,13 @@ void CsvLogger::Start() {
   std::unique_lock lock(mutex_);
   if (started_) throw std::logic_error("CsvLogger::Start called twice for '" + config_.path + "'");
   if (stopped_) throw std::logic_error("CsvLogger::Start after Stop for '" + config_.path + "'");
-  std::string start_error;
   writer_ready_ = false;
-  writer_ = std::thread([this] { WriterMain(); });
-  writer_done_.wait(lock, [this] { return writer_ready_; });
-  if (!error_.empty()) {
-    // The writer could not be configured and has returned; stay unstarted so Stop drains
-    // inline.
-    start_error = error_;
-    error_.clear();
-    lock.unlock();
-    writer_.join();
-    throw std::runtime_error("CsvLogger: writer thread for '" + config_.path + "': " + start_error);
+  try {
+    writer_ = kernel_glue::NamedThread({"hiltwin-log", config_.writer_cpus}, [this] { WriterMain(); });
+  } catch (const std::exception& e) {
+    throw std::runtime_error("CsvLogger: writer thread for '" + config_.path + "': " + e.what());
   }
+  writer_done_.wait(lock, [this] { return writer_ready_; });
   started_ = true;
   writer_ready_for_producer_.store(true, std::memory_order_release);
 }
@@ -264,7 +258,7 @@ void CsvLogger::Stop() {
   accepting_.store(false, std::memory_order_relaxed);
   if (writer_.joinable()) {
     wake_writer_.notify_all();
-    writer_.join();
+    writer_.Join();
   }
   // The writer drained after seeing the stop request; this catches a writer that never ran.
   DrainAvailable();
@@ -279,9 +273,7 @@ void CsvLogger::WriterMain() {
   ConfigureWriterThread();
   std::unique_lock lock(mutex_);
   writer_ready_ = true;
-  const bool configured = error_.empty();
   writer_done_.notify_all();
-  if (!configured) return;
   const auto poll_period = std::chrono::nanoseconds(config_.writer_poll_period_ns);
   for (;;) {
     const bool stop = stop_requested_;
@@ -305,32 +297,12 @@ void CsvLogger::WriterMain() {
 }
 
 void CsvLogger::ConfigureWriterThread() {
-  // Threads inherit the creator's policy: if Start runs on a SCHED_FIFO loop thread the
-  // writer would compete with it, so demote explicitly.
-  std::string problem;
-  sched_param param{};
-  param.sched_priority = 0;
-  if (const int rc = pthread_setschedparam(pthread_self(), SCHED_OTHER, &param); rc != 0) {
-    problem = "pthread_setschedparam(SCHED_OTHER) failed: " + ErrnoText(rc);
-  }
-  if (problem.empty() && !config_.writer_cpus.empty()) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    for (const int cpu : config_.writer_cpus) CPU_SET(static_cast<std::size_t>(cpu), &set);
-    if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof set, &set); rc != 0) {
-      problem =
-          "pthread_setaffinity_np failed: " + ErrnoText(rc) + "; list CPUs this process may use";
-    }
-  }
-  pthread_setname_np(pthread_self(), "hiltwin-log");
+  // The thread was created at SCHED_OTHER on writer_cpus (kernel_glue::NamedThread), whatever
+  // the policy of the thread that started it; record what it runs at for the report and tests.
   int policy = -1;
   sched_param actual{};
   if (pthread_getschedparam(pthread_self(), &policy, &actual) == 0) {
     writer_policy_.store(policy, std::memory_order_relaxed);
-  }
-  if (!problem.empty()) {
-    std::lock_guard lock(mutex_);
-    error_ = problem;
   }
 }
 

@@ -90,8 +90,9 @@ TEST_F(RunCli, VirtualClockWithoutInjectionPassesWithExactCycleCounts) {
   // and the openloop profile never asks for more pulses than one period can carry.
   EXPECT_EQ(report["input"], "openloop");
   EXPECT_EQ(report["io_errors"], 0);
-  EXPECT_EQ(report["controller_absent_cycles"], 0);
-  EXPECT_EQ(report["encoder_counts_over_limit"], 0);
+  EXPECT_EQ(report["peer"], "controller");
+  EXPECT_EQ(report["peer_absent_cycles"], 0);
+  EXPECT_EQ(report["pulse_limit_cycles"], 0);
 }
 
 TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
@@ -100,7 +101,7 @@ TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
                                "--report", Path("r.json")}));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
-  EXPECT_EQ(report["controller_absent_cycles"], 400);
+  EXPECT_EQ(report["peer_absent_cycles"], 400);
   EXPECT_EQ(report["input"], "the controller on " + wire);
   EXPECT_NE(r.err.find("no controller was attached to " + wire + " in 400 of 400 cycles"),
             std::string::npos)
@@ -148,7 +149,7 @@ TEST_F(RunCli, InjectedOverrunsAreFlaggedAtTheExactFirstViolatingCycle) {
   std::string header;
   const auto rows = ReadCsv(Path("log.csv"), &header);
   ASSERT_EQ(rows.size(), 8000U);
-  const std::size_t missed_col = 13, cycle_col = 10;
+  const std::size_t missed_col = 14, cycle_col = 10;
   EXPECT_EQ(header.substr(header.rfind(',') + 1), "missed");
   std::vector<int> missed;
   for (const auto& row : rows) {
@@ -241,6 +242,9 @@ TEST_F(RunCli, BadInputOnEveryEntryPointExitsTwoWithAHelpfulMessage) {
       {{"--io", "carrier-pigeon"}, "--io"},
       {{"--qos", "11:10"}, "11:10"},
       {{"--inject-overrun", "at=5"}, "extra-us"},
+      // Outside the run's 40 cycles it would never fire: refused, not silently ignored.
+      {{"--inject-overrun", "at=40,count=3,extra-us=600"}, "--inject-overrun 'at=40,count=3"},
+      {{"--inject-overrun", "every=100,offset=50,extra-us=600"}, "first fires at cycle 50"},
       {{"--on-violation", "panic"}, "on-violation"},
   };
   for (const auto& c : cases) {
@@ -253,6 +257,60 @@ TEST_F(RunCli, BadInputOnEveryEntryPointExitsTwoWithAHelpfulMessage) {
     EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << (c.args.size() > 1 ? c.args[1] : "") << "\n" << r.err;
     EXPECT_NE(r.err.find(c.expect_in_message), std::string::npos)
         << "message for " << c.args[0] << " should mention '" << c.expect_in_message << "': " << r.err;
+  }
+}
+
+TEST_F(RunCli, ARateTheModelCannotIntegrateStablyIsRefusedWithTheReason) {
+  // 20 Hz Euler used to run into NaN mid-run (a model fault, exit 1); now it never starts.
+  const auto r = Hiltwin(Args({"--clock", "virtual", "--rate", "20", "--duration", "5",
+                               "--integrator", "euler"}));
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_EQ(r.out.find("verdict"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("--rate 20: the RELbot model diverges with euler"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("update rate of at least"), std::string::npos) << r.err;
+}
+
+TEST_F(RunCli, MissesInsideTheGracePeriodAreReportedApartFromTheJudgedOnes) {
+  // The example: 60 overruns inside a 200-cycle grace period. The summary used to
+  // print "misses 71" from the executive above a PASS judged by the monitor; now both come
+  // from the monitor's one ledger and the summary says which misses were judged.
+  const auto r = Hiltwin(Args({"--clock", "virtual", "--grace-cycles", "200", "--inject-overrun",
+                               "at=10,count=60,extra-us=300", "--report", Path("r.json")}));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const auto report = ReadJson(Path("r.json"));
+  EXPECT_EQ(report["verdict"], "PASS");
+  EXPECT_TRUE(report["miss_counts_include_grace"].get<bool>());
+  const auto misses = report["deadline_misses"].get<std::uint64_t>();
+  EXPECT_GT(misses, 60U);
+  EXPECT_EQ(report["qos"]["grace_misses"], misses);  // every miss fell in the grace period
+  EXPECT_EQ(report["qos"]["misses_judged"], 0);
+  EXPECT_EQ(report["qos"]["cycles_judged"], 40000 - 200);
+  EXPECT_EQ(report["releases_recorded"], 40000);
+  EXPECT_NE(r.out.find("judged     0 misses of 39800 releases"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the first 200 releases (" + std::to_string(misses) + " misses) are not judged"),
+            std::string::npos) << r.out;
+}
+
+TEST_F(RunCli, AbortUnderSkipJudgesNoReleaseAfterTheAbortCycle) {
+  // 20 kHz (50 us): cycle 777 overruns by 1 ms, so releases 778..796 pass while it runs and
+  // are skipped. The window of 20 ending at 782 holds 6 misses (777..782): (15,20) fails
+  // there, the run aborts, and releases 783..796 are not judged.
+  const auto r = Hiltwin(Args({"--clock", "virtual", "--rate", "20000", "--duration", "1",
+                               "--inject-overrun", "at=777,extra-us=1000", "--qos", "15:20",
+                               "--overrun-policy", "skip", "--on-violation", "abort", "--report",
+                               Path("r.json")}));
+  ASSERT_EQ(r.exit_code, 4) << r.out << r.err;
+  const auto report = ReadJson(Path("r.json"));
+  EXPECT_EQ(report["verdict"], "ABORTED");
+  EXPECT_EQ(report["qos"]["abort_cycle"], 782);
+  EXPECT_EQ(report["deadline_misses"], 6);
+  EXPECT_EQ(report["releases_recorded"], 783);
+  EXPECT_EQ(report["releases_skipped"], 19);  // what the executive saw pass, for the record
+  for (const auto& c : report["constraints"]) {
+    if (c["kind"] != "mk_firm") continue;
+    EXPECT_EQ(c["violations"], 1);
+    EXPECT_EQ(c["min_met_in_window"], 14);
+    EXPECT_EQ(c["first_violation_cycle"], 782);
   }
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <limits>
 
 #include "fakes/alloc_counter.h"
@@ -206,21 +207,62 @@ TEST(RelbotModel, DutyIsSaturatedAndNanSwitchesTheMotorOff) {
   EXPECT_TRUE(c.state().isZero());
 }
 
-TEST(RelbotModel, StateIsFiniteTurnsFalseWhenEulerDiverges) {
-  // 50 ms Euler steps against the 30 Hz wheel-to-body mode (|lambda h| about 9): unstable.
-  RelbotModel model(RelbotParams{}, Integrator::kEuler, 0.05);
+TEST(RelbotModel, StateIsFiniteTurnsFalseOnANonFiniteState) {
+  RelbotModel model(RelbotParams{}, Integrator::kRk4, kStepS);
+  Drive(model, 1.0, 0.5, 0.1);
   EXPECT_TRUE(model.StateIsFinite());
-  int steps = 0;
-  while (model.StateIsFinite() && steps < 5000) {
-    model.Step(1.0, 0.5);
-    ++steps;
-  }
+  RelbotState broken = model.state();
+  broken[s::kBodyVelocityXMPerS] = std::numeric_limits<double>::quiet_NaN();
+  model.set_state(broken);
   EXPECT_FALSE(model.StateIsFinite());
-  EXPECT_LT(steps, 5000);
-  // The same step with RK4 at 4 kHz stays finite.
-  RelbotModel stable(RelbotParams{}, Integrator::kRk4, kStepS);
-  Drive(stable, 1.0, 0.5, 1.0);
-  EXPECT_TRUE(stable.StateIsFinite());
+  model.Step(1.0, 0.5);
+  EXPECT_FALSE(model.StateIsFinite());
+}
+
+// Integrates the equations directly (no constructor check) and says whether the state grew
+// without bound within `duration_s` at full duty.
+bool Diverges(Integrator method, double step_s, double duration_s) {
+  const RelbotCoefficients c = MakeRelbotCoefficients(RelbotParams{});
+  const auto f = [&c](const RelbotState& x, RelbotState& dxdt) noexcept {
+    RelbotDerivative(c, x, 1.0, 0.5, dxdt);
+  };
+  RelbotState x = RelbotState::Zero();
+  for (double t = 0.0; t < duration_s; t += step_s) {
+    IntegrateStep(method, f, x, step_s);
+    if (!x.allFinite() || x.head<2>().norm() > 1e6) return true;
+  }
+  return false;
+}
+
+TEST(RelbotModel, TheStableStepBoundIsTightAndTooLongAStepIsRefusedWithTheRate) {
+  for (const Integrator method : {Integrator::kEuler, Integrator::kRk2, Integrator::kRk4}) {
+    const double max_step_s = RelbotMaxStableStepS(RelbotParams{}, method);
+    ASSERT_GT(max_step_s, kStepS) << IntegratorName(method);  // 4 kHz is comfortably stable
+    // Just inside the bound the model stays finite; just outside it the equations blow up.
+    EXPECT_FALSE(Diverges(method, 0.97 * max_step_s, 36.0)) << IntegratorName(method);
+    EXPECT_TRUE(Diverges(method, 1.1 * max_step_s, 36.0)) << IntegratorName(method);
+    EXPECT_NO_THROW(RelbotModel(RelbotParams{}, method, 0.97 * max_step_s));
+    try {
+      RelbotModel model(RelbotParams{}, method, 1.1 * max_step_s);
+      FAIL() << "an unstable step was accepted for " << IntegratorName(method);
+    } catch (const ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("update rate of at least"), std::string::npos)
+          << error.what();
+    }
+  }
+  // Higher order buys a longer stable step.
+  EXPECT_LT(RelbotMaxStableStepS(RelbotParams{}, Integrator::kEuler),
+            RelbotMaxStableStepS(RelbotParams{}, Integrator::kRk4));
+}
+
+TEST(Integrator, MaxStableStepMatchesTheClosedFormForEuler) {
+  // Euler is stable for |1 + h·lambda| <= 1, i.e. h <= -2 Re(lambda) / |lambda|^2.
+  const std::complex<double> mode{-160.0, 122.0};
+  const std::complex<double> modes[] = {mode, {0.0, 0.0}, {-5.0, 0.0}};
+  EXPECT_NEAR(MaxStableStepS(Integrator::kEuler, modes), 2.0 * 160.0 / std::norm(mode), 1e-9);
+  // A real mode: RK4 is stable up to |h·lambda| = 2.785 (its real-axis stability boundary).
+  const std::complex<double> real_mode[] = {{-1000.0, 0.0}};
+  EXPECT_NEAR(MaxStableStepS(Integrator::kRk4, real_mode), 2.785e-3, 1e-6);
 }
 
 TEST(RelbotModel, StepAllocatesNothing) {

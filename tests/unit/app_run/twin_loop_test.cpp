@@ -1,11 +1,13 @@
-// The whole twin loop as `hiltwin run` assembles it — executive, mock FPGA link, RELbot model,
-// QoS monitor, tracepoints and CSV logger — runs without a single heap allocation after start.
+// The RELbot twin in the real run assembly (runtime::RunSession, exactly as `hiltwin run` uses
+// it): executive, lifecycle, mock FPGA link, RELbot model, QoS monitor, tracepoints and CSV
+// logger run 20,000 cycles on the loop thread without a single heap allocation after start.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "fakes/alloc_counter.h"
 #include "hiltwin/app_relbot/input_profile.h"
@@ -14,49 +16,52 @@
 #include "hiltwin/app_relbot/twin_task.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/qos/rules.h"
-#include "hiltwin/scheduler/executive.h"
+#include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
 namespace {
+
+constexpr std::uint64_t kCycles = 20'000;
+
+/// Counts the loop thread's allocations between BeforeLoop and AfterLoop.
+class LoopAllocations final : public runtime::LoopThreadHooks {
+ public:
+  void BeforeLoop() noexcept override { counter_.emplace(); }
+  void AfterLoop() noexcept override {
+    count = counter_->count();
+    counter_.reset();
+  }
+  std::uint64_t count = ~std::uint64_t{0};
+
+ private:
+  std::optional<test::ScopedAllocationCount> counter_;
+};
 
 struct TwinRig {
   explicit TwinRig(const std::string& log_path)
       : profile(OpenLoopProfile()),
         pwm_source(profile, 1000.0),
         backend(io::OpenBackend("mock", io::BackendOptions{})),
-        driver(backend->bus(), &clock),
+        driver(backend->bus()),
         params(DefaultRelbotParams()),
         model(params, Integrator::kRk4, 2.5e-4),
         geometry(WheelGeometryOf(params)),
-        monitor(MakeQos()),
-        executive(clock, MakeExecutive()),
-        task(driver, model, geometry, clock, injector, lifecycle),
-        qos_observer(monitor) {
+        task(driver, model, geometry) {
     backend->emulated_board()->SetPwmSource(&pwm_source);
     EXPECT_TRUE(driver.Init(250'000).ok);
-    tracing::CsvLoggerConfig log_config;
-    log_config.path = log_path;
-    log_config.columns = LogObserver::Columns();
-    logger = std::make_unique<tracing::CsvLogger>(log_config);
-    log_observer = std::make_unique<LogObserver>(*logger, task);
-    executive.AddObserver(qos_observer);
-    executive.AddObserver(*log_observer);
-    injector.Add(ParseOverrunInjection("every=997,extra-us=400"));  // exercise the miss path
-  }
-  static qos::QosConfig MakeQos() {
-    qos::QosConfig c;
-    c.rules = qos::DefaultRules();
-    c.planned_cycles = 20'000;
-    return c;
-  }
-  static scheduler::ExecutiveConfig MakeExecutive() {
-    scheduler::ExecutiveConfig c;
-    c.period_ns = 250'000;
-    c.max_cycles = 20'000;
-    return c;
+    runtime::SessionConfig config;
+    config.task_name = "RELbot twin";
+    config.io = "mock";
+    config.clock = runtime::ClockKind::kVirtual;
+    config.executive.period_ns = 250'000;
+    config.executive.max_cycles = kCycles;
+    config.qos.rules = qos::DefaultRules();
+    config.qos.planned_cycles = kCycles;
+    config.injector.Add(runtime::ParseOverrunInjection("every=997,extra-us=400"));  // miss path
+    config.log = runtime::LogConfig{log_path, 1};
+    session.emplace(std::move(config), task);
   }
 
-  kernel_glue::VirtualClock clock;
   InputProfile profile;
   ProfilePwmSource pwm_source;
   std::unique_ptr<io::IoBackend> backend;
@@ -64,44 +69,43 @@ struct TwinRig {
   RelbotParams params;
   RelbotModel model;
   io::WheelGeometry geometry;
-  OverrunInjector injector;
-  statemachine::Lifecycle lifecycle;
-  qos::QosMonitor monitor;
-  scheduler::Executive executive;
   TwinTask task;
-  QosObserver qos_observer;
-  std::unique_ptr<tracing::CsvLogger> logger;
-  std::unique_ptr<LogObserver> log_observer;
+  std::optional<runtime::RunSession> session;
 };
 
+std::string TempLog(const char* name) {
+  return (std::filesystem::temp_directory_path() /
+          (std::string(name) + std::to_string(getpid()) + ".csv"))
+      .string();
+}
+
 TEST(TwinLoop, RunsTwentyThousandCyclesWithoutAllocating) {
-  const std::string log_path =
-      (std::filesystem::temp_directory_path() / ("hiltwin_twin_loop_" + std::to_string(getpid()) + ".csv")).string();
+  const std::string log_path = TempLog("hiltwin_twin_loop_");
   TwinRig rig(log_path);
-  rig.logger->Start();
-  std::uint64_t allocations = 0;
-  {
-    test::ScopedAllocationCount count;
-    rig.executive.Run(rig.task);
-    allocations = count.count();
-  }
-  rig.logger->Stop();
-  EXPECT_EQ(allocations, 0U);
+  LoopAllocations allocations;
+  rig.session->SetLoopThreadHooks(&allocations);
+  const runtime::RunReport report = rig.session->Run();
+  EXPECT_EQ(allocations.count, 0U) << "malloc counted: " << test::MallocIsCounted();
   // The loop really did the work: the robot moved, misses were injected, rows were logged.
-  EXPECT_EQ(rig.executive.stats().cycles_run, 20'000U);
-  EXPECT_GT(rig.executive.stats().deadline_misses, 0U);
-  EXPECT_EQ(rig.monitor.cycles_recorded(), rig.executive.stats().releases);
+  EXPECT_EQ(report.cycles_run, kCycles);
+  EXPECT_GT(report.misses.deadline_misses, 0U);
+  EXPECT_EQ(report.misses.releases, report.releases);  // every release is in the one ledger
+  EXPECT_EQ(report.stop_reason, statemachine::StopReason::kFinished);
+  EXPECT_EQ(report.final_state, statemachine::State::kStopped);
   EXPECT_NE(rig.model.Outputs().wheel_left_m, 0.0);
-  EXPECT_EQ(rig.task.io_errors(), 0U);
-  EXPECT_EQ(rig.logger->rows_written(), 20'000U);
+  EXPECT_EQ(rig.model.steps(), kCycles);
+  EXPECT_EQ(report.link.io_errors, 0U);
+  ASSERT_TRUE(report.log.has_value());
+  EXPECT_EQ(report.log->rows_written, kCycles);
+  EXPECT_TRUE(report.outputs_safe);
   std::filesystem::remove(log_path);
 }
 
-TEST(TwinLoop, EncoderPositionsReachTheBoardAndHoldOutputsStopsThePulses) {
-  const std::string log_path =
-      (std::filesystem::temp_directory_path() / ("hiltwin_twin_hold_" + std::to_string(getpid()) + ".csv")).string();
+TEST(TwinLoop, EncoderPositionsReachTheBoardAndTheSafeOutputsStopThePulses) {
+  const std::string log_path = TempLog("hiltwin_twin_hold_");
   TwinRig rig(log_path);
-  rig.executive.Run(rig.task);
+  const runtime::RunReport report = rig.session->Run();  // ends with the safe outputs
+  ASSERT_TRUE(report.outputs_safe);
   const auto& sent = rig.task.last().encoder_counts;
   // The counts are the wheel travel at the encoder's scale: counts per motor turn times motor
   // turns per wheel turn over the wheel's circumference (about 12 732 counts/m by default).
@@ -114,16 +118,16 @@ TEST(TwinLoop, EncoderPositionsReachTheBoardAndHoldOutputsStopsThePulses) {
   ASSERT_GT(std::abs(wheels.wheel_left_m), 0.05);  // the profile moved the wheel
   EXPECT_NEAR(sent[kLeftChannel], wheels.wheel_left_m * counts_per_m, 1.0);
   EXPECT_NEAR(sent[kRightChannel], wheels.wheel_right_m * counts_per_m, 1.0);
-  const io::ExchangeStatus hold = rig.task.HoldOutputs();
-  EXPECT_TRUE(hold.ok()) << hold.reason;
-  // After holding, the emulator settles on the last position sent and emits no more pulses.
+  // The safe outputs repeat what the last live exchange sent (the step before the last one's
+  // positions), so the emulator settles there and emits no more pulses: a robot at rest.
+  const auto& held = rig.task.encoder_sent();
+  EXPECT_NEAR(held[kLeftChannel], sent[kLeftChannel], 20);  // one 250 µs step of travel
   const io::EmulatedFpga& board = *rig.backend->emulated_board();
   const io::EncoderEmulator& left = board.encoder(kLeftChannel);
   const std::int64_t now_ns = board.time_ns();
-  EXPECT_EQ(left.PositionAt(now_ns + 10 * 250'000), io::WrapToRelative(sent[kLeftChannel]));
+  EXPECT_EQ(left.PositionAt(now_ns + 10 * 250'000), io::WrapToRelative(held[kLeftChannel]));
   // Pulses already due finish within one period; after that the emulator is still.
   EXPECT_EQ(left.PositionAt(now_ns + 250'000), left.PositionAt(now_ns + 10 * 250'000));
-  rig.logger->Stop();
   std::filesystem::remove(log_path);
 }
 

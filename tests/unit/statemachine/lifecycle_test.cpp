@@ -43,6 +43,7 @@ const std::map<std::pair<State, Event>, State>& Legal() {
       {{S::kRun, E::kModelFault}, S::kError},
       {{S::kPaused, E::kStart}, S::kRun},
       {{S::kPaused, E::kStopRequest}, S::kStopping},
+      {{S::kPaused, E::kFinishReached}, S::kStopping},  // the planned releases ran out
       {{S::kPaused, E::kIoFault}, S::kError},
       {{S::kPaused, E::kModelFault}, S::kError},
       {{S::kStopping, E::kDrained}, S::kStopped},

@@ -7,17 +7,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "hiltwin/runtime/exit_code.h"
+
 namespace hiltwin::app {
 
-/// Process exit codes; users' scripts and CI rely on these numbers.
-enum class ExitCode : int {
-  kPass = 0,      ///< success / QoS PASS
-  kInternal = 1,  ///< a bug or an unexpected failure inside hiltwin
-  kUsage = 2,     ///< bad flag, configuration or input file
-  kFlagged = 3,   ///< run completed but QoS FLAGGED (results unreliable)
-  kAborted = 4,   ///< run ABORTED by the QoS policy
-  kIo = 5,        ///< hardware / I/O error (e.g. the wrong FPGA image)
-};
+/// Process exit codes (DESIGN.md "Contracts"), shared with the run assembly.
+using ExitCode = runtime::ExitCode;
 
 /// Ends a command with `code` and a message that says what, where and what to do.
 /// Thrown only outside the real-time loop (configuration, start-up, reporting).

@@ -4,6 +4,8 @@
 /// functor `f(const State& x, State& dxdt) noexcept`; the stages live on the stack, so a step
 /// allocates nothing.
 
+#include <complex>
+#include <span>
 #include <string_view>
 
 namespace hiltwin::app {
@@ -21,6 +23,17 @@ enum class Integrator { kEuler, kRk2, kRk4 };
 [[nodiscard]] constexpr int StagesPerStep(Integrator integrator) noexcept {
   return integrator == Integrator::kEuler ? 1 : integrator == Integrator::kRk2 ? 2 : 4;
 }
+
+/// The method's stability function R(z): one step maps x' = λx to x·R(hλ) with z = hλ
+/// (1 + z for Euler; the truncated exponential series to order 2 and 4 for RK2 and RK4).
+[[nodiscard]] std::complex<double> StabilityFunction(Integrator integrator,
+                                                     std::complex<double> z) noexcept;
+
+/// Largest step in seconds at which `integrator` keeps every mode with eigenvalue `modes`
+/// (1/s) from growing: |R(h·λ)| <= 1 for all of them. Modes with |λ| below 1e-6 1/s (pure
+/// integrators, such as positions) are marginal at any step and ignored. At most 1 s.
+[[nodiscard]] double MaxStableStepS(Integrator integrator,
+                                    std::span<const std::complex<double>> modes) noexcept;
 
 /// x(t+h) = x + h f(x).
 template <class State, class Derivative>

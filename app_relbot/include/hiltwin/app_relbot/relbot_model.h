@@ -7,7 +7,9 @@
 /// fixed-size Eigen, no allocation.
 
 #include <Eigen/Core>
+#include <complex>
 #include <cstdint>
+#include <vector>
 
 #include "hiltwin/app_relbot/integrator.h"
 #include "hiltwin/app_relbot/relbot_params.h"
@@ -82,13 +84,21 @@ void RelbotDerivative(const RelbotCoefficients& c, const RelbotState& x, double 
 /// Outputs read from a state.
 [[nodiscard]] RelbotOutputs OutputsOf(const RelbotState& x) noexcept;
 
+/// Eigenvalues (1/s) of the model's Jacobian at rest with zero duty. At rest the castor's
+/// smoothed Coulomb friction is steepest, so these are the fastest modes the integrator meets.
+[[nodiscard]] std::vector<std::complex<double>> RelbotModesAtRest(const RelbotCoefficients& c);
+
+/// Largest fixed step (s) at which `integrator` integrates the RELbot stably.
+[[nodiscard]] double RelbotMaxStableStepS(const RelbotParams& params, Integrator integrator);
+
 /// The RELbot plant at a fixed step with a chosen explicit integrator.
 class RelbotModel {
  public:
   using State = RelbotState;
 
-  /// Validates params (throws ConfigError) and step_s (finite, > 0, <= 0.1 s; throws
-  /// ConfigError). Starts at rest at the world origin, heading 0.
+  /// Validates params (throws ConfigError) and step_s (finite, > 0, <= 0.1 s, and no longer
+  /// than RelbotMaxStableStepS: a step that makes the model diverge is refused with the
+  /// reason, not discovered as NaN mid-run). Starts at rest at the world origin, heading 0.
   RelbotModel(const RelbotParams& params, Integrator integrator = Integrator::kRk4,
               double step_s = 2.5e-4);
 

@@ -1,5 +1,6 @@
 #pragma once
-/// The QoS monitor: records one met/missed flag per release and keeps, for every rule, whether
+/// The QoS monitor: the run's one miss ledger. It records one met/missed flag per release (the
+/// grace period apart) and keeps, for every rule, whether
 /// it is violated, how many windows violate it, the first violating cycle, the worst window and
 /// the live distance to failure. Record() is O(rules) = O(1) per cycle, allocation-free,
 /// lock-free and never throws; all memory is taken in the constructor. Semantics: docs/qos.md.
@@ -73,8 +74,10 @@ struct RuleStatus {
 
 /// Figures any thread may read while the loop runs (each field is one relaxed atomic load).
 struct LiveQos {
-  std::uint64_t cycles_judged = 0;
-  std::uint64_t misses = 0;
+  std::uint64_t releases = 0;         ///< every release recorded, grace period included
+  std::uint64_t deadline_misses = 0;  ///< misses among them, grace period included
+  std::uint64_t cycles_judged = 0;    ///< releases after the grace period
+  std::uint64_t misses = 0;           ///< misses among the judged releases
   std::uint32_t distance_to_failure = kNeverFails;  ///< minimum over the rules
   Verdict verdict = Verdict::kPass;                 ///< verdict if the run ended now
 };
@@ -98,6 +101,13 @@ class QosMonitor {
   [[nodiscard]] std::uint64_t cycles_recorded() const noexcept { return judged_cycles_; }
   [[nodiscard]] std::uint64_t misses() const noexcept { return misses_; }
   [[nodiscard]] std::uint64_t max_consecutive_misses() const noexcept { return max_run_; }
+  /// Every release recorded (grace period included) and the misses among them.
+  [[nodiscard]] std::uint64_t releases_recorded() const noexcept { return grace_seen_ + judged_cycles_; }
+  [[nodiscard]] std::uint64_t all_misses() const noexcept { return grace_misses_ + misses_; }
+  /// Longest run of consecutive misses over every release, grace period included.
+  [[nodiscard]] std::uint64_t max_consecutive_all_misses() const noexcept { return max_run_all_; }
+  /// Percentage of all recorded releases missed, grace period included.
+  [[nodiscard]] double all_miss_pct() const noexcept;
   /// Percentage of judged cycles missed (0 before the first judged cycle).
   [[nodiscard]] double miss_pct() const noexcept;
   /// Releases inside the grace period and how many of them missed (reported, not judged).
@@ -145,6 +155,8 @@ class QosMonitor {
   std::uint64_t misses_ = 0;
   std::uint64_t run_ = 0;  // current run of consecutive judged misses
   std::uint64_t max_run_ = 0;
+  std::uint64_t run_all_ = 0;  // current run of consecutive misses, grace period included
+  std::uint64_t max_run_all_ = 0;
   std::uint64_t grace_seen_ = 0;
   std::uint64_t grace_misses_ = 0;
   std::uint64_t judged_plan_ = 0;  // planned_cycles - grace_cycles (0: no plan)
@@ -152,6 +164,8 @@ class QosMonitor {
   std::optional<std::uint64_t> abort_cycle_;
   std::optional<std::size_t> abort_rule_;
 
+  std::atomic<std::uint64_t> live_releases_{0};
+  std::atomic<std::uint64_t> live_all_misses_{0};
   std::atomic<std::uint64_t> live_cycles_{0};
   std::atomic<std::uint64_t> live_misses_{0};
   std::atomic<std::uint32_t> live_distance_{kNeverFails};

@@ -16,6 +16,7 @@ struct TimingSample {
   TimeNs wake_ns = 0;             ///< when the sleep returned
   TimeNs start_ns = 0;            ///< when the step began
   TimeNs end_ns = 0;              ///< when the step (and its I/O) ended
+  TimeNs io_ns = 0;               ///< of end - start, the time the step spent in I/O
   std::uint32_t releases_skipped = 0;  ///< releases after this one dropped by kSkip (each a miss)
   bool missed = false;            ///< end_ns > release_ns + deadline
 };
@@ -37,6 +38,9 @@ class CyclicTask {
  public:
   virtual ~CyclicTask() = default;
   virtual CycleAction Step(const CycleContext& context) noexcept = 0;
+  /// How much of the last Step() was I/O (bus transfers), so that compute time and I/O time
+  /// are reported apart. Tasks without I/O keep the default.
+  [[nodiscard]] virtual TimeNs IoNsOfLastStep() const noexcept { return 0; }
 };
 
 /// Receives every cycle's timing right after the cycle (QoS, tracing, logging). One virtual

@@ -47,23 +47,23 @@ enum class StopCause {
 [[nodiscard]] const char* ToString(StopCause cause) noexcept;
 
 /// Counters written by the loop and readable from any thread (progress display, telemetry).
+/// Misses are not here: the QoS monitor is the one miss ledger.
 struct LiveCounters {
   std::atomic<std::uint64_t> cycles_run{0};
-  std::atomic<std::uint64_t> deadline_misses{0};
   std::atomic<std::int64_t> max_latency_ns{0};
   std::atomic<std::int64_t> max_response_ns{0};
 };
 
-/// Statistics of a run; read them after Run() returns.
+/// Timing statistics of a run; read them after Run() returns. Whether a cycle missed is
+/// decided here (TimingSample::missed), but misses are counted by the QoS monitor alone.
 struct ExecutiveStats {
   std::uint64_t cycles_run = 0;        ///< steps executed
   std::uint64_t releases = 0;          ///< releases consumed (run + skipped)
-  std::uint64_t deadline_misses = 0;   ///< missed cycles + skipped releases
   std::uint64_t releases_skipped = 0;  ///< by the kSkip policy
-  std::uint64_t max_consecutive_misses = 0;
   TimingStats wake_latency;   ///< wake - release of cycles whose release found the loop
                               ///< asleep: the OS's share (catch-up cycles are not in it)
-  TimingStats compute;        ///< end - start: the step's share
+  TimingStats compute;        ///< end - start - io: the step's own computation
+  TimingStats io;             ///< the step's I/O time (CyclicTask::IoNsOfLastStep)
   TimingStats response;       ///< end - release
   TimingStats period_jitter;  ///< (start_k - start_{k-1}) - period, consecutive cycles only
 };
@@ -105,7 +105,6 @@ class Executive {
   bool (*stop_requested_)() noexcept = nullptr;
   ExecutiveStats stats_;
   LiveCounters live_;
-  std::uint64_t consecutive_misses_ = 0;
   std::vector<TimingSample> recent_;  // ring buffer, preallocated
   std::size_t recent_next_ = 0;
   std::uint64_t recent_count_ = 0;

@@ -28,7 +28,7 @@
 ///   init      --configured--> ready       --start--> run        --pause--> paused
 ///   paused    --start-->      run
 ///   init|ready|run|paused --stop_request--> stopping   (reason stop_requested)
-///   run       --finish_reached--> stopping              (reason finished)
+///   run|paused --finish_reached--> stopping             (reason finished)
 ///   run       --qos_abort-->  error                     (reason qos_abort)
 ///   init|ready|run|paused|stopping --io_fault|model_fault--> error
 ///   stopping  --drained-->    stopped     error --drained--> safe_stop

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/tracing/spsc_ring.h"
 
 namespace hiltwin::tracing {
@@ -35,7 +36,7 @@ struct CsvLoggerConfig {
   std::uint32_t decimation = 1;                     ///< log every Nth offered row (1 = all)
   std::int64_t writer_poll_period_ns = 2'000'000;   ///< writer sleeps this long between drains
   std::int64_t file_flush_period_ns = 100'000'000;  ///< writer hands data to the OS this often
-  std::vector<int> writer_cpus;  ///< CPUs for the writer thread; empty = inherit the starter's
+  std::vector<int> writer_cpus;  ///< CPUs for the writer thread; empty = every allowed CPU
   /// Off-line runs only (virtual clock): when the queue is full the producer waits for the
   /// started writer instead of dropping, so an as-fast-as-possible run logs every row. Never
   /// set this for a real-time loop: it makes TryLog block.
@@ -54,7 +55,7 @@ class CsvLogger {
   CsvLogger(const CsvLogger&) = delete;
   CsvLogger& operator=(const CsvLogger&) = delete;
 
-  /// Starts the writer thread at SCHED_OTHER. Throws std::logic_error if called twice or
+  /// Starts the writer thread `hiltwin-log` at SCHED_OTHER on writer_cpus. Throws std::logic_error if called twice or
   /// after Stop, std::system_error if the thread cannot be created.
   void Start();
 
@@ -126,7 +127,7 @@ class CsvLogger {
   std::uint64_t flush_completed_ = 0;
   std::string error_;
   std::atomic<int> writer_policy_{-1};
-  std::thread writer_;
+  kernel_glue::NamedThread writer_;
 };
 
 }  // namespace hiltwin::tracing

@@ -1,9 +1,9 @@
-#include "hiltwin/app_relbot/overrun_injection.h"
+#include "hiltwin/runtime/overrun_injection.h"
 
 #include <charconv>
 #include <stdexcept>
 
-namespace hiltwin::app {
+namespace hiltwin::runtime {
 namespace {
 
 constexpr const char* kForms =
@@ -11,7 +11,7 @@ constexpr const char* kForms =
     "e.g. 'at=40000,count=5,extra-us=600' or 'every=1000,extra-us=300'";
 
 [[noreturn]] void Fail(std::string_view spec, const std::string& what) {
-  throw std::invalid_argument("--inject-overrun '" + std::string(spec) + "': " + what + "; " +
+  throw std::invalid_argument("'" + std::string(spec) + "': " + what + "; " +
                               kForms);
 }
 
@@ -74,8 +74,33 @@ OverrunInjection ParseOverrunInjection(std::string_view spec) {
 }
 
 void OverrunInjector::Add(const OverrunInjection& injection) {
-  if (size_ == kMaxInjections) throw std::length_error("at most 8 --inject-overrun specs");
+  if (size_ == kMaxInjections) {
+    throw std::length_error("at most " + std::to_string(kMaxInjections) + " overrun injections");
+  }
   injections_[size_++] = injection;
+}
+
+std::string Describe(const OverrunInjection& injection) {
+  std::string text = injection.kind == OverrunInjection::Kind::kAt
+                         ? "at=" + std::to_string(injection.first_cycle) +
+                               ",count=" + std::to_string(injection.count)
+                         : "every=" + std::to_string(injection.every) +
+                               ",offset=" + std::to_string(injection.offset);
+  return text + ",extra-us=" + std::to_string(injection.extra_ns / kernel_glue::kNsPerUs);
+}
+
+void OverrunInjector::CheckFiresWithin(std::uint64_t planned_cycles) const {
+  if (planned_cycles == 0) return;  // runs until stopped: every cycle may come
+  for (std::size_t i = 0; i < size_; ++i) {
+    const OverrunInjection& inj = injections_[i];
+    const std::uint64_t first =
+        inj.kind == OverrunInjection::Kind::kAt ? inj.first_cycle : inj.offset;
+    if (first < planned_cycles) continue;
+    throw std::invalid_argument(
+        "'" + Describe(inj) + "' first fires at cycle " + std::to_string(first) +
+        ", but the run's cycles are 0 to " + std::to_string(planned_cycles - 1) +
+        "; choose a cycle inside the run or lengthen it");
+  }
 }
 
 kernel_glue::TimeNs OverrunInjector::ExtraNs(std::uint64_t cycle) const noexcept {
@@ -90,4 +115,4 @@ kernel_glue::TimeNs OverrunInjector::ExtraNs(std::uint64_t cycle) const noexcept
   return extra_ns;
 }
 
-}  // namespace hiltwin::app
+}  // namespace hiltwin::runtime

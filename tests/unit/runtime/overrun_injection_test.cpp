@@ -1,11 +1,11 @@
-#include "hiltwin/app_relbot/overrun_injection.h"
+#include "hiltwin/runtime/overrun_injection.h"
 
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 #include <string>
 
-namespace hiltwin::app {
+namespace hiltwin::runtime {
 namespace {
 
 TEST(OverrunInjection, AtCountAndEvery) {
@@ -53,4 +53,4 @@ TEST(OverrunInjection, AtMostEightSpecs) {
 }
 
 }  // namespace
-}  // namespace hiltwin::app
+}  // namespace hiltwin::runtime

@@ -1,0 +1,113 @@
+#pragma once
+/// One run assembly for every command (DESIGN.md "runtime"). Given a validated configuration
+/// and a task, a RunSession owns, in this order: the executive, the QoS monitor (the one miss
+/// ledger), the lifecycle, the CSV logger; then, in Run(), the loop thread (created through
+/// kernel_glue::NamedThread, raised to SCHED_FIFO and pinned by the RT set-up on itself),
+/// the logger's writer thread (SCHED_OTHER on the CPUs the loop does not use), the loop, the
+/// safe outputs, the drain, and the typed RunReport. The calling (control) thread stays
+/// SCHED_OTHER and prints the progress line; no other thread exists. docs/architecture.md
+/// draws it.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hiltwin/kernel_glue/clock.h"
+#include "hiltwin/kernel_glue/rt_setup.h"
+#include "hiltwin/qos/monitor.h"
+#include "hiltwin/runtime/overrun_injection.h"
+#include "hiltwin/runtime/run_report.h"
+#include "hiltwin/runtime/run_task.h"
+#include "hiltwin/scheduler/executive.h"
+#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/tracing/csv_logger.h"
+
+namespace hiltwin::runtime {
+
+class CycleRunner;
+
+/// Where and how often to log.
+struct LogConfig {
+  std::string path;
+  std::uint32_t decimation = 1;  ///< every Nth cycle
+};
+
+/// A validated run, as plain data (cactus-rt style config struct).
+struct SessionConfig {
+  std::string task_name = "task";  ///< for the report, e.g. "RELbot twin"
+  std::string io;                  ///< backend spec, for the report
+  std::string peer_name = "peer";  ///< who is on the other side of the link
+  std::vector<std::pair<std::string, std::string>> details;  ///< app facts for the report
+  ClockKind clock = ClockKind::kRealtime;
+  double rate_hz = 4000.0;
+  scheduler::ExecutiveConfig executive;  ///< max_cycles: the planned releases (0: until stopped)
+  qos::QosConfig qos;
+  kernel_glue::RtSetupRequest rt;  ///< applied to the loop thread (realtime clock only)
+  OverrunInjector injector;
+  std::optional<LogConfig> log;
+  bool progress = false;  ///< a throttled progress line on stderr, from the control thread
+  /// Called on the control thread once the loop thread is set up, before the first cycle:
+  /// the RT set-up record (null on the virtual clock). For the command's start-up lines.
+  std::function<void(const kernel_glue::RtSetupRecord*)> on_ready;
+};
+
+/// Test hooks run on the loop thread around the loop (e.g. to count allocations there).
+class LoopThreadHooks {
+ public:
+  virtual ~LoopThreadHooks() = default;
+  virtual void BeforeLoop() noexcept {}
+  /// After the loop and the safe outputs.
+  virtual void AfterLoop() noexcept {}
+};
+
+/// Commands another thread may send to a running session.
+enum class SessionCommand : std::uint8_t { kStop, kPause, kResume };
+
+class RunSession {
+ public:
+  /// Builds everything and opens the log (truncating it). Throws std::invalid_argument for a
+  /// bad configuration and std::runtime_error when the log cannot be created; the messages
+  /// name domain values, not flags. `task` must outlive the session.
+  RunSession(SessionConfig config, RunTask& task);
+  ~RunSession();
+  RunSession(const RunSession&) = delete;
+  RunSession& operator=(const RunSession&) = delete;
+
+  /// Runs the session to its end (see the header comment) and returns its report. Call once.
+  /// Throws std::runtime_error when a thread cannot be started.
+  [[nodiscard]] RunReport Run();
+
+  /// Thread-safe and lock-free; acted on by the loop after its current cycle.
+  void Post(SessionCommand command) noexcept;
+  void SetLoopThreadHooks(LoopThreadHooks* hooks) noexcept { hooks_ = hooks; }
+
+  [[nodiscard]] const scheduler::Executive& executive() const noexcept { return executive_; }
+  [[nodiscard]] const qos::QosMonitor& monitor() const noexcept { return monitor_; }
+  [[nodiscard]] const statemachine::Lifecycle& lifecycle() const noexcept { return lifecycle_; }
+  [[nodiscard]] kernel_glue::Clock& clock() noexcept { return *clock_; }
+
+ private:
+  struct LoopResult;
+  void LoopThreadMain(LoopResult& result) noexcept;
+  void PrintProgress() const;
+  [[nodiscard]] RunReport BuildReport(const LoopResult& result, double wall_time_s) const;
+
+  SessionConfig config_;
+  RunTask& task_;
+  std::unique_ptr<kernel_glue::Clock> clock_;
+  statemachine::Lifecycle lifecycle_;
+  qos::QosMonitor monitor_;
+  scheduler::Executive executive_;
+  std::unique_ptr<tracing::CsvLogger> logger_;
+  std::unique_ptr<CycleRunner> runner_;
+  std::vector<int> allowed_cpus_;  ///< the process's CPUs, read before anything is pinned
+  LoopThreadHooks* hooks_ = nullptr;
+  bool ran_ = false;
+};
+
+}  // namespace hiltwin::runtime

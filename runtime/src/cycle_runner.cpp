@@ -1,0 +1,120 @@
+#include "cycle_runner.h"
+
+#include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/tracing/trace.h"
+
+namespace hiltwin::runtime {
+
+using statemachine::Event;
+using statemachine::StopReason;
+
+CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
+                         statemachine::Lifecycle& lifecycle, qos::QosMonitor& monitor,
+                         const OverrunInjector& injector, tracing::CsvLogger* logger,
+                         std::uint64_t planned_releases, std::size_t task_log_columns) noexcept
+    : task_(task),
+      clock_(clock),
+      lifecycle_(lifecycle),
+      monitor_(monitor),
+      injector_(injector),
+      logger_(logger),
+      planned_releases_(planned_releases),
+      task_log_columns_(task_log_columns) {}
+
+scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
+  const statemachine::StateRules rules = lifecycle_.rules();
+  stepped_ = false;
+  step_status_ = StepStatus::Ok();
+  const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
+  const io::ExchangeStatus io = task_.Exchange(rules.live_outputs);
+  io_ns_ = clock_.NowNs() - io_start_ns;
+  io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
+  if (io_fault_) {
+    NoteFault(StopReason::kIoFault, context.cycle, io.reason);
+    return scheduler::CycleAction::kContinue;  // OnCycle still records the cycle, then stops
+  }
+  if (!io.ok()) ++counts_.io_errors;  // the task held its inputs
+  if (io.peer_absent) ++counts_.peer_absent_cycles;
+  if (io.pulse_limit) ++counts_.pulse_limit_cycles;
+  if (!rules.steps_model) {
+    ++counts_.paused_cycles;
+    return scheduler::CycleAction::kContinue;
+  }
+  step_status_ = task_.Step(context);
+  const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(context.cycle);
+  if (extra_ns > 0) clock_.SpendNs(extra_ns);
+  if (step_status_.code == StepStatus::Code::kModelFault) {
+    NoteFault(StopReason::kModelFault, context.cycle, step_status_.reason);
+  } else {
+    stepped_ = true;
+  }
+  return scheduler::CycleAction::kContinue;
+}
+
+scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sample) noexcept {
+  HILTWIN_TRACE(cycle, sample.cycle, sample.release_ns, sample.wake_ns, sample.start_ns,
+                sample.end_ns, sample.releases_skipped, static_cast<std::uint8_t>(sample.missed));
+  qos_abort_ = false;
+  if (lifecycle_.rules().records_qos) RecordQos(sample);
+  if (stepped_ && logger_ != nullptr) Log(sample);
+  PostEvents(sample);
+  return lifecycle_.rules().releases_cycles ? scheduler::CycleAction::kContinue
+                                            : scheduler::CycleAction::kStop;
+}
+
+void CycleRunner::RecordQos(const scheduler::TimingSample& sample) noexcept {
+  // Skipped releases are misses too, but once the monitor says abort the run has ended:
+  // releases after that one are not judged.
+  qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
+  for (std::uint32_t i = 1; i <= sample.releases_skipped && !qos_abort_; ++i) {
+    qos_abort_ = monitor_.Record(sample.cycle + i, true);
+  }
+  const qos::LiveQos live = monitor_.Live();
+  HILTWIN_TRACE(qos, sample.cycle, static_cast<std::int64_t>(live.distance_to_failure),
+                static_cast<std::uint8_t>(live.verdict));
+}
+
+void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
+  const std::size_t n = task_log_columns_;
+  task_.FillLogRow(std::span<double>(row_.data(), n));
+  row_[n] = static_cast<double>(sample.cycle);  // release index: model time lags it under skip
+  row_[n + 1] = static_cast<double>(sample.wake_ns - sample.release_ns) * 1e-3;
+  row_[n + 2] = static_cast<double>(sample.end_ns - sample.start_ns - sample.io_ns) * 1e-3;
+  row_[n + 3] = static_cast<double>(sample.io_ns) * 1e-3;
+  row_[n + 4] = sample.missed ? 1.0 : 0.0;
+  logger_->TryLog(task_.LogTimeS(), std::span<const double>(row_.data(), n + kTimingLogColumns.size()));
+}
+
+void CycleRunner::PostEvents(const scheduler::TimingSample& sample) noexcept {
+  // Faults first: when several causes meet in one cycle the report names the one that makes
+  // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
+  if (io_fault_) lifecycle_.Handle(Event::kIoFault);
+  if (step_status_.code == StepStatus::Code::kModelFault) lifecycle_.Handle(Event::kModelFault);
+  if (qos_abort_) lifecycle_.Handle(Event::kQosAbort);
+  const std::uint8_t commands = commands_.exchange(0, std::memory_order_acq_rel);
+  if (kernel_glue::StopRequested() || (commands & static_cast<std::uint8_t>(CommandBit::kStop)) != 0) {
+    lifecycle_.Handle(Event::kStopRequest);
+  }
+  const std::uint64_t next_release = sample.cycle + 1 + sample.releases_skipped;
+  const bool plan_done = planned_releases_ != 0 && next_release >= planned_releases_;
+  if (plan_done || step_status_.code == StepStatus::Code::kFinished) {
+    lifecycle_.Handle(Event::kFinishReached);
+  }
+  if ((commands & static_cast<std::uint8_t>(CommandBit::kPause)) != 0) lifecycle_.Handle(Event::kPause);
+  if ((commands & static_cast<std::uint8_t>(CommandBit::kResume)) != 0) lifecycle_.Handle(Event::kStart);
+}
+
+void CycleRunner::Post(CommandBit command) noexcept {
+  commands_.fetch_or(static_cast<std::uint8_t>(command), std::memory_order_acq_rel);
+}
+
+bool CycleRunner::WriteSafeOutputs() noexcept {
+  const io::ExchangeStatus status = task_.Exchange(false);
+  return status.code != io::ExchangeStatus::Code::kFault;
+}
+
+void CycleRunner::NoteFault(StopReason kind, std::uint64_t cycle, const char* reason) noexcept {
+  if (!fault_) fault_ = LoopFault{kind, cycle, reason};
+}
+
+}  // namespace hiltwin::runtime

@@ -1,0 +1,95 @@
+#pragma once
+// The per-cycle path of a RunSession, on the loop thread: asks the lifecycle what the state
+// allows (RulesOf), times the board exchange apart from the step, applies fault injection,
+// records the cycle in the QoS monitor (the one miss ledger), fires the cycle tracepoint,
+// offers the log row, and turns every status and stop cause into a lifecycle event. Nothing
+// here allocates, blocks, prints or throws.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <optional>
+
+#include "hiltwin/kernel_glue/clock.h"
+#include "hiltwin/qos/monitor.h"
+#include "hiltwin/runtime/overrun_injection.h"
+#include "hiltwin/runtime/run_task.h"
+#include "hiltwin/scheduler/cycle.h"
+#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/tracing/csv_logger.h"
+
+namespace hiltwin::runtime {
+
+/// Commands from other threads (signals, telemetry, tests), one bit each.
+enum class CommandBit : std::uint8_t { kStop = 1, kPause = 2, kResume = 4 };
+
+/// The first fault of a run, as the loop saw it (reason is static text).
+struct LoopFault {
+  statemachine::StopReason kind = statemachine::StopReason::kNone;
+  std::uint64_t cycle = 0;
+  const char* reason = "";
+};
+
+/// Counts only the loop knows; read after the loop has stopped.
+struct LoopCounts {
+  std::uint64_t io_errors = 0;
+  std::uint64_t peer_absent_cycles = 0;
+  std::uint64_t pulse_limit_cycles = 0;
+  std::uint64_t paused_cycles = 0;
+};
+
+/// Timing columns the session appends to every task's log row.
+inline constexpr std::array<const char*, 5> kTimingLogColumns = {
+    "cycle", "latency_us", "compute_us", "io_us", "missed"};
+
+class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleObserver {
+ public:
+  /// None of the references is owned. `logger` may be null (no log). `planned_releases` 0:
+  /// until stopped.
+  CycleRunner(RunTask& task, kernel_glue::Clock& clock, statemachine::Lifecycle& lifecycle,
+              qos::QosMonitor& monitor, const OverrunInjector& injector,
+              tracing::CsvLogger* logger, std::uint64_t planned_releases,
+              std::size_t task_log_columns) noexcept;
+
+  scheduler::CycleAction Step(const scheduler::CycleContext& context) noexcept override;
+  [[nodiscard]] kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
+  scheduler::CycleAction OnCycle(const scheduler::TimingSample& sample) noexcept override;
+
+  /// Thread-safe and lock-free: the loop acts on it after the current cycle.
+  void Post(CommandBit command) noexcept;
+
+  /// One exchange with safe outputs, after the loop: true when the board took it.
+  [[nodiscard]] bool WriteSafeOutputs() noexcept;
+
+  [[nodiscard]] const LoopCounts& counts() const noexcept { return counts_; }
+  [[nodiscard]] const std::optional<LoopFault>& fault() const noexcept { return fault_; }
+
+ private:
+  void RecordQos(const scheduler::TimingSample& sample) noexcept;
+  void Log(const scheduler::TimingSample& sample) noexcept;
+  void PostEvents(const scheduler::TimingSample& sample) noexcept;
+  void NoteFault(statemachine::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
+
+  RunTask& task_;
+  kernel_glue::Clock& clock_;
+  statemachine::Lifecycle& lifecycle_;
+  qos::QosMonitor& monitor_;
+  const OverrunInjector& injector_;
+  tracing::CsvLogger* logger_;
+  std::uint64_t planned_releases_;
+  std::size_t task_log_columns_;
+  std::array<double, tracing::kMaxLogColumns> row_{};
+
+  // This cycle, from Step to OnCycle.
+  kernel_glue::TimeNs io_ns_ = 0;
+  bool stepped_ = false;
+  bool io_fault_ = false;
+  StepStatus step_status_;
+  bool qos_abort_ = false;
+
+  LoopCounts counts_;
+  std::optional<LoopFault> fault_;
+  std::atomic<std::uint8_t> commands_{0};
+};
+
+}  // namespace hiltwin::runtime

@@ -1,0 +1,245 @@
+#include "hiltwin/runtime/run_session.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+#include <stdexcept>
+
+#include "cycle_runner.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/kernel_glue/thread.h"
+
+namespace hiltwin::runtime {
+namespace {
+
+std::unique_ptr<kernel_glue::Clock> MakeClock(ClockKind kind) {
+  if (kind == ClockKind::kVirtual) return std::make_unique<kernel_glue::VirtualClock>();
+  return std::make_unique<kernel_glue::MonotonicClock>();
+}
+
+std::unique_ptr<tracing::CsvLogger> MakeLogger(const SessionConfig& config, const RunTask& task,
+                                               const std::vector<int>& allowed_cpus) {
+  if (!config.log) return nullptr;
+  tracing::CsvLoggerConfig log;
+  log.path = config.log->path;
+  log.columns = task.LogColumns();
+  log.columns.insert(log.columns.end(), kTimingLogColumns.begin(), kTimingLogColumns.end());
+  log.decimation = config.log->decimation;
+  // No deadline on the virtual clock: keep every row rather than drop when the writer lags.
+  log.wait_when_full = config.clock == ClockKind::kVirtual;
+  log.writer_cpus = kernel_glue::HelperCpus(allowed_cpus, config.rt.cpus);
+  return std::make_unique<tracing::CsvLogger>(std::move(log));
+}
+
+void CheckConfig(const SessionConfig& config) {
+  const std::uint64_t planned = config.executive.max_cycles;
+  if (planned != 0 && config.qos.grace_cycles >= planned) {
+    // A grace period that covers the whole run would judge nothing and always PASS.
+    throw std::invalid_argument("a grace period of " + std::to_string(config.qos.grace_cycles) +
+                                " releases covers the whole run of " + std::to_string(planned) +
+                                "; judge at least one release");
+  }
+  if (config.qos.planned_cycles != planned) {
+    throw std::invalid_argument("the QoS plan (" + std::to_string(config.qos.planned_cycles) +
+                                " releases) differs from the run's (" + std::to_string(planned) + ")");
+  }
+  config.injector.CheckFiresWithin(planned);
+  if (config.rt.fifo_priority < 0 || config.rt.fifo_priority > 99) {
+    throw std::invalid_argument("SCHED_FIFO priority " + std::to_string(config.rt.fifo_priority) +
+                                " is outside 0 (none) .. 99");
+  }
+}
+
+}  // namespace
+
+/// What the loop thread hands back to the control thread.
+struct RunSession::LoopResult {
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool ready = false;  // RT set-up done, waiting for go
+  bool go = false;
+  bool done = false;
+  std::optional<kernel_glue::RtSession> rt;
+  std::string setup_error;
+  scheduler::StopCause cause = scheduler::StopCause::kCycleLimit;
+  bool outputs_safe = false;
+};
+
+RunSession::RunSession(SessionConfig config, RunTask& task)
+    : config_((CheckConfig(config), std::move(config))),
+      task_(task),
+      clock_(MakeClock(config_.clock)),
+      monitor_(config_.qos),
+      executive_(*clock_, config_.executive),
+      allowed_cpus_(kernel_glue::AllowedCpus()) {
+  if (task_.LogColumns().size() + kTimingLogColumns.size() > tracing::kMaxLogColumns) {
+    throw std::invalid_argument("the task logs " + std::to_string(task_.LogColumns().size()) +
+                                " columns; at most " +
+                                std::to_string(tracing::kMaxLogColumns - kTimingLogColumns.size()) +
+                                " fit beside the timing columns");
+  }
+  logger_ = MakeLogger(config_, task_, allowed_cpus_);
+  runner_ = std::make_unique<CycleRunner>(task_, *clock_, lifecycle_, monitor_, config_.injector,
+                                          logger_.get(), config_.executive.max_cycles,
+                                          task_.LogColumns().size());
+  executive_.AddObserver(*runner_);
+  lifecycle_.Handle(statemachine::Event::kConfigured);
+}
+
+RunSession::~RunSession() = default;
+
+void RunSession::Post(SessionCommand command) noexcept {
+  switch (command) {
+    case SessionCommand::kStop: runner_->Post(CommandBit::kStop); break;
+    case SessionCommand::kPause: runner_->Post(CommandBit::kPause); break;
+    case SessionCommand::kResume: runner_->Post(CommandBit::kResume); break;
+  }
+}
+
+void RunSession::LoopThreadMain(LoopResult& result) noexcept {
+  {
+    std::unique_lock lock(result.mutex);
+    if (config_.clock == ClockKind::kRealtime) {
+      // On this thread: SCHED_FIFO, affinity and the stack pre-fault act on the caller.
+      // Before the writer thread exists, because mallopt is process-wide and not thread-safe.
+      try {
+        result.rt.emplace(kernel_glue::RtSession::Apply(config_.rt));
+      } catch (const std::exception& e) {
+        result.setup_error = e.what();
+      }
+    }
+    result.ready = true;
+    result.changed.notify_all();
+    result.changed.wait(lock, [&] { return result.go; });
+    if (!result.setup_error.empty()) return;
+  }
+  if (hooks_ != nullptr) hooks_->BeforeLoop();
+  result.cause = executive_.Run(*runner_);
+  // Leaving run or paused: the outputs go safe at once, from the loop thread.
+  result.outputs_safe = runner_->WriteSafeOutputs();
+  if (hooks_ != nullptr) hooks_->AfterLoop();
+  std::lock_guard lock(result.mutex);
+  result.done = true;
+  result.changed.notify_all();
+}
+
+RunReport RunSession::Run() {
+  if (ran_) throw std::logic_error("RunSession::Run called twice");
+  ran_ = true;
+  kernel_glue::InstallStopSignalHandlers();
+  LoopResult result;
+  kernel_glue::NamedThread loop({"hiltwin-loop", allowed_cpus_}, [this, &result] { LoopThreadMain(result); });
+  std::unique_lock lock(result.mutex);
+  result.changed.wait(lock, [&] { return result.ready; });
+  if (!result.setup_error.empty()) {
+    result.go = true;
+    result.changed.notify_all();
+    lock.unlock();
+    loop.Join();
+    throw std::runtime_error("real-time set-up: " + result.setup_error);
+  }
+  if (logger_) logger_->Start();  // after the RT set-up: see LoopThreadMain
+  if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
+  const kernel_glue::MonotonicClock wall;
+  const kernel_glue::TimeNs wall_start_ns = wall.NowNs();
+  lifecycle_.Handle(statemachine::Event::kStart);
+  result.go = true;
+  result.changed.notify_all();
+  while (!result.changed.wait_for(lock, std::chrono::milliseconds(250), [&] { return result.done; })) {
+    if (config_.progress) PrintProgress();
+  }
+  lock.unlock();
+  loop.Join();
+  const double wall_time_s = static_cast<double>(wall.NowNs() - wall_start_ns) * 1e-9;
+  if (config_.progress) {
+    PrintProgress();
+    std::fputc('\n', stderr);
+  }
+  if (logger_) logger_->Stop();
+  lifecycle_.Handle(statemachine::Event::kDrained);
+  return BuildReport(result, wall_time_s);
+}
+
+void RunSession::PrintProgress() const {
+  const qos::LiveQos q = monitor_.Live();
+  const std::string distance =
+      q.distance_to_failure == qos::kNeverFails ? std::string("-") : std::to_string(q.distance_to_failure);
+  std::fprintf(stderr,
+               "\r  %llu/%llu cycles  %s  misses %llu  worst latency %.1f us  verdict so far %s  "
+               "misses to failure %s   ",
+               static_cast<unsigned long long>(executive_.live().cycles_run.load()),
+               static_cast<unsigned long long>(config_.executive.max_cycles),
+               statemachine::ToString(lifecycle_.state()),
+               static_cast<unsigned long long>(q.deadline_misses),
+               static_cast<double>(executive_.live().max_latency_ns.load()) / 1e3,
+               qos::ToString(q.verdict), distance.c_str());
+  std::fflush(stderr);
+}
+
+}  // namespace hiltwin::runtime
+
+namespace hiltwin::runtime {
+namespace {
+
+MissLedger LedgerOf(const qos::QosMonitor& m) {
+  MissLedger ledger;
+  ledger.releases = m.releases_recorded();
+  ledger.deadline_misses = m.all_misses();
+  ledger.miss_pct = m.all_miss_pct();
+  ledger.max_consecutive_misses = m.max_consecutive_all_misses();
+  ledger.grace_cycles = m.config().grace_cycles;
+  ledger.grace_misses = m.grace_misses();
+  ledger.cycles_judged = m.cycles_recorded();
+  ledger.misses_judged = m.misses();
+  ledger.miss_pct_judged = m.miss_pct();
+  ledger.max_consecutive_misses_judged = m.max_consecutive_misses();
+  ledger.abort_cycle = m.abort_cycle();
+  return ledger;
+}
+
+}  // namespace
+
+RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) const {
+  RunReport r;
+  r.task_name = config_.task_name;
+  r.io = config_.io;
+  r.clock = config_.clock;
+  r.details = config_.details;
+  r.verdict = monitor_.verdict();
+  r.stop_reason = lifecycle_.stop_reason();
+  r.fault_while_stopping = lifecycle_.fault_while_stopping();
+  r.final_state = lifecycle_.state();
+  const scheduler::ExecutiveStats& stats = executive_.stats();
+  r.rate_hz = config_.rate_hz;
+  r.period_ns = executive_.config().period_ns;
+  r.deadline_ns = executive_.deadline_ns();
+  r.overrun_policy = executive_.config().overrun_policy;
+  r.cycles_planned = config_.executive.max_cycles;
+  r.cycles_run = stats.cycles_run;
+  r.cycles_paused = runner_->counts().paused_cycles;
+  r.releases = stats.releases;
+  r.releases_skipped = stats.releases_skipped;
+  r.misses = LedgerOf(monitor_);
+  r.qos_policy = monitor_.config().policy;
+  r.constraints.assign(monitor_.rules().begin(), monitor_.rules().end());
+  r.latency = stats.wake_latency.Summary();
+  r.compute = stats.compute.Summary();
+  r.io_time = stats.io.Summary();
+  r.response = stats.response.Summary();
+  r.period_jitter = stats.period_jitter.Summary();
+  const LoopCounts& counts = runner_->counts();
+  r.link = {counts.io_errors, counts.peer_absent_cycles, counts.pulse_limit_cycles, config_.peer_name};
+  if (const auto& fault = runner_->fault()) r.fault = RunFault{fault->kind, fault->cycle, fault->reason};
+  r.outputs_safe = result.outputs_safe;
+  if (logger_) {
+    r.log = LogFigures{logger_->path(), logger_->rows_written(), logger_->rows_dropped(), logger_->error()};
+  }
+  r.wall_time_s = wall_time_s;
+  if (result.rt) r.rt_setup = result.rt->record();
+  return r;
+}
+
+}  // namespace hiltwin::runtime
