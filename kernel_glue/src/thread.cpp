@@ -1,8 +1,10 @@
 #include "hiltwin/kernel_glue/thread.h"
 
 #include <sched.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <memory>
 #include <stdexcept>
 #include <system_error>
@@ -32,6 +34,17 @@ class ThreadAttributes {
   pthread_attr_t attr_{};
 };
 
+// Every configured CPU: the kernel intersects the mask with the process's cpuset, so this
+// means "wherever this process may run", not the creator's (possibly pinned) set.
+std::vector<int> EveryCpu() {
+  const long configured = sysconf(_SC_NPROCESSORS_CONF);
+  std::vector<int> cpus;
+  for (int cpu = 0; cpu < std::min<long>(configured > 0 ? configured : 1, CPU_SETSIZE); ++cpu) {
+    cpus.push_back(cpu);
+  }
+  return cpus;
+}
+
 void Check(int error, const char* what) {
   if (error != 0) throw std::system_error(error, std::generic_category(), what);
 }
@@ -44,7 +57,7 @@ NamedThread::NamedThread(const ThreadSpec& spec, std::function<void()> body) {
   }
   cpu_set_t cpus;
   CPU_ZERO(&cpus);
-  for (const int cpu : spec.cpus.empty() ? AllowedCpus() : spec.cpus) {
+  for (const int cpu : spec.cpus.empty() ? EveryCpu() : spec.cpus) {
     if (cpu < 0 || cpu >= CPU_SETSIZE) {
       throw std::invalid_argument("thread '" + spec.name + "': CPU " + std::to_string(cpu) +
                                   " is not a CPU number");
@@ -98,6 +111,16 @@ std::vector<int> AllowedCpus() {
     if (CPU_ISSET(static_cast<std::size_t>(cpu), &set)) cpus.push_back(cpu);
   }
   return cpus;
+}
+
+int SetCallingThreadCpus(std::span<const int> cpus) noexcept {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (const int cpu : cpus) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE) return EINVAL;
+    CPU_SET(static_cast<std::size_t>(cpu), &set);
+  }
+  return pthread_setaffinity_np(pthread_self(), sizeof set, &set);
 }
 
 std::vector<int> HelperCpus(std::span<const int> allowed, std::span<const int> loop_cpus) {

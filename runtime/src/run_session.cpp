@@ -61,6 +61,7 @@ struct RunSession::LoopResult {
   std::condition_variable changed;
   bool ready = false;  // RT set-up done, waiting for go
   bool go = false;
+  bool cancelled = false;  // start-up failed on the control thread: run no cycle
   bool done = false;
   std::optional<kernel_glue::RtSession> rt;
   std::string setup_error;
@@ -114,7 +115,7 @@ void RunSession::LoopThreadMain(LoopResult& result) noexcept {
     result.ready = true;
     result.changed.notify_all();
     result.changed.wait(lock, [&] { return result.go; });
-    if (!result.setup_error.empty()) return;
+    if (result.cancelled) return;
   }
   if (hooks_ != nullptr) hooks_->BeforeLoop();
   result.cause = executive_.Run(*runner_);
@@ -134,15 +135,23 @@ RunReport RunSession::Run() {
   kernel_glue::NamedThread loop({"hiltwin-loop", allowed_cpus_}, [this, &result] { LoopThreadMain(result); });
   std::unique_lock lock(result.mutex);
   result.changed.wait(lock, [&] { return result.ready; });
-  if (!result.setup_error.empty()) {
+  try {
+    if (!result.setup_error.empty()) throw std::runtime_error("real-time set-up: " + result.setup_error);
+    if (logger_) logger_->Start();  // after the RT set-up: see LoopThreadMain
+    if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
+  } catch (...) {
+    // Release the waiting loop thread without running a cycle, then report the failure.
+    result.cancelled = true;
     result.go = true;
     result.changed.notify_all();
     lock.unlock();
     loop.Join();
-    throw std::runtime_error("real-time set-up: " + result.setup_error);
+    throw;
   }
-  if (logger_) logger_->Start();  // after the RT set-up: see LoopThreadMain
-  if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
+  // The control thread is a helper too while the loop runs: off the loop's CPUs. Best effort:
+  // a refusal leaves it where it was, which costs the loop nothing it did not have before.
+  const std::vector<int> helper_cpus = kernel_glue::HelperCpus(allowed_cpus_, config_.rt.cpus);
+  static_cast<void>(kernel_glue::SetCallingThreadCpus(helper_cpus));
   const kernel_glue::MonotonicClock wall;
   const kernel_glue::TimeNs wall_start_ns = wall.NowNs();
   lifecycle_.Handle(statemachine::Event::kStart);
@@ -153,6 +162,7 @@ RunReport RunSession::Run() {
   }
   lock.unlock();
   loop.Join();
+  static_cast<void>(kernel_glue::SetCallingThreadCpus(allowed_cpus_));
   const double wall_time_s = static_cast<double>(wall.NowNs() - wall_start_ns) * 1e-9;
   if (config_.progress) {
     PrintProgress();

@@ -47,6 +47,9 @@ class NamedThread {
 /// The CPUs the calling thread may run on (its affinity mask), in increasing order.
 [[nodiscard]] std::vector<int> AllowedCpus();
 
+/// Pins the calling thread to `cpus`; 0 or an errno value (EINVAL for a bad CPU number).
+[[nodiscard]] int SetCallingThreadCpus(std::span<const int> cpus) noexcept;
+
 /// CPUs for helper threads: `allowed` minus `loop_cpus`; all of `allowed` when the loop is not
 /// pinned or takes every allowed CPU (a helper must run somewhere).
 [[nodiscard]] std::vector<int> HelperCpus(std::span<const int> allowed,
