@@ -190,12 +190,11 @@ void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image
   }
 }
 
-int RunIoTest(const IoTestOptions& options) {
-  const io::Image image = *io::ParseImage(options.image);
+/// Checks the flags against the backend kind and opens it (exit 2 for usage, 5 for I/O).
+std::unique_ptr<io::IoBackend> OpenIoTestBackend(const IoTestOptions& options, io::Image image) {
   io::BackendOptions backend_options;
   backend_options.side = image;
   if (!options.board_image.empty()) backend_options.mock_board_image = io::ParseImage(options.board_image);
-
   io::BackendSpec spec;
   try {
     spec = io::ParseBackendSpec(options.io);
@@ -212,41 +211,50 @@ int RunIoTest(const IoTestOptions& options) {
                        "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a "
                        "real board's peer cannot be seen from here (drop --wait-peer)");
   }
-  std::unique_ptr<io::IoBackend> backend;
   try {
-    backend = io::OpenBackend(options.io, backend_options);
+    return io::OpenBackend(options.io, backend_options);
   } catch (const io::ConfigError& e) {
     throw CommandError(ExitCode::kUsage, std::string("--io ") + options.io + ": " + e.what());
   } catch (const std::exception& e) {
     throw CommandError(ExitCode::kIo, std::string(e.what()) + " (--io " + options.io + ")");
   }
-  if (options.wait_peer_s > 0.0) WaitForPeer(*backend, options, image);
-  const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(options.rate_hz);
-  const bool mock = backend->kind() == io::BackendSpec::Kind::kMock;
-  PatternSource pattern(period_ns);
-  if (mock) {
-    backend->emulated_board()->SetPwmSource(&pattern);
-    backend->emulated_board()->SetEncoderSource(&pattern);
-  }
-  io::EmulatedFpga* board = backend->emulated_board();
+}
 
-  auto run = [&](auto& driver, auto inputs_tag, auto send, auto check) {
-    const io::InitResult init = driver.Init(period_ns);
-    if (!init.ok) throw CommandError(ExitCode::kIo, init.message);
-    using Inputs = decltype(inputs_tag);
-    const Summary summary =
-        RunFrames<std::remove_reference_t<decltype(driver)>, Inputs>(driver, options, period_ns, send, check);
-    return std::make_pair(summary, init);
-  };
-
+/// Everything one io-test found; the JSON, the text and the exit code derive from it.
+struct IoTestOutcome {
   Summary summary;
   io::InitResult init;
   io::LinkCounters counters;
   io::TransferTiming timing;
+  io::EncoderLineCounters reader;  ///< ECS board model's line readers (mock only)
+  std::uint64_t count_errors = 0;  ///< pattern mismatches plus reader errors
+  bool ok = false;
+  [[nodiscard]] double mean_transfer_ns() const {
+    return timing.transfers > 0 ? static_cast<double>(timing.total_ns) / static_cast<double>(timing.transfers)
+                                : 0.0;
+  }
+};
+
+template <typename Driver, typename Inputs, typename Send, typename Check>
+void ExchangeWith(Driver& driver, const IoTestOptions& options, std::int64_t period_ns, Send send,
+                  Check check, IoTestOutcome& outcome) {
+  outcome.init = driver.Init(period_ns);
+  if (!outcome.init.ok) throw CommandError(ExitCode::kIo, outcome.init.message);
+  outcome.summary = RunFrames<Driver, Inputs>(driver, options, period_ns, send, check);
+  outcome.counters = driver.counters();
+  outcome.timing = driver.timing();
+}
+
+/// INIT, then the pattern frames from this side's driver; a mock board plays the other side.
+IoTestOutcome ExchangeFrames(io::IoBackend& backend, const IoTestOptions& options, io::Image image,
+                             std::int64_t period_ns) {
+  const bool mock = backend.kind() == io::BackendSpec::Kind::kMock;
+  io::EmulatedFpga* board = backend.emulated_board();
+  IoTestOutcome outcome;
   if (image == io::Image::kIcoboardInverse) {
-    io::IcoBoardInverse driver(backend->bus());
-    std::tie(summary, init) = run(
-        driver, io::TwinInputs{},
+    io::IcoBoardInverse driver(backend.bus());
+    ExchangeWith<io::IcoBoardInverse, io::TwinInputs>(
+        driver, options, period_ns,
         [](std::int64_t k) {
           std::array<std::int32_t, io::kChannels> out{};
           for (std::size_t c = 0; c < io::kChannels; ++c) out[c] = PatternPosition(k, c);
@@ -259,14 +267,13 @@ int RunIoTest(const IoTestOptions& options) {
             if (in.pwm[c] != PatternPwm(k, c)) return false;
           }
           return true;
-        });
-    counters = driver.counters();
-    timing = driver.timing();
+        },
+        outcome);
   } else {
-    io::IcoBoard driver(backend->bus());
+    io::IcoBoard driver(backend.bus());
     PeerCountsCheck peer_counts;
-    std::tie(summary, init) = run(
-        driver, io::EcsInputs{},
+    ExchangeWith<io::IcoBoard, io::EcsInputs>(
+        driver, options, period_ns,
         [](std::int64_t k) {
           std::array<std::int32_t, io::kChannels> out{};
           for (std::size_t c = 0; c < io::kChannels; ++c) out[c] = PatternPwm(k, c);
@@ -279,66 +286,70 @@ int RunIoTest(const IoTestOptions& options) {
             if (in.counts[c] != PatternCounts(k, c)) return false;
           }
           return true;
-        });
-    counters = driver.counters();
-    timing = driver.timing();
+        },
+        outcome);
   }
-
   // The ECS board model's readers: edges a real reader would miscount, and lines that jumped.
-  const io::EncoderLineCounters reader = board != nullptr && image == io::Image::kIcoboard
-                                             ? board->encoder_lines().counters()
-                                             : io::EncoderLineCounters{};
-  const std::uint64_t count_errors =
-      summary.count_errors + reader.illegal_transitions + reader.too_fast_edges + reader.resyncs;
-  const bool ok = summary.fault == nullptr && count_errors == 0 && summary.frames_peer_absent == 0 &&
-                  counters.frames_corrupted == 0 && counters.frames_missed == 0 &&
-                  counters.frames_received == counters.frames_sent;
-  const double mean_ns =
-      timing.transfers > 0 ? static_cast<double>(timing.total_ns) / static_cast<double>(timing.transfers) : 0.0;
-  if (options.json) {
-    nlohmann::json j;
-    j["backend"] = options.io;
-    j["image"] = options.image;
-    j["board_identity"] = init.identity;
-    j["rate_hz"] = options.rate_hz;
-    j["frames_sent"] = counters.frames_sent;
-    j["frames_received"] = counters.frames_received;
-    j["frames_corrupted"] = counters.frames_corrupted;
-    j["frames_missed"] = counters.frames_missed;
-    j["count_errors"] = count_errors;
-    j["faults"] = counters.faults;
-    j["pulse_limit_events"] = counters.pulse_limit_events;
-    j["counts_over_limit"] = counters.counts_over_limit;
-    j["reader_illegal_transitions"] = reader.illegal_transitions;
-    j["reader_too_fast_edges"] = reader.too_fast_edges;
-    j["reader_resyncs"] = reader.resyncs;
-    j["transfer_ns_mean"] = mean_ns;
-    j["transfer_ns_max"] = timing.max_ns;
-    j["peer_absent"] = summary.frames_peer_absent > 0;
-    j["frames_peer_absent"] = summary.frames_peer_absent;
-    j["ok"] = ok;
-    std::printf("%s\n", j.dump(2).c_str());
-  } else {
-    std::printf("io-test over %s, image %s (board identity %u), %.0f Hz\n", options.io.c_str(),
-                options.image.c_str(), static_cast<unsigned>(init.identity), options.rate_hz);
-    std::printf("  frames sent       %llu\n", static_cast<unsigned long long>(counters.frames_sent));
-    std::printf("  frames received   %llu\n", static_cast<unsigned long long>(counters.frames_received));
-    std::printf("  frames corrupted  %llu\n", static_cast<unsigned long long>(counters.frames_corrupted));
-    std::printf("  frames missed     %llu\n", static_cast<unsigned long long>(counters.frames_missed));
-    std::printf("  count errors      %llu (reader: %llu illegal, %llu too fast, %llu resyncs)\n",
-                static_cast<unsigned long long>(count_errors),
-                static_cast<unsigned long long>(reader.illegal_transitions),
-                static_cast<unsigned long long>(reader.too_fast_edges),
-                static_cast<unsigned long long>(reader.resyncs));
-    std::printf("  counts over limit %llu\n", static_cast<unsigned long long>(counters.counts_over_limit));
-    std::printf("  transfer time     mean %.0f ns, max %lld ns\n", mean_ns,
-                static_cast<long long>(timing.max_ns));
-    if (summary.frames_peer_absent > 0) {
-      std::printf("  no peer           %lld of %lld frames\n", static_cast<long long>(summary.frames_peer_absent),
-                  static_cast<long long>(summary.frames));
-    }
-    std::printf("%s\n", ok ? "PASS" : "FAIL");
+  if (board != nullptr && image == io::Image::kIcoboard) outcome.reader = board->encoder_lines().counters();
+  const io::EncoderLineCounters& r = outcome.reader;
+  outcome.count_errors = outcome.summary.count_errors + r.illegal_transitions + r.too_fast_edges + r.resyncs;
+  const io::LinkCounters& c = outcome.counters;
+  outcome.ok = outcome.summary.fault == nullptr && outcome.count_errors == 0 &&
+               outcome.summary.frames_peer_absent == 0 && c.frames_corrupted == 0 &&
+               c.frames_missed == 0 && c.frames_received == c.frames_sent;
+  return outcome;
+}
+
+void PrintJson(const IoTestOptions& options, const IoTestOutcome& o) {
+  nlohmann::json j;
+  j["backend"] = options.io;
+  j["image"] = options.image;
+  j["board_identity"] = o.init.identity;
+  j["rate_hz"] = options.rate_hz;
+  j["frames_sent"] = o.counters.frames_sent;
+  j["frames_received"] = o.counters.frames_received;
+  j["frames_corrupted"] = o.counters.frames_corrupted;
+  j["frames_missed"] = o.counters.frames_missed;
+  j["count_errors"] = o.count_errors;
+  j["faults"] = o.counters.faults;
+  j["pulse_limit_events"] = o.counters.pulse_limit_events;
+  j["counts_over_limit"] = o.counters.counts_over_limit;
+  j["reader_illegal_transitions"] = o.reader.illegal_transitions;
+  j["reader_too_fast_edges"] = o.reader.too_fast_edges;
+  j["reader_resyncs"] = o.reader.resyncs;
+  j["transfer_ns_mean"] = o.mean_transfer_ns();
+  j["transfer_ns_max"] = o.timing.max_ns;
+  j["peer_absent"] = o.summary.frames_peer_absent > 0;
+  j["frames_peer_absent"] = o.summary.frames_peer_absent;
+  j["ok"] = o.ok;
+  std::printf("%s\n", j.dump(2).c_str());
+}
+
+void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
+  using ull = unsigned long long;
+  std::printf("io-test over %s, image %s (board identity %u), %.0f Hz\n", options.io.c_str(),
+              options.image.c_str(), static_cast<unsigned>(o.init.identity), options.rate_hz);
+  std::printf("  frames sent       %llu\n", static_cast<ull>(o.counters.frames_sent));
+  std::printf("  frames received   %llu\n", static_cast<ull>(o.counters.frames_received));
+  std::printf("  frames corrupted  %llu\n", static_cast<ull>(o.counters.frames_corrupted));
+  std::printf("  frames missed     %llu\n", static_cast<ull>(o.counters.frames_missed));
+  std::printf("  count errors      %llu (reader: %llu illegal, %llu too fast, %llu resyncs)\n",
+              static_cast<ull>(o.count_errors), static_cast<ull>(o.reader.illegal_transitions),
+              static_cast<ull>(o.reader.too_fast_edges), static_cast<ull>(o.reader.resyncs));
+  std::printf("  counts over limit %llu\n", static_cast<ull>(o.counters.counts_over_limit));
+  std::printf("  transfer time     mean %.0f ns, max %lld ns\n", o.mean_transfer_ns(),
+              static_cast<long long>(o.timing.max_ns));
+  if (o.summary.frames_peer_absent > 0) {
+    std::printf("  no peer           %lld of %lld frames\n",
+                static_cast<long long>(o.summary.frames_peer_absent),
+                static_cast<long long>(o.summary.frames));
   }
+  std::printf("%s\n", o.ok ? "PASS" : "FAIL");
+}
+
+/// Exit 5 with what went wrong and the way out; returns when the test passed.
+void ThrowUnlessPassed(const IoTestOptions& options, io::Image image, const IoTestOutcome& o, bool mock) {
+  const Summary& summary = o.summary;
   if (summary.fault != nullptr) {
     throw CommandError(ExitCode::kIo, std::string("link fault on ") + options.io + ": " + summary.fault);
   }
@@ -353,13 +364,33 @@ int RunIoTest(const IoTestOptions& options) {
                   " frames, which tested nothing";
     throw CommandError(ExitCode::kIo, what + "; " + NoPeerAdvice(options, image, options.wait_peer_s > 0.0));
   }
-  if (!ok) {
+  if (!o.ok) {
     throw CommandError(ExitCode::kIo, "the link had errors (see the summary above); check wiring, "
                                       "cable length and SPI speed, then rerun" +
                                       std::string(mock ? "" : "; over a wire or real link the other "
                                                               "side must run io-test too (its pattern "
                                                               "is checked)"));
   }
+}
+
+int RunIoTest(const IoTestOptions& options) {
+  const io::Image image = *io::ParseImage(options.image);
+  const std::unique_ptr<io::IoBackend> backend = OpenIoTestBackend(options, image);
+  if (options.wait_peer_s > 0.0) WaitForPeer(*backend, options, image);
+  const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(options.rate_hz);
+  const bool mock = backend->kind() == io::BackendSpec::Kind::kMock;
+  PatternSource pattern(period_ns);
+  if (mock) {
+    backend->emulated_board()->SetPwmSource(&pattern);
+    backend->emulated_board()->SetEncoderSource(&pattern);
+  }
+  const IoTestOutcome outcome = ExchangeFrames(*backend, options, image, period_ns);
+  if (options.json) {
+    PrintJson(options, outcome);
+  } else {
+    PrintText(options, outcome);
+  }
+  ThrowUnlessPassed(options, image, outcome, mock);
   return static_cast<int>(ExitCode::kPass);
 }
 

@@ -188,11 +188,13 @@ std::string WireBus::SegmentName(const std::string& name) {
 
 void WireBus::Unlink(const std::string& name) { ::shm_unlink(SegmentName(name).c_str()); }
 
-WireBus::WireBus(const std::string& name, Image side)
-    : label_("wire:" + name), segment_name_(SegmentName(name)), side_(side), board_(side, &clock_) {
-  const int fd = ::shm_open(segment_name_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0660);
+namespace {
+
+/// Opens (creating if needed), sizes and maps the named segment.
+WireSegment* MapSegment(const std::string& segment_name, const std::string& label) {
+  const int fd = ::shm_open(segment_name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0660);
   if (fd < 0) {
-    throw std::runtime_error("cannot open shared memory " + segment_name_ + " for " + label_ +
+    throw std::runtime_error("cannot open shared memory " + segment_name + " for " + label +
                              ": " + std::strerror(errno) + "; check /dev/shm is mounted and writable");
   }
   struct stat info {};
@@ -201,38 +203,61 @@ WireBus::WireBus(const std::string& name, Image side)
       (info.st_size == 0 && ::ftruncate(fd, size) != 0)) {
     const int error = errno;
     ::close(fd);
-    throw std::runtime_error("shared memory " + segment_name_ + " has the wrong size or cannot " +
+    throw std::runtime_error("shared memory " + segment_name + " has the wrong size or cannot " +
                              "be sized (" + std::strerror(error) + "); it may be from another " +
-                             "hiltwin version: remove /dev/shm" + segment_name_ + " and retry");
+                             "hiltwin version: remove /dev/shm" + segment_name + " and retry");
   }
   void* map = ::mmap(nullptr, sizeof(WireSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   ::close(fd);
   if (map == MAP_FAILED) {
-    throw std::runtime_error("cannot map " + segment_name_ + ": " + std::strerror(errno));
+    throw std::runtime_error("cannot map " + segment_name + ": " + std::strerror(errno));
   }
-  segment_ = static_cast<WireSegment*>(map);
+  return static_cast<WireSegment*>(map);
+}
 
-  // Whoever comes first lays the segment out; the other waits (start-up only, bounded).
+/// Whoever comes first lays the segment out; the other waits (start-up only, bounded). False
+/// when the segment is not a wire of this layout version.
+bool LayOutOrCheck(WireSegment& segment) {
   std::uint32_t expected = kFresh;
-  if (segment_->init_state.compare_exchange_strong(expected, kInitialising)) {
-    segment_->magic.store(kMagic, std::memory_order_relaxed);
-    segment_->version.store(kLayoutVersion, std::memory_order_relaxed);
-    segment_->size.store(static_cast<std::uint32_t>(sizeof(WireSegment)), std::memory_order_relaxed);
-    segment_->init_state.store(kReady, std::memory_order_release);
+  if (segment.init_state.compare_exchange_strong(expected, kInitialising)) {
+    segment.magic.store(kMagic, std::memory_order_relaxed);
+    segment.version.store(kLayoutVersion, std::memory_order_relaxed);
+    segment.size.store(static_cast<std::uint32_t>(sizeof(WireSegment)), std::memory_order_relaxed);
+    segment.init_state.store(kReady, std::memory_order_release);
   } else {
-    for (int i = 0; i < 1000 && segment_->init_state.load(std::memory_order_acquire) != kReady; ++i) {
+    for (int i = 0; i < 1000 && segment.init_state.load(std::memory_order_acquire) != kReady; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   }
-  if (segment_->init_state.load(std::memory_order_acquire) != kReady ||
-      segment_->magic.load() != kMagic || segment_->version.load() != kLayoutVersion ||
-      segment_->size.load() != sizeof(WireSegment)) {
+  return segment.init_state.load(std::memory_order_acquire) == kReady &&
+         segment.magic.load() == kMagic && segment.version.load() == kLayoutVersion &&
+         segment.size.load() == sizeof(WireSegment);
+}
+
+}  // namespace
+
+WireBus::WireBus(const std::string& name, Image side)
+    : label_("wire:" + name), segment_name_(SegmentName(name)), side_(side), board_(side, &clock_) {
+  segment_ = MapSegment(segment_name_, label_);
+  if (!LayOutOrCheck(*segment_)) {
     ::munmap(segment_, sizeof(WireSegment));
     segment_ = nullptr;
     throw std::runtime_error("shared memory " + segment_name_ + " is not a hiltwin wire of this " +
                              "version; remove /dev/shm" + segment_name_ + " and retry");
   }
+  Attach();
+  pwm_wire_ = std::make_unique<PwmWire>(*segment_);
+  encoder_wire_ = std::make_unique<EncoderWire>(*segment_);
+  if (side_ == Image::kIcoboardInverse) {
+    segment_->twin_sampling_ns.store(kNotSampling);  // a crashed twin may have left it set
+    board_.SetPwmSource(pwm_wire_.get());
+    board_.SetEncoderSink(encoder_wire_.get());
+  } else {
+    board_.SetEncoderSource(encoder_wire_.get());
+  }
+}
 
+void WireBus::Attach() {
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
   WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
   const std::int32_t previous_pid = self.pid.load();
@@ -264,16 +289,6 @@ WireBus::WireBus(const std::string& name, Image side)
   self.attached.store(1);
   self.sessions.fetch_add(1);
   segment_->attach_count.fetch_add(1);
-
-  pwm_wire_ = std::make_unique<PwmWire>(*segment_);
-  encoder_wire_ = std::make_unique<EncoderWire>(*segment_);
-  if (side_ == Image::kIcoboardInverse) {
-    segment_->twin_sampling_ns.store(kNotSampling);  // a crashed twin may have left it set
-    board_.SetPwmSource(pwm_wire_.get());
-    board_.SetEncoderSink(encoder_wire_.get());
-  } else {
-    board_.SetEncoderSource(encoder_wire_.get());
-  }
 }
 
 WireBus::~WireBus() {

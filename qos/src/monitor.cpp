@@ -174,6 +174,45 @@ std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
   return ClampDistance(j);
 }
 
+bool QosMonitor::UpdateWindowRule(Engine& engine, RuleStatus& status, std::uint64_t t,
+                                  bool missed) noexcept {
+  // Cycle t - k leaves the window (before the first k judged cycles it is the met
+  // pre-history); the ring still holds it because its capacity is >= k.
+  const bool leaving = t >= engine.k && Bit(t - engine.k);
+  engine.misses_in_window += (missed ? 1U : 0U);
+  engine.misses_in_window -= (leaving ? 1U : 0U);
+  if (!missed) {
+    engine.met_ring[engine.met_head] = static_cast<std::int64_t>(t);
+    engine.met_head = engine.met_head + 1 == engine.met_ring.size() ? 0 : engine.met_head + 1;
+  }
+  // The m-th most recent met cycle p stays in the window for k - (t - p) - 1 more
+  // misses; the window ending at t + j fails first at j = p + k - t (DBP).
+  const std::int64_t distance = engine.met_ring[engine.met_head] +
+                                static_cast<std::int64_t>(engine.k) - static_cast<std::int64_t>(t);
+  status.distance_to_failure = distance > 0 ? static_cast<std::uint32_t>(distance) : 0;
+  if (engine.misses_in_window > status.max_misses_in_window) {
+    status.max_misses_in_window = engine.misses_in_window;
+    status.min_met_in_window = engine.k - engine.misses_in_window;
+  }
+  return engine.misses_in_window > engine.allowed_misses;
+}
+
+void QosMonitor::UpdateRatioRule(const Engine& engine, RuleStatus& status, std::size_t rule,
+                                 std::uint64_t cycle) noexcept {
+  status.violated = RatioFails(misses_, judged_cycles_, engine.max_miss_pct);
+  status.violations = status.violated ? 1 : 0;
+  if (engine.miss_budget > 0 && misses_ >= engine.miss_budget && !status.first_violation_cycle) {
+    // The planned run can no longer end below the limit.
+    status.first_violation_cycle = cycle;
+    if (config_.policy == ViolationPolicy::kAbort && !aborted_) {
+      aborted_ = true;
+      abort_cycle_ = cycle;
+      abort_rule_ = rule;
+    }
+  }
+  status.distance_to_failure = RatioDistance(engine);
+}
+
 bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
   run_all_ = missed ? run_all_ + 1 : 0;
   max_run_all_ = std::max(max_run_all_, run_all_);
@@ -202,48 +241,16 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
     bool violated_now = false;
     switch (engine.kind) {
       case RuleKind::kMkFirm:
-      case RuleKind::kMissesInWindow: {
-        // Cycle t - k leaves the window (before the first k judged cycles it is the met
-        // pre-history); the ring still holds it because its capacity is >= k.
-        const bool leaving = t >= engine.k && Bit(t - engine.k);
-        engine.misses_in_window += (missed ? 1U : 0U);
-        engine.misses_in_window -= (leaving ? 1U : 0U);
-        if (!missed) {
-          engine.met_ring[engine.met_head] = static_cast<std::int64_t>(t);
-          engine.met_head = engine.met_head + 1 == engine.met_ring.size() ? 0 : engine.met_head + 1;
-        }
-        // The m-th most recent met cycle p stays in the window for k - (t - p) - 1 more
-        // misses; the window ending at t + j fails first at j = p + k - t (DBP).
-        const std::int64_t distance = engine.met_ring[engine.met_head] +
-                                      static_cast<std::int64_t>(engine.k) -
-                                      static_cast<std::int64_t>(t);
-        status.distance_to_failure = distance > 0 ? static_cast<std::uint32_t>(distance) : 0;
-        if (engine.misses_in_window > status.max_misses_in_window) {
-          status.max_misses_in_window = engine.misses_in_window;
-          status.min_met_in_window = engine.k - engine.misses_in_window;
-        }
-        violated_now = engine.misses_in_window > engine.allowed_misses;
+      case RuleKind::kMissesInWindow:
+        violated_now = UpdateWindowRule(engine, status, t, missed);
         break;
-      }
       case RuleKind::kConsecutiveMisses:
         violated_now = run_ > engine.allowed_misses;
         status.distance_to_failure =
             violated_now ? 0 : ClampDistance(engine.allowed_misses + 1 - run_);
         break;
       case RuleKind::kMissRatio:
-        status.violated = RatioFails(misses_, judged_cycles_, engine.max_miss_pct);
-        status.violations = status.violated ? 1 : 0;
-        if (engine.miss_budget > 0 && misses_ >= engine.miss_budget &&
-            !status.first_violation_cycle) {
-          // The planned run can no longer end below the limit.
-          status.first_violation_cycle = cycle;
-          if (config_.policy == ViolationPolicy::kAbort && !aborted_) {
-            aborted_ = true;
-            abort_cycle_ = cycle;
-            abort_rule_ = i;
-          }
-        }
-        status.distance_to_failure = RatioDistance(engine);
+        UpdateRatioRule(engine, status, i, cycle);
         break;
     }
     if (violated_now) MarkViolation(i, cycle);

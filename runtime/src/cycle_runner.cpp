@@ -22,11 +22,11 @@ CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
       task_log_columns_(task_log_columns) {}
 
 scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
-  const statemachine::StateRules rules = lifecycle_.rules();
+  rules_ = lifecycle_.rules();
   stepped_ = false;
   step_status_ = StepStatus::Ok();
   const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
-  const io::ExchangeStatus io = task_.Exchange(rules.live_outputs);
+  const io::ExchangeStatus io = task_.Exchange(rules_.live_outputs);
   io_ns_ = clock_.NowNs() - io_start_ns;
   io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
   if (io_fault_) {
@@ -36,7 +36,7 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   if (!io.ok()) ++counts_.io_errors;  // the task held its inputs
   if (io.peer_absent) ++counts_.peer_absent_cycles;
   if (io.pulse_limit) ++counts_.pulse_limit_cycles;
-  if (!rules.steps_model) {
+  if (!rules_.steps_model) {
     ++counts_.paused_cycles;
     return scheduler::CycleAction::kContinue;
   }
@@ -55,23 +55,23 @@ scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sampl
   HILTWIN_TRACE(cycle, sample.cycle, sample.release_ns, sample.wake_ns, sample.start_ns,
                 sample.end_ns, sample.releases_skipped, static_cast<std::uint8_t>(sample.missed));
   qos_abort_ = false;
-  if (lifecycle_.rules().records_qos) RecordQos(sample);
+  if (rules_.records_qos) RecordQos(sample);
   if (stepped_ && logger_ != nullptr) Log(sample);
-  PostEvents(sample);
+  if (!PostEvents(sample)) return scheduler::CycleAction::kContinue;
   return lifecycle_.rules().releases_cycles ? scheduler::CycleAction::kContinue
                                             : scheduler::CycleAction::kStop;
 }
 
-void CycleRunner::RecordQos(const scheduler::TimingSample& sample) noexcept {
+[[gnu::always_inline]] inline void CycleRunner::RecordQos(const scheduler::TimingSample& sample) noexcept {
   // Skipped releases are misses too, but once the monitor says abort the run has ended:
   // releases after that one are not judged.
   qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
   for (std::uint32_t i = 1; i <= sample.releases_skipped && !qos_abort_; ++i) {
     qos_abort_ = monitor_.Record(sample.cycle + i, true);
   }
-  const qos::LiveQos live = monitor_.Live();
-  HILTWIN_TRACE(qos, sample.cycle, static_cast<std::int64_t>(live.distance_to_failure),
-                static_cast<std::uint8_t>(live.verdict));
+  // Arguments are evaluated only while a trace session records.
+  HILTWIN_TRACE(qos, sample.cycle, static_cast<std::int64_t>(monitor_.DistanceToFailure()),
+                static_cast<std::uint8_t>(monitor_.Live().verdict));
 }
 
 void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
@@ -85,23 +85,29 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
   logger_->TryLog(task_.LogTimeS(), std::span<const double>(row_.data(), n + kTimingLogColumns.size()));
 }
 
-void CycleRunner::PostEvents(const scheduler::TimingSample& sample) noexcept {
+[[gnu::always_inline]] inline bool CycleRunner::PostEvents(const scheduler::TimingSample& sample) noexcept {
+  const std::uint64_t next_release = sample.cycle + 1 + sample.releases_skipped;
+  const bool plan_done = planned_releases_ != 0 && next_release >= planned_releases_;
+  // The common cycle: nothing happened and nothing was asked. A relaxed load first; the
+  // exchange (a locked instruction) only when a command is there.
+  const bool quiet = !io_fault_ && step_status_.code == StepStatus::Code::kOk && !qos_abort_ &&
+                     !plan_done && commands_.load(std::memory_order_relaxed) == 0 &&
+                     !kernel_glue::StopRequested();
+  if (quiet) return false;
+  const std::uint8_t commands = commands_.exchange(0, std::memory_order_acq_rel);
+  const auto asked = [commands](CommandBit bit) { return (commands & static_cast<std::uint8_t>(bit)) != 0; };
   // Faults first: when several causes meet in one cycle the report names the one that makes
   // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
   if (io_fault_) lifecycle_.Handle(Event::kIoFault);
   if (step_status_.code == StepStatus::Code::kModelFault) lifecycle_.Handle(Event::kModelFault);
   if (qos_abort_) lifecycle_.Handle(Event::kQosAbort);
-  const std::uint8_t commands = commands_.exchange(0, std::memory_order_acq_rel);
-  if (kernel_glue::StopRequested() || (commands & static_cast<std::uint8_t>(CommandBit::kStop)) != 0) {
-    lifecycle_.Handle(Event::kStopRequest);
-  }
-  const std::uint64_t next_release = sample.cycle + 1 + sample.releases_skipped;
-  const bool plan_done = planned_releases_ != 0 && next_release >= planned_releases_;
+  if (kernel_glue::StopRequested() || asked(CommandBit::kStop)) lifecycle_.Handle(Event::kStopRequest);
   if (plan_done || step_status_.code == StepStatus::Code::kFinished) {
     lifecycle_.Handle(Event::kFinishReached);
   }
-  if ((commands & static_cast<std::uint8_t>(CommandBit::kPause)) != 0) lifecycle_.Handle(Event::kPause);
-  if ((commands & static_cast<std::uint8_t>(CommandBit::kResume)) != 0) lifecycle_.Handle(Event::kStart);
+  if (asked(CommandBit::kPause)) lifecycle_.Handle(Event::kPause);
+  if (asked(CommandBit::kResume)) lifecycle_.Handle(Event::kStart);
+  return true;
 }
 
 void CycleRunner::Post(CommandBit command) noexcept {

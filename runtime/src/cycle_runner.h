@@ -67,7 +67,9 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
  private:
   void RecordQos(const scheduler::TimingSample& sample) noexcept;
   void Log(const scheduler::TimingSample& sample) noexcept;
-  void PostEvents(const scheduler::TimingSample& sample) noexcept;
+  /// Offers this cycle's events to the lifecycle; false when there were none (the state is
+  /// unchanged, the common case).
+  bool PostEvents(const scheduler::TimingSample& sample) noexcept;
   void NoteFault(statemachine::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
 
   RunTask& task_;
@@ -80,7 +82,9 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   std::size_t task_log_columns_;
   std::array<double, tracing::kMaxLogColumns> row_{};
 
-  // This cycle, from Step to OnCycle.
+  // This cycle, from Step to OnCycle. Only the loop thread changes the state while the loop
+  // runs, so the rules read in Step hold until OnCycle posts events.
+  statemachine::StateRules rules_;
   kernel_glue::TimeNs io_ns_ = 0;
   bool stepped_ = false;
   bool io_fault_ = false;

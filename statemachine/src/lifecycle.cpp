@@ -21,28 +21,6 @@ constexpr bool Ending(State state) noexcept {
 
 }  // namespace
 
-StateRules RulesOf(State state) noexcept {
-  switch (state) {
-    case State::kRun:
-      return StateRules{.releases_cycles = true,
-                        .steps_model = true,
-                        .live_outputs = true,
-                        .records_qos = true,
-                        .terminal = false};
-    case State::kPaused:
-      return StateRules{.releases_cycles = true};
-    case State::kStopped:
-    case State::kSafeStop:
-      return StateRules{.terminal = true};
-    case State::kInit:
-    case State::kReady:
-    case State::kStopping:
-    case State::kError:
-      return StateRules{};
-  }
-  return StateRules{};
-}
-
 Transition Next(State state, Event event) noexcept {
   switch (event) {
     case Event::kConfigured:

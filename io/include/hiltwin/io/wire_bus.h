@@ -58,6 +58,9 @@ class WireBus final : public SpiBus {
  private:
   class PwmWire;
   class EncoderWire;
+  /// Registers this side in the segment (refusing a second live process on it) and clears
+  /// the flags of a peer that crashed without detaching.
+  void Attach();
   void Publish(std::int64_t now_ns) noexcept;
 
   std::string label_;

@@ -144,6 +144,10 @@ class QosMonitor {
   [[nodiscard]] bool Bit(std::uint64_t index) const noexcept;
   void SetBit(std::uint64_t index, bool value) noexcept;
   void MarkViolation(std::size_t rule, std::uint64_t cycle) noexcept;
+  /// Window rules ((m,k)-firm, misses in window) after judged cycle `t`; true if violated now.
+  bool UpdateWindowRule(Engine& engine, RuleStatus& status, std::uint64_t t, bool missed) noexcept;
+  void UpdateRatioRule(const Engine& engine, RuleStatus& status, std::size_t rule,
+                       std::uint64_t cycle) noexcept;
   [[nodiscard]] std::uint32_t RatioDistance(const Engine& engine) const noexcept;
 
   QosConfig config_;

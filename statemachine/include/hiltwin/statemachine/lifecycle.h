@@ -48,7 +48,9 @@
 /// stop first); quit = no event, the process exits when RulesOf(state).terminal.
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
+#include <iterator>
 
 namespace hiltwin::statemachine {
 
@@ -108,7 +110,30 @@ struct StateRules {
   bool terminal = false;         ///< nothing happens until reset (the process may exit)
 };
 
-[[nodiscard]] StateRules RulesOf(State state) noexcept;
+/// What `state` allows. A table lookup, inline: the loop asks once per cycle (RunSession).
+[[nodiscard]] constexpr StateRules RulesOf(State state) noexcept {
+  constexpr StateRules kRun{.releases_cycles = true,
+                            .steps_model = true,
+                            .live_outputs = true,
+                            .records_qos = true,
+                            .terminal = false};
+  constexpr StateRules kPaused{.releases_cycles = true};
+  constexpr StateRules kTerminal{.terminal = true};
+  constexpr StateRules kNothing{};
+  constexpr StateRules kTable[] = {
+      kNothing,   // init
+      kNothing,   // ready
+      kRun,       // run
+      kPaused,    // paused
+      kNothing,   // stopping
+      kTerminal,  // stopped
+      kNothing,   // error
+      kTerminal,  // safe_stop
+  };
+  static_assert(static_cast<std::size_t>(State::kSafeStop) + 1 == std::size(kTable));
+  const auto index = static_cast<std::size_t>(state);
+  return index < std::size(kTable) ? kTable[index] : kNothing;
+}
 /// The transition table as a pure function (from == to unless outcome is kTransitioned).
 [[nodiscard]] Transition Next(State state, Event event) noexcept;
 /// The stop reason an event stands for (kNone for events that do not stop the run).
