@@ -193,7 +193,7 @@ TEST_F(AssessCli, BadCellsNameFileLineColumn) {
   ExpectUsageError(Run("'" + Write("b.csv", head + "0.2,nan,2\n") + "'"), {"b.csv:4:2", "NaN or Inf"});
   ExpectUsageError(Run("'" + Write("c.csv", head + "0.2,2,inf\n") + "'"), {"c.csv:4:3", "NaN or Inf"});
   ExpectUsageError(Run("'" + Write("d.csv", head + "0.1,2,2\n") + "'"), {"d.csv:4:1", "repeats"});
-  ExpectUsageError(Run("'" + Write("e.csv", head + "0.05,2,2\n") + "'"), {"e.csv:4:1", "backwards"});
+  ExpectUsageError(Run("'" + Write("e.csv", head + "0.05,2,2\n") + "'"), {"e.csv:4:1", "earlier than the previous row"});
   ExpectUsageError(Run("'" + Write("f.csv", "time,sim,exp\n0,0,0\n") + "'"),
                    {"f.csv:2", "1 data row", "at least two"});
   ExpectUsageError(Run("'" + Write("g.csv", head + "0.2,2\n") + "'"), {"g.csv:4", "2 cells"});
