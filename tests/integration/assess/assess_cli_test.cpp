@@ -246,6 +246,12 @@ TEST_F(AssessCli, BadFlagsAreNamed) {
   ExpectUsageError(Run("'" + file + "' --eta-pass 1"), {"--eta-pass"});
   ExpectUsageError(Run("'" + file + "' --plot '" + Path("no/such/dir/x.png") + "'"),
                    {"--plot", "does not exist"});
+  // The library describes the value; the command puts its flag and the value given in front.
+  ExpectUsageError(Run("'" + file + "' --segment 5:2"),
+                   {"--segment 5:2: segment 5 s to 2 s: the end must come after the start"});
+  ExpectUsageError(Run("'" + file + "' --kp 0"), {"--kp 0: confidence interval Kp 0"});
+  ExpectUsageError(Run("'" + file + "' --weights 1,0,1"),
+                   {"--weights 1,0,1: the frequency domain", "no input curve given (--input)"});
   ExpectUsageError(Run("--sim 2 --exp 3"), {"--sim", "which file"});
   ExpectUsageError(Run(""), {"nothing to compare"});
 }
