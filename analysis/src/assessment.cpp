@@ -30,36 +30,52 @@ namespace {
 
 std::string Num(double v) { return Format("%.6g", v); }
 
+// "5 s to 2 s": a range as the user gave it, in its unit.
+std::string FromTo(const std::pair<double, double>& range, const char* unit) {
+  return Num(range.first) + " " + unit + " to " + Num(range.second) + " " + unit;
+}
+
 void CheckOptions(const AssessOptions& o) {
   const auto& p = o.params;
   if (!(std::isfinite(p.kp) && p.kp > 0.0 && p.kp < 1.0)) {
-    throw InputError("--kp " + Num(p.kp) +
-                     ": the confidence interval must lie between 0 and 1 (thesis: 0.05)");
+    throw OptionError(AssessOption::kKp, "confidence interval Kp " + Num(p.kp) +
+                                             ": must lie strictly between 0 and 1 (thesis: 0.05)");
   }
   if (!(p.eta_pass > 0.0 && p.eta_pass < 1.0)) {
-    throw InputError("--eta-pass " + Num(p.eta_pass) +
-                     ": the passing score must lie strictly between 0 and 1 (thesis: 0.6)");
+    throw OptionError(AssessOption::kEtaPass,
+                      "passing score eta_pass " + Num(p.eta_pass) +
+                          ": must lie strictly between 0 and 1 (thesis: 0.6)");
   }
+  const std::string weights =
+      "weights " + Num(o.weights[0]) + "," + Num(o.weights[1]) + "," + Num(o.weights[2]) + ": ";
   double sum = 0.0;
   for (const double w : o.weights) {
     if (!(std::isfinite(w) && w >= 0.0)) {
-      throw InputError("--weights: every weight must be a number >= 0 (thesis: 1,0,0)");
+      throw OptionError(AssessOption::kWeights,
+                        weights + "every weight must be a number >= 0 (thesis: 1,0,0)");
     }
     sum += w;
   }
-  if (!(sum > 0.0)) throw InputError("--weights: at least one weight must be > 0 (thesis: 1,0,0)");
+  if (!(sum > 0.0)) {
+    throw OptionError(AssessOption::kWeights,
+                      weights + "at least one weight must be > 0 (thesis: 1,0,0)");
+  }
   if (o.segment && !(o.segment->second > o.segment->first)) {
-    throw InputError("--segment " + Num(o.segment->first) + ":" + Num(o.segment->second) +
-                     ": the end must come after the start (seconds, e.g. --segment 2:5)");
+    throw OptionError(AssessOption::kSegment,
+                      "segment " + FromTo(*o.segment, "s") +
+                          ": the end must come after the start (times in seconds, start first)");
   }
   if (o.max_delay_s && !(*o.max_delay_s >= 0.0)) {
-    throw InputError("--max-delay: give a search range in seconds >= 0");
+    throw OptionError(AssessOption::kMaxDelay, "delay search range " + Num(*o.max_delay_s) +
+                                                   " s: must be a time in seconds >= 0");
   }
   if (o.band_hz && !(o.band_hz->first >= 0.0 && o.band_hz->second > o.band_hz->first)) {
-    throw InputError("--band: give LO:HI in Hz with 0 <= LO < HI, e.g. --band 0:20");
+    throw OptionError(AssessOption::kBand, "frequency band " + FromTo(*o.band_hz, "Hz") +
+                                               ": need 0 <= low < high, e.g. 0 Hz to 20 Hz");
   }
   if (!(o.coherence_min >= 0.0 && o.coherence_min < 1.0)) {
-    throw InputError("--coherence: give a threshold in [0, 1) (default 0.8)");
+    throw OptionError(AssessOption::kCoherence, "coherence threshold " + Num(o.coherence_min) +
+                                                    ": must lie in [0, 1) (default 0.8)");
   }
 }
 
@@ -154,10 +170,11 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
 
   const auto [lo_it, hi_it] = std::minmax_element(a.y_exp.begin(), a.y_exp.end());
   if (!(*hi_it > *lo_it)) {
-    throw InputError(Lines(exp, first, last - 1, exp.column) + ": the experiment curve (" +
-                     exp.label + ") is constant (" + Num(*lo_it) +
-                     ") over the compared range, so the error threshold eps_t = Kp*(max - min) "
-                     "is 0 and no score exists; pick the column that moves (--exp)");
+    throw OptionError(AssessOption::kExp,
+                      Lines(exp, first, last - 1, exp.column) + ": the experiment curve (" +
+                          exp.label + ") is constant (" + Num(*lo_it) +
+                          ") over the compared range, so the error threshold eps_t = "
+                          "Kp*(max - min) is 0 and no score exists; pick the column that moves");
   }
   a.time = ScoreTimeDomain(a.y_sim, a.y_exp, options.params);
 
@@ -187,7 +204,8 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
   }
   if (a.delay.at_search_limit) {
     a.notes.push_back("the delay estimate sits at the edge of the search range (+-" +
-                      Num(max_delay_s) + " s); widen it with --max-delay");
+                      Num(max_delay_s) + " s); widen the search range" +
+                      OptionHint(options.name_option, AssessOption::kMaxDelay));
   }
   {
     std::vector<double> queries;
@@ -223,11 +241,11 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
     if (options.segment) {
       std::tie(p_first, p_last) = Inside(a.t_s, options.segment->first, options.segment->second);
       if (p_last - p_first < 3) {
-        throw InputError("--segment " + Num(options.segment->first) + ":" +
-                         Num(options.segment->second) + ": holds " +
-                         std::to_string(p_last - p_first) +
-                         " samples of the compared range [" + Num(a.overlap_t0_s) + ", " +
-                         Num(a.overlap_t1_s) + "] s; need at least 3 (start it at the step)");
+        throw OptionError(AssessOption::kSegment,
+                          "segment " + FromTo(*options.segment, "s") + " holds " +
+                              std::to_string(p_last - p_first) +
+                              " samples of the compared range [" + Num(a.overlap_t0_s) + ", " +
+                              Num(a.overlap_t1_s) + "] s; need at least 3 (start it at the step)");
       }
     }
     const auto count = p_last - p_first;
@@ -242,22 +260,25 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
     } else if (!a.performance) {
       a.performance_note = "the experiment shows no step in [" + Num(t_seg.front()) + ", " +
                            Num(t_seg.back()) + "] s (final value equals initial value); " +
-                           "choose the step with --segment t0:t1";
+                           "choose the step's start and end times" +
+                           OptionHint(options.name_option, AssessOption::kSegment);
     }
   }
 
   // Frequency domain (needs the input the two systems were given).
   if (input == nullptr) {
-    a.frequency_note = "no input column given (--input COL)";
+    a.frequency_note =
+        "no input curve given" + OptionHint(options.name_option, AssessOption::kInput);
   } else {
     const double f_lo = std::max(grid.front(), input->t_s.front());
     const double f_hi = std::min(grid.back(), input->t_s.back());
     const auto [g_first, g_last] = Inside(grid, f_lo, f_hi);
     if (!(f_lo < f_hi) || g_last - g_first < 16) {
-      throw InputError("--input: " + input->label + " covers " + Range(*input) +
-                       ", which leaves fewer than 16 samples of the compared range [" +
-                       Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) +
-                       "] s; give the input that drove both runs");
+      throw OptionError(AssessOption::kInput,
+                        "the input curve " + input->label + " covers " + Range(*input) +
+                            ", which leaves fewer than 16 samples of the compared range [" +
+                            Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) +
+                            "] s; give the input that drove both runs");
     }
     const std::span<const double> g(grid.data() + g_first, g_last - g_first);
     const std::vector<double> u = InterpolateAt(input->t_s, input->y, g);
@@ -270,23 +291,28 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
       const auto at_end = std::lower_bound(ut.begin(), ut.end(), g.back()) - ut.begin();
       const auto u_first = static_cast<std::size_t>(std::max<std::ptrdiff_t>(after_start - 1, 0));
       const auto u_last = std::min(static_cast<std::size_t>(at_end), ut.size() - 1);
-      throw InputError(Lines(*input, u_first, u_last, input->column) + ": the input curve (" +
-                       input->label + ") is constant (" + Num(*ulo) + ") over the compared " +
-                       "range [" + Num(g.front()) + ", " + Num(g.back()) + "] s, so it excites " +
-                       "no frequency; give the column that drove both systems (--input)");
+      throw OptionError(AssessOption::kInput,
+                        Lines(*input, u_first, u_last, input->column) + ": the input curve (" +
+                            input->label + ") is constant (" + Num(*ulo) +
+                            ") over the compared range [" + Num(g.front()) + ", " +
+                            Num(g.back()) + "] s, so it excites no frequency; give the column "
+                            "that drove both systems");
     }
     const std::size_t segment =
         options.welch_segment > 0 ? options.welch_segment : DefaultWelchSegment(g.size());
     if (segment < 8 || segment > g.size()) {
-      throw InputError("--welch-segment " + std::to_string(segment) + ": must lie in [8, " +
-                       std::to_string(g.size()) + "] (the samples available)");
+      throw OptionError(AssessOption::kWelchSegment,
+                        "Welch segment of " + std::to_string(segment) +
+                            " samples: must lie in [8, " + std::to_string(g.size()) +
+                            "] (the samples available)");
     }
     const std::span<const double> gs(grid_sim.data() + g_first, g.size());
     const std::span<const double> ge(grid_exp.data() + g_first, g.size());
     a.frequency = ScoreFrequency(
         u, gs, ge, a.grid_step_s, segment, options.coherence_min, options.params,
         a.frequency_note, options.band_hz ? options.band_hz->first : 0.0,
-        options.band_hz ? options.band_hz->second : std::numeric_limits<double>::infinity());
+        options.band_hz ? options.band_hz->second : std::numeric_limits<double>::infinity(),
+        options.name_option);
   }
 
   // Cross-checks.
@@ -310,12 +336,14 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
   // Total: the weighted mean of the domains that carry weight.
   const auto& w = options.weights;
   if (w[1] > 0.0 && !a.performance) {
-    throw InputError("--weights gives the performance domain weight " + Num(w[1]) +
-                     " but it cannot be computed: " + a.performance_note);
+    throw OptionError(AssessOption::kWeights, "the performance domain has weight " + Num(w[1]) +
+                                                  " but cannot be computed: " +
+                                                  a.performance_note);
   }
   if (w[2] > 0.0 && !a.frequency) {
-    throw InputError("--weights gives the frequency domain weight " + Num(w[2]) +
-                     " but it cannot be computed: " + a.frequency_note);
+    throw OptionError(AssessOption::kWeights, "the frequency domain has weight " + Num(w[2]) +
+                                                  " but cannot be computed: " +
+                                                  a.frequency_note);
   }
   const double eta_time = options.total_uses_compensated ? a.time_compensated.eta : a.time.eta;
   double sum = w[0] * eta_time;

@@ -1,8 +1,11 @@
 #include "hiltwin/analysis/csv.h"
 
 #include <algorithm>
+#include <array>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <system_error>
@@ -90,10 +93,128 @@ std::string Quote(std::string_view s) {
   return out;
 }
 
+// "FILE:LINE:COL: column 'name': " (the name only with a header), the start of a cell message.
+std::string CellPrefix(const CsvTable& table, std::size_t line_no, std::size_t column) {
+  std::string prefix = CsvLocation(table.path, line_no, column + 1) + ": ";
+  if (table.has_header) prefix += "column " + Quote(table.names.at(column)) + ": ";
+  return prefix;
+}
+
+// Takes the header, or the names "1", "2", ... when the first row holds only numbers. Returns
+// whether the row was a header (and so holds no data).
+bool ReadLayout(CsvTable& table, const std::vector<Field>& fields, std::size_t line_no,
+                const CsvRules& rules) {
+  table.has_header = !std::all_of(fields.begin(), fields.end(), [](const Field& field) {
+    double unused = 0.0;
+    return !field.quoted && ParseNumber(field.text, unused) != NumberStatus::kNotNumber;
+  });
+  table.header_line = table.has_header ? line_no : 0;
+  table.columns.resize(fields.size());
+  for (std::size_t c = 0; c < fields.size(); ++c) {
+    const bool named = table.has_header && !fields[c].text.empty();
+    table.names.push_back(named ? fields[c].text : std::to_string(c + 1));
+  }
+  if (rules.check_layout) rules.check_layout(table, line_no);
+  if (fields.size() < 2) {
+    throw InputError(CsvLocation(table.path, line_no, 2) + ": " +
+                     (table.has_header ? "the header" : "the first row") +
+                     " has one column; need time plus at least one more (separators accepted: "
+                     "',' ';' tab)");
+  }
+  return table.has_header;
+}
+
+double ReadCell(const CsvTable& table, const Field& field, std::size_t line_no,
+                std::size_t column) {
+  double value = 0.0;
+  const NumberStatus status = ParseNumber(field.text, value);
+  if (status == NumberStatus::kOk) return value;
+  const std::string prefix = CellPrefix(table, line_no, column);
+  if (status == NumberStatus::kNotFinite) {
+    throw InputError(prefix + Quote(field.text) +
+                     " is not finite (NaN or Inf); replace it with a finite number or remove "
+                     "the row");
+  }
+  throw InputError(prefix +
+                   (field.text.empty() ? std::string("empty cell")
+                                       : Quote(field.text) + " is not a number") +
+                   "; every data cell must be a number with '.' as decimal point");
+}
+
+// Checks the time of the row just added against the rows before it.
+void CheckTime(const CsvTable& table, TimeOrder order) {
+  const std::vector<double>& time = table.columns[0];
+  const std::size_t n = time.size();
+  if (n < 2 || time[n - 1] > time[n - 2]) return;
+  const bool strict = order == TimeOrder::kStrictlyIncreasing;
+  const std::string rule = strict ? "the first column must be time in seconds, strictly increasing"
+                                  : "the first column must be time in seconds, never decreasing";
+  const std::string what = table.Where(n - 1, 0) + ": time " + NumberText(time[n - 1]) + " s";
+  const std::string previous_line = "line " + std::to_string(table.lines[n - 2]);
+  if (time[n - 1] < time[n - 2]) {
+    throw InputError(what + " is earlier than the previous row's " + NumberText(time[n - 2]) +
+                     " s (" + previous_line + "); " + rule + ": sort the rows by time");
+  }
+  if (strict) {
+    throw InputError(what + " repeats the previous row's (" + previous_line + "); " + rule +
+                     ": remove the duplicate row");
+  }
+  if (n >= 3 && time[n - 3] == time[n - 1]) {
+    throw InputError(what + " is on a third row (lines " + std::to_string(table.lines[n - 3]) +
+                     ", " + std::to_string(table.lines[n - 2]) + " and " +
+                     std::to_string(table.lines[n - 1]) +
+                     "); a sudden step is two rows with the same time (before and after): "
+                     "remove the extra row");
+  }
+}
+
+void ReadRow(CsvTable& table, const std::vector<Field>& fields, std::size_t line_no,
+             TimeOrder order) {
+  const std::size_t width = table.columns.size();
+  if (fields.size() != width) {
+    // Point at the first cell that is missing or one too many.
+    throw InputError(CsvLocation(table.path, line_no, std::min(fields.size(), width) + 1) +
+                     ": row has " + std::to_string(fields.size()) + " cells but " +
+                     (table.has_header ? "the header has " : "the first row has ") +
+                     std::to_string(width) +
+                     "; every row needs one value per column (check for a missing or extra "
+                     "separator)");
+  }
+  for (std::size_t c = 0; c < width; ++c) {
+    table.columns[c].push_back(ReadCell(table, fields[c], line_no, c));
+  }
+  table.lines.push_back(line_no);
+  CheckTime(table, order);
+}
+
+void CheckRowCount(const CsvTable& table, std::string_view purpose) {
+  if (table.columns.empty()) {
+    throw InputError(CsvLocation(table.path, 1, 1) +
+                     ": empty file; need a header row and at least two data rows " +
+                     std::string(purpose));
+  }
+  if (table.rows() < 2) {
+    const std::size_t last_line = table.lines.empty() ? table.header_line : table.lines.back();
+    throw InputError(table.path + ":" + std::to_string(last_line) + ": " +
+                     std::to_string(table.rows()) + " data row" + (table.rows() == 1 ? "" : "s") +
+                     "; need at least two rows " + std::string(purpose));
+  }
+}
+
 }  // namespace
 
+std::string CsvLocation(std::string_view path, std::size_t line, std::size_t column) {
+  return std::string(path) + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+std::string NumberText(double value) {
+  std::array<char, 32> text{};
+  const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
+  return std::string(text.data(), result.ptr);
+}
+
 std::string CsvTable::Where(std::size_t row, std::size_t column) const {
-  return path + ":" + std::to_string(lines.at(row)) + ":" + std::to_string(column + 1);
+  return CsvLocation(path, lines.at(row), column + 1);
 }
 
 std::string CsvTable::ColumnLabel(std::size_t column) const {
@@ -102,7 +223,7 @@ std::string CsvTable::ColumnLabel(std::size_t column) const {
   return label;
 }
 
-CsvTable ParseCsv(std::string_view text, const std::string& path) {
+CsvTable ParseCsv(std::string_view text, const std::string& path, const CsvRules& rules) {
   // Excel and Windows editors save "CSV UTF-8" with a byte order mark, which would otherwise
   // become part of the first header name (or make the first time cell "not a number").
   constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
@@ -110,111 +231,33 @@ CsvTable ParseCsv(std::string_view text, const std::string& path) {
   CsvTable table;
   table.path = path;
   char separator = ',';
-  bool have_layout = false;
   std::size_t line_no = 0;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
+  for (std::size_t pos = 0; pos <= text.size();) {
     std::size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
-    const std::string_view raw = text.substr(pos, end - pos);
+    const std::string_view line = Trim(text.substr(pos, end - pos));
     pos = end + 1;
     ++line_no;
-    const std::string_view line = Trim(raw);
-    if (line.empty() || line.front() == '#') {
-      if (end == text.size()) break;
-      continue;
-    }
-    if (!have_layout) {
+    if (line.empty() || line.front() == '#') continue;
+    if (table.columns.empty()) {
       separator = DetectSeparator(line);
-      const std::vector<Field> fields = SplitLine(line, separator);
-      bool all_numbers = true;
-      for (const Field& field : fields) {
-        double unused = 0.0;
-        if (field.quoted || ParseNumber(field.text, unused) == NumberStatus::kNotNumber) {
-          all_numbers = false;
-        }
-      }
-      have_layout = true;
-      table.columns.resize(fields.size());
-      if (!all_numbers) {
-        table.has_header = true;
-        table.header_line = line_no;
-        for (std::size_t c = 0; c < fields.size(); ++c) {
-          std::string name = fields[c].text;
-          if (name.empty()) name = std::to_string(c + 1);
-          table.names.push_back(std::move(name));
-        }
-        if (fields.size() < 2) {
-          throw InputError(path + ":" + std::to_string(line_no) +
-                           ": the header has one column; need time plus at least one curve "
-                           "(separators accepted: ',' ';' tab)");
-        }
-        if (end == text.size()) break;
-        continue;
-      }
-      table.has_header = false;
-      for (std::size_t c = 0; c < fields.size(); ++c) table.names.push_back(std::to_string(c + 1));
+      if (ReadLayout(table, SplitLine(line, separator), line_no, rules)) continue;
     }
-    const std::vector<Field> fields = SplitLine(line, separator);
-    if (fields.size() != table.columns.size()) {
-      throw InputError(path + ":" + std::to_string(line_no) + ": row has " +
-                       std::to_string(fields.size()) + " cells but " +
-                       (table.has_header ? "the header has " : "the first row has ") +
-                       std::to_string(table.columns.size()) +
-                       "; every row needs one value per column (check for a missing or extra "
-                       "separator)");
-    }
-    for (std::size_t c = 0; c < fields.size(); ++c) {
-      double value = 0.0;
-      const NumberStatus status = ParseNumber(fields[c].text, value);
-      const std::string where = path + ":" + std::to_string(line_no) + ":" + std::to_string(c + 1);
-      const std::string label = table.has_header ? " (" + Quote(table.names[c]) + ")" : "";
-      if (status == NumberStatus::kNotNumber) {
-        throw InputError(where + label + ": " +
-                         (fields[c].text.empty() ? std::string("empty cell")
-                                                 : Quote(fields[c].text) + " is not a number") +
-                         "; every data cell must be a number with '.' as decimal point");
-      }
-      if (status == NumberStatus::kNotFinite) {
-        throw InputError(where + label + ": " + Quote(fields[c].text) +
-                         " is not a finite number (NaN or Inf); remove or fix that row");
-      }
-      table.columns[c].push_back(value);
-    }
-    table.lines.push_back(line_no);
-    const std::vector<double>& time = table.columns[0];
-    const std::size_t n = time.size();
-    if (n >= 2 && !(time[n - 1] > time[n - 2])) {
-      throw InputError(path + ":" + std::to_string(line_no) + ":1: time " +
-                       std::to_string(time[n - 1]) +
-                       (time[n - 1] == time[n - 2] ? " repeats" : " goes backwards from") +
-                       " line " + std::to_string(table.lines[n - 2]) + " (" +
-                       std::to_string(time[n - 2]) +
-                       "); the first column must be time in seconds, strictly increasing "
-                       "(remove duplicate rows, or sort the file)");
-    }
-    if (end == text.size()) break;
+    ReadRow(table, SplitLine(line, separator), line_no, rules.time_order);
   }
-  if (!have_layout) {
-    throw InputError(path + ": empty file; need a header row and at least two data rows");
-  }
-  if (table.rows() < 2) {
-    const std::size_t last_line = table.lines.empty() ? table.header_line : table.lines.back();
-    throw InputError(path + ":" + std::to_string(last_line) + ": " + std::to_string(table.rows()) +
-                     " data row" + (table.rows() == 1 ? "" : "s") +
-                     "; need at least two samples to assess a curve");
-  }
+  CheckRowCount(table, rules.purpose);
   return table;
 }
 
-CsvTable ReadCsv(const std::string& path) {
+CsvTable ReadCsv(const std::string& path, const CsvRules& rules) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
-    throw InputError(path + ": cannot open for reading; check the path and permissions");
+    throw InputError(path + ": cannot open for reading (" + std::strerror(errno) +
+                     "); check the path and permissions");
   }
   std::ostringstream buffer;
   buffer << file.rdbuf();
-  return ParseCsv(buffer.str(), path);
+  return ParseCsv(buffer.str(), path, rules);
 }
 
 std::size_t ResolveColumn(const CsvTable& table, const std::string& selector,

@@ -122,7 +122,8 @@ std::optional<FrequencyScore> ScoreFrequency(std::span<const double> u,
                                              std::span<const double> y_exp, double step_s,
                                              std::size_t segment_samples, double coherence_min,
                                              const CredibilityParams& params, std::string& why,
-                                             double band_lo_hz, double band_hi_hz) {
+                                             double band_lo_hz, double band_hi_hz,
+                                             OptionNamer name_option) {
   const FrequencyResponse sim = EstimateFrequencyResponse(u, y_sim, step_s, segment_samples);
   const FrequencyResponse exp = EstimateFrequencyResponse(u, y_exp, step_s, segment_samples);
   FrequencyScore score;
@@ -139,10 +140,11 @@ std::optional<FrequencyScore> ScoreFrequency(std::span<const double> u,
           " of the largest segment's); need at least " + std::to_string(kMinInputSegments) +
           " for a coherence estimate; " +
           (score.segments_total < kMinInputSegments
-               ? std::string("use a shorter --welch-segment or a longer record")
+               ? "use shorter Welch segments" +
+                     OptionHint(name_option, AssessOption::kWelchSegment) + " or a longer record"
                : std::string("give an input that keeps changing (noise, a chirp, or many "
                              "steps: a step excites only the two segments around it, whatever "
-                             "--welch-segment)"));
+                             "the Welch segment length)"));
     return std::nullopt;
   }
   // Bins the input hardly excites are dropped before the coherence gate: on noise-free data
@@ -176,7 +178,9 @@ std::optional<FrequencyScore> ScoreFrequency(std::span<const double> u,
           " for both curves (" + std::to_string(in_band) + " bins in the band " + G(band_lo_hz) +
           " .. " + G(band_hi_hz) + " Hz, " + std::to_string(score.bins_low_input) +
           " with too little input power; " + segments_text +
-          "); excite the system more broadly, record longer, or change --welch-segment or --band";
+          "); excite the system more broadly, record longer, or change the Welch segment length" +
+          OptionHint(name_option, AssessOption::kWelchSegment) + " or the band" +
+          OptionHint(name_option, AssessOption::kBand);
     return std::nullopt;
   }
   const auto used = static_cast<double>(score.bins_used);

@@ -1,6 +1,7 @@
 // `hiltwin assess`: credibility of a simulation against an experiment (thesis §2.4,
 // appendix C), read from CSV files. It reports a score and a verdict; it exits 0 whenever the
 // assessment completed, PASS or FAIL, so the exit code tells "ran" from "could not run".
+#include <array>
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "hiltwin/analysis/assessment.h"
@@ -101,6 +103,49 @@ std::pair<double, double> ParseRange(const std::string& text, const std::string&
           ParseDouble(text.substr(colon + 1), flag + " " + text)};
 }
 
+// The library names its choices as domain values; the command names them by flag, in advice
+// (through AssessOptions::name_option) and in front of each OptionError.
+std::string_view FlagOf(analysis::AssessOption option) {
+  using analysis::AssessOption;
+  switch (option) {
+    case AssessOption::kSim: return "--sim";
+    case AssessOption::kExp: return "--exp";
+    case AssessOption::kInput: return "--input";
+    case AssessOption::kKp: return "--kp";
+    case AssessOption::kEtaPass: return "--eta-pass";
+    case AssessOption::kWeights: return "--weights";
+    case AssessOption::kSegment: return "--segment";
+    case AssessOption::kMaxDelay: return "--max-delay";
+    case AssessOption::kWelchSegment: return "--welch-segment";
+    case AssessOption::kCoherence: return "--coherence";
+    case AssessOption::kBand: return "--band";
+  }
+  return {};
+}
+
+// "--segment 5:2: ": the flag and its value, as typed wherever the command keeps the text.
+std::string FlagPrefix(const AssessCliOptions& o, analysis::AssessOption option) {
+  using analysis::AssessOption;
+  using analysis::NumberText;
+  std::string value;
+  switch (option) {
+    case AssessOption::kSim: value = o.sim.empty() ? "2" : o.sim; break;
+    case AssessOption::kExp: value = o.exp.empty() ? "3" : o.exp; break;
+    case AssessOption::kInput: value = o.input; break;
+    case AssessOption::kKp: value = NumberText(o.kp); break;
+    case AssessOption::kEtaPass: value = NumberText(o.eta_pass); break;
+    case AssessOption::kWeights: value = o.weights; break;
+    case AssessOption::kSegment: value = o.segment; break;
+    case AssessOption::kMaxDelay: value = o.max_delay_s ? NumberText(*o.max_delay_s) : ""; break;
+    case AssessOption::kWelchSegment:
+      value = o.welch_segment > 0 ? std::to_string(o.welch_segment) : "";
+      break;
+    case AssessOption::kCoherence: value = NumberText(o.coherence); break;
+    case AssessOption::kBand: value = o.band; break;
+  }
+  return std::string(FlagOf(option)) + (value.empty() ? "" : " " + value) + ": ";
+}
+
 int RunAssess(const AssessCliOptions& o) {
   if (o.file.empty() && (o.sim.empty() || o.exp.empty())) {
     throw Usage("nothing to compare: give FILE (columns 2 and 3 are the simulation and the "
@@ -122,6 +167,7 @@ int RunAssess(const AssessCliOptions& o) {
   options.total_uses_compensated = o.use_compensated;
   options.welch_segment = o.welch_segment;
   options.coherence_min = o.coherence;
+  options.name_option = FlagOf;
   if (!o.plot.empty()) {
     const std::filesystem::path parent = std::filesystem::path(o.plot).parent_path();
     std::error_code ec;
@@ -151,6 +197,8 @@ int RunAssess(const AssessCliOptions& o) {
       std::printf("%s", analysis::FormatText(result).c_str());
       if (!o.plot.empty()) std::printf("Plot written to %s\n", o.plot.c_str());
     }
+  } catch (const analysis::OptionError& e) {
+    throw Usage(FlagPrefix(o, e.option()) + e.what());
   } catch (const analysis::InputError& e) {
     throw Usage(e.what());
   } catch (const analysis::PlotError& e) {

@@ -3,12 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <cstring>
-#include <fstream>
-#include <sstream>
+#include <utility>
+
+#include "hiltwin/analysis/csv.h"
 
 namespace hiltwin::app {
 namespace {
@@ -21,16 +19,6 @@ constexpr const char* kCsvForm =
 
 bool DutyOk(double duty) { return std::isfinite(duty) && duty >= -1.0 && duty <= 1.0; }
 
-std::string_view Trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) {
-    text.remove_prefix(1);
-  }
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) {
-    text.remove_suffix(1);
-  }
-  return text;
-}
-
 bool EqualsIgnoreCase(std::string_view a, std::string_view b) {
   return a.size() == b.size() &&
          std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
@@ -39,33 +27,84 @@ bool EqualsIgnoreCase(std::string_view a, std::string_view b) {
          });
 }
 
-struct Field {
-  std::string_view text;  // trimmed
-  std::size_t column;     // 1-based column of the field's first character (after trimming)
-};
-
-// Splits one line on commas; columns count from 1 as editors show them.
-std::vector<Field> SplitFields(std::string_view line) {
-  std::vector<Field> fields;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    const std::size_t end = comma == std::string_view::npos ? line.size() : comma;
-    std::string_view raw = line.substr(start, end - start);
-    std::size_t lead = 0;
-    while (lead < raw.size() && std::isspace(static_cast<unsigned char>(raw[lead]))) ++lead;
-    fields.push_back(Field{Trim(raw), start + lead + 1});
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
+// The header names the columns, so a file with left and right swapped or a log of another
+// kind is refused instead of played: time (or time_s), left, right, in any letter case.
+void CheckProfileHeader(const analysis::CsvTable& table, std::size_t line) {
+  constexpr std::string_view kAdvice =
+      "; add that header as the first line (time in seconds, duties in [-1, 1])";
+  const std::string_view expected = "expected the header 'time,left,right'";
+  if (!table.has_header) {
+    throw analysis::InputError(analysis::CsvLocation(table.path, line, 1) + ": " +
+                               std::string(expected) + ", found a row of numbers" +
+                               std::string(kAdvice));
   }
-  return fields;
+  constexpr std::array<std::string_view, 3> kNames{"time", "left", "right"};
+  for (std::size_t i = 0; i < kNames.size(); ++i) {
+    const bool ok = i < table.names.size() &&
+                    (EqualsIgnoreCase(table.names[i], kNames[i]) ||
+                     (i == 0 && EqualsIgnoreCase(table.names[i], "time_s")));
+    if (!ok) {
+      std::string found;
+      for (const std::string& name : table.names) found += (found.empty() ? "" : ",") + name;
+      throw analysis::InputError(analysis::CsvLocation(table.path, line, i + 1) + ": " +
+                                 std::string(expected) + ", found '" + found + "'" +
+                                 std::string(kAdvice));
+    }
+  }
+  if (table.names.size() > kNames.size()) {
+    throw analysis::InputError(analysis::CsvLocation(table.path, line, kNames.size() + 1) +
+                               ": the header has more than the three columns time,left,right; "
+                               "remove the extra columns");
+  }
 }
 
-[[noreturn]] void Fail(std::string_view source, std::size_t line, std::size_t column,
-                       const std::string& what, std::string_view todo) {
-  std::ostringstream out;
-  out << source << ':' << line << ':' << column << ": " << what << "; " << todo;
-  throw ProfileError(out.str());
+analysis::CsvRules ProfileRules() {
+  analysis::CsvRules rules;
+  rules.time_order = analysis::TimeOrder::kStepsAllowed;
+  rules.purpose = "for an input profile (a start and an end time; it repeats with the last time "
+                  "as its period)";
+  rules.check_layout = CheckProfileHeader;
+  return rules;
+}
+
+// What the reader cannot know about a profile: it starts at 0 s or later, duties are
+// fractions of the supply voltage, and the period is > 0.
+std::vector<ProfileKnot> KnotsOf(const analysis::CsvTable& table) {
+  constexpr std::array<std::string_view, 3> kWhat{"time", "left duty", "right duty"};
+  std::vector<ProfileKnot> knots;
+  for (std::size_t row = 0; row < table.rows(); ++row) {
+    const double time_s = table.columns[0][row];
+    if (time_s < 0.0) {
+      throw analysis::InputError(table.Where(row, 0) + ": time " + analysis::NumberText(time_s) +
+                                 " s is negative; profiles start at time 0 or later");
+    }
+    for (std::size_t c = 1; c < kWhat.size(); ++c) {
+      if (!DutyOk(table.columns[c][row])) {
+        throw analysis::InputError(
+            table.Where(row, c) + ": " + std::string(kWhat[c]) + " " +
+            analysis::NumberText(table.columns[c][row]) +
+            " is outside [-1, 1]; duty is a fraction of the supply voltage: scale the column "
+            "into [-1, 1]");
+      }
+    }
+    knots.push_back(ProfileKnot{time_s, Duty{table.columns[1][row], table.columns[2][row]}});
+  }
+  if (!(knots.back().time_s > 0.0)) {
+    throw analysis::InputError(table.Where(table.rows() - 1, 0) +
+                               ": the last time is 0 s; the profile repeats with the last time "
+                               "as its period: add a row for the end time");
+  }
+  return knots;
+}
+
+// One place where reader errors become profile errors, for text and files alike.
+template <typename ReadTable>
+InputProfile ProfileFromCsv(std::string name, ReadTable read_table) {
+  try {
+    return InputProfile::FromKnots(std::move(name), KnotsOf(read_table()));
+  } catch (const analysis::InputError& error) {
+    throw ProfileError(error.what());
+  }
 }
 
 }  // namespace
@@ -141,132 +180,13 @@ InputProfile OpenLoopProfile() {
 }
 
 InputProfile ParseCsvProfile(std::string_view text, std::string_view source_name) {
-  std::vector<ProfileKnot> knots;
-  bool have_header = false;
-  std::size_t line_number = 0;
-  std::size_t last_line = 0;
-  std::size_t same_time_count = 0;
-  std::size_t pos = 0;
-  // Spreadsheet programs often start a CSV with a UTF-8 byte-order mark; it is not data.
-  if (text.starts_with("\xEF\xBB\xBF")) pos = 3;
-  while (pos <= text.size()) {
-    const std::size_t newline = text.find('\n', pos);
-    const std::size_t end = newline == std::string_view::npos ? text.size() : newline;
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    const std::string_view trimmed = Trim(line);
-    if (trimmed.empty() || trimmed.front() == '#') {
-      if (newline == std::string_view::npos) break;
-      continue;
-    }
-    const std::vector<Field> fields = SplitFields(line);
-    if (!have_header) {
-      constexpr std::array<std::string_view, 3> kExpected{"time", "left", "right"};
-      for (std::size_t i = 0; i < kExpected.size(); ++i) {
-        const bool ok = i < fields.size() &&
-                        (EqualsIgnoreCase(fields[i].text, kExpected[i]) ||
-                         (i == 0 && EqualsIgnoreCase(fields[i].text, "time_s")));
-        if (!ok) {
-          const std::size_t column = i < fields.size() ? fields[i].column : line.size() + 1;
-          Fail(source_name, line_number, column,
-               "expected the header 'time,left,right', found '" + std::string(trimmed) + "'",
-               "add that header as the first line (time in seconds, duties in [-1, 1])");
-        }
-      }
-      if (fields.size() > kExpected.size()) {
-        Fail(source_name, line_number, fields[3].column,
-             "the header has more than the three columns time,left,right",
-             "remove the extra columns");
-      }
-      have_header = true;
-      if (newline == std::string_view::npos) break;
-      continue;
-    }
-    if (fields.size() != 3) {
-      const std::size_t column =
-          fields.size() > 3 ? fields[3].column : line.size() + 1;
-      Fail(source_name, line_number, column,
-           "expected 3 values (time,left,right), found " + std::to_string(fields.size()),
-           kCsvForm);
-    }
-    std::array<double, 3> values{};
-    constexpr std::array<std::string_view, 3> kWhat{"time", "left duty", "right duty"};
-    for (std::size_t i = 0; i < 3; ++i) {
-      std::string_view number = fields[i].text;
-      if (!number.empty() && number.front() == '+') number.remove_prefix(1);
-      const char* first = number.data();
-      const char* last = number.data() + number.size();
-      const auto [ptr, ec] = std::from_chars(first, last, values[i]);
-      if (number.empty() || ec != std::errc() || ptr != last) {
-        Fail(source_name, line_number, fields[i].column,
-             std::string(kWhat[i]) + " '" + std::string(fields[i].text) + "' is not a number",
-             kCsvForm);
-      }
-      if (!std::isfinite(values[i])) {
-        Fail(source_name, line_number, fields[i].column,
-             std::string(kWhat[i]) + " '" + std::string(fields[i].text) +
-                 "' is not finite (NaN or infinity)",
-             "replace it with a finite number");
-      }
-    }
-    const double time_s = values[0];
-    if (time_s < 0.0) {
-      Fail(source_name, line_number, fields[0].column,
-           "time " + std::string(fields[0].text) + " s is negative",
-           "profiles start at time 0 or later");
-    }
-    for (std::size_t i = 1; i < 3; ++i) {
-      if (!DutyOk(values[i])) {
-        Fail(source_name, line_number, fields[i].column,
-             std::string(kWhat[i]) + " " + std::string(fields[i].text) +
-                 " is outside [-1, 1]",
-             "duty is a fraction of the supply voltage; scale the column into [-1, 1]");
-      }
-    }
-    if (!knots.empty()) {
-      const double previous_s = knots.back().time_s;
-      if (time_s < previous_s) {
-        std::ostringstream what;
-        what << "time " << fields[0].text << " s is earlier than the previous row's " << previous_s
-             << " s (line " << last_line << ")";
-        Fail(source_name, line_number, fields[0].column, what.str(),
-             "sort the rows by time; times must not decrease");
-      }
-      same_time_count = time_s == previous_s ? same_time_count + 1 : 0;
-      if (same_time_count >= 2) {
-        Fail(source_name, line_number, fields[0].column,
-             "a third row with time " + std::string(fields[0].text) + " s",
-             "a sudden step is two rows with the same time (before and after); remove the "
-             "extra row");
-      }
-    }
-    knots.push_back(ProfileKnot{time_s, Duty{values[1], values[2]}});
-    last_line = line_number;
-    if (newline == std::string_view::npos) break;
-  }
-  if (!have_header) {
-    Fail(source_name, 1, 1, "the file is empty", kCsvForm);
-  }
-  if (knots.size() < 2 || !(knots.back().time_s > 0.0)) {
-    Fail(source_name, line_number, 1,
-         "the profile needs at least two rows and a last time > 0 (it has " +
-             std::to_string(knots.size()) + " row(s))",
-         "add a row for the end time; the profile repeats with that period");
-  }
-  return InputProfile::FromKnots(std::string(source_name), std::move(knots));
+  const std::string name(source_name);
+  return ProfileFromCsv(name, [&] { return analysis::ParseCsv(text, name, ProfileRules()); });
 }
 
 InputProfile LoadCsvProfile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw ProfileError(path.string() + ": cannot read the input profile (" +
-                       std::string(std::strerror(errno)) + "); check the path");
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseCsvProfile(text.str(), path.string());
+  const std::string name = path.string();
+  return ProfileFromCsv(name, [&] { return analysis::ReadCsv(name, ProfileRules()); });
 }
 
 InputProfile LoadInputProfile(std::string_view name_or_path) {

@@ -193,7 +193,7 @@ TEST_F(AssessCli, BadCellsNameFileLineColumn) {
   ExpectUsageError(Run("'" + Write("b.csv", head + "0.2,nan,2\n") + "'"), {"b.csv:4:2", "NaN or Inf"});
   ExpectUsageError(Run("'" + Write("c.csv", head + "0.2,2,inf\n") + "'"), {"c.csv:4:3", "NaN or Inf"});
   ExpectUsageError(Run("'" + Write("d.csv", head + "0.1,2,2\n") + "'"), {"d.csv:4:1", "repeats"});
-  ExpectUsageError(Run("'" + Write("e.csv", head + "0.05,2,2\n") + "'"), {"e.csv:4:1", "backwards"});
+  ExpectUsageError(Run("'" + Write("e.csv", head + "0.05,2,2\n") + "'"), {"e.csv:4:1", "earlier than the previous row"});
   ExpectUsageError(Run("'" + Write("f.csv", "time,sim,exp\n0,0,0\n") + "'"),
                    {"f.csv:2", "1 data row", "at least two"});
   ExpectUsageError(Run("'" + Write("g.csv", head + "0.2,2\n") + "'"), {"g.csv:4", "2 cells"});
@@ -246,6 +246,12 @@ TEST_F(AssessCli, BadFlagsAreNamed) {
   ExpectUsageError(Run("'" + file + "' --eta-pass 1"), {"--eta-pass"});
   ExpectUsageError(Run("'" + file + "' --plot '" + Path("no/such/dir/x.png") + "'"),
                    {"--plot", "does not exist"});
+  // The library describes the value; the command puts its flag and the value given in front.
+  ExpectUsageError(Run("'" + file + "' --segment 5:2"),
+                   {"--segment 5:2: segment 5 s to 2 s: the end must come after the start"});
+  ExpectUsageError(Run("'" + file + "' --kp 0"), {"--kp 0: confidence interval Kp 0"});
+  ExpectUsageError(Run("'" + file + "' --weights 1,0,1"),
+                   {"--weights 1,0,1: the frequency domain", "no input curve given (--input)"});
   ExpectUsageError(Run("--sim 2 --exp 3"), {"--sim", "which file"});
   ExpectUsageError(Run(""), {"nothing to compare"});
 }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,22 @@ std::string ErrorOf(const Curve& sim, const Curve& exp, const AssessOptions& opt
     return e.what();
   }
   return "";
+}
+
+// The option an OptionError from Assess concerns, with its message.
+struct OptionFailure {
+  std::optional<AssessOption> option;  // empty: no OptionError
+  std::string message;
+};
+
+OptionFailure OptionErrorOf(const Curve& sim, const Curve& exp, const AssessOptions& options,
+                            const Curve* input = nullptr) {
+  try {
+    (void)Assess(sim, exp, input, options);
+  } catch (const OptionError& e) {
+    return {e.option(), e.what()};
+  }
+  return {};
 }
 
 TEST(Assess, PureDelayScoresAboutOneAfterCompensation) {
@@ -125,7 +142,8 @@ TEST(Assess, ConstantInputQuotesTheLinesOfTheComparedRange) {
   EXPECT_NE(m.find("u.csv:2-101:2:"), std::string::npos) << m;
   EXPECT_NE(m.find("constant (0.5)"), std::string::npos) << m;
   EXPECT_NE(m.find("[0, 0.99] s"), std::string::npos) << m;
-  EXPECT_NE(m.find("--input"), std::string::npos) << m;
+  EXPECT_NE(m.find("give the column that drove both systems"), std::string::npos) << m;
+  EXPECT_EQ(OptionErrorOf(sim, exp, AssessOptions{}, &u).option, AssessOption::kInput);
 }
 
 TEST(Assess, IsoRatingNeedsTwentySamplesElseItIsNullWithAReason) {
@@ -163,16 +181,93 @@ TEST(Assess, WeightedDomainThatCannotBeComputedIsAnInputError) {
   const Curve sim = MakeCurve("sim", 0.0, 1e-2, 500, 0.0);
   AssessOptions freq;
   freq.weights = {1.0, 0.0, 1.0};
-  EXPECT_NE(ErrorOf(sim, sim, freq).find("--input"), std::string::npos);
-  AssessOptions bad;
-  bad.weights = {0.0, 0.0, 0.0};
-  EXPECT_NE(ErrorOf(sim, sim, bad).find("--weights"), std::string::npos);
-  AssessOptions kp;
-  kp.params.kp = 0.0;
-  EXPECT_NE(ErrorOf(sim, sim, kp).find("--kp"), std::string::npos);
+  const OptionFailure f = OptionErrorOf(sim, sim, freq);
+  EXPECT_EQ(f.option, AssessOption::kWeights);
+  EXPECT_NE(f.message.find("the frequency domain has weight 1 but cannot be computed: no input "
+                           "curve given"),
+            std::string::npos)
+      << f.message;
   AssessOptions seg;
   seg.segment = std::pair{100.0, 200.0};
-  EXPECT_NE(ErrorOf(sim, sim, seg).find("--segment"), std::string::npos);
+  const OptionFailure s = OptionErrorOf(sim, sim, seg);
+  EXPECT_EQ(s.option, AssessOption::kSegment);
+  EXPECT_NE(s.message.find("segment 100 s to 200 s holds 0 samples"), std::string::npos)
+      << s.message;
+}
+
+// The library describes domain values and leaves flag names to the command line: no message
+// or note holds "--", and every bad choice says which AssessOption it concerns.
+TEST(Assess, LibraryMessagesNameDomainValuesNotFlags) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 500, 0.0);
+  Curve constant = sim;
+  constant.y.assign(constant.y.size(), 1.0);
+  const Curve short_input = MakeCurve("u", 0.0, 1e-2, 10, 0.0);
+  struct Case {
+    AssessOptions options;
+    const Curve* exp;
+    const Curve* input;
+    AssessOption option;
+    const char* what;
+  };
+  std::vector<Case> cases;
+  auto add = [&](auto change, AssessOption option, const char* what,
+                 const Curve* exp = nullptr, const Curve* input = nullptr) {
+    AssessOptions o;
+    change(o);
+    cases.push_back({o, exp != nullptr ? exp : &sim, input, option, what});
+  };
+  add([](AssessOptions& o) { o.params.kp = 0.0; }, AssessOption::kKp, "confidence interval Kp 0:");
+  add([](AssessOptions& o) { o.params.eta_pass = 1.0; }, AssessOption::kEtaPass,
+      "passing score eta_pass 1:");
+  add([](AssessOptions& o) { o.weights = {1.0, -1.0, 0.0}; }, AssessOption::kWeights,
+      "weights 1,-1,0: every weight");
+  add([](AssessOptions& o) { o.weights = {0.0, 0.0, 0.0}; }, AssessOption::kWeights,
+      "at least one weight must be > 0");
+  add([](AssessOptions& o) { o.segment = std::pair{5.0, 2.0}; }, AssessOption::kSegment,
+      "segment 5 s to 2 s: the end must come after the start");
+  add([](AssessOptions& o) { o.max_delay_s = -1.0; }, AssessOption::kMaxDelay,
+      "delay search range -1 s");
+  add([](AssessOptions& o) { o.band_hz = std::pair{20.0, 0.0}; }, AssessOption::kBand,
+      "frequency band 20 Hz to 0 Hz");
+  add([](AssessOptions& o) { o.coherence_min = 1.0; }, AssessOption::kCoherence,
+      "coherence threshold 1:");
+  add([](AssessOptions& o) { o.welch_segment = 4; }, AssessOption::kWelchSegment,
+      "Welch segment of 4 samples", nullptr, &sim);
+  add([](AssessOptions&) {}, AssessOption::kExp, "the experiment curve", &constant);
+  add([](AssessOptions&) {}, AssessOption::kInput, "fewer than 16 samples", nullptr,
+      &short_input);
+  add([](AssessOptions& o) { o.weights = {1.0, 0.0, 1.0}; }, AssessOption::kWeights,
+      "no input curve given");
+  for (const Case& c : cases) {
+    const OptionFailure f = OptionErrorOf(sim, *c.exp, c.options, c.input);
+    EXPECT_EQ(f.option, c.option) << c.what << " -> " << f.message;
+    EXPECT_NE(f.message.find(c.what), std::string::npos) << f.message;
+    EXPECT_EQ(f.message.find("--"), std::string::npos) << f.message;
+  }
+}
+
+TEST(Assess, NotesNameOptionsOnlyThroughTheNamer) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-3, 2000, 0.0);
+  const Curve exp = MakeCurve("exp", 0.0, 1e-3, 2000, 0.05);  // 50 ms late
+  AssessOptions options;
+  options.max_delay_s = 0.01;
+  options.segment = std::pair{0.0, 1.0};
+  const Assessment plain = Assess(sim, exp, nullptr, options);
+  ASSERT_TRUE(plain.delay.at_search_limit);
+  std::vector<std::string> texts = plain.notes;
+  texts.push_back(plain.frequency_note);
+  for (const std::string& text : texts) EXPECT_EQ(text.find("--"), std::string::npos) << text;
+  EXPECT_EQ(plain.frequency_note, "no input curve given");
+
+  options.name_option = [](AssessOption option) -> std::string_view {
+    return option == AssessOption::kMaxDelay ? "--max-delay"
+           : option == AssessOption::kInput  ? "--input"
+                                             : "";
+  };
+  const Assessment named = Assess(sim, exp, nullptr, options);
+  EXPECT_EQ(named.frequency_note, "no input curve given (--input)");
+  EXPECT_NE(named.notes.back().find("widen the search range (--max-delay)"), std::string::npos)
+      << named.notes.back();
 }
 
 TEST(Assess, StepSegmentGivesPerformanceDomainAndWeightedTotal) {
@@ -264,7 +359,7 @@ TEST(Assess, StepInputLeavesTheFrequencyDomainNotComputed) {
   AssessOptions weighted;
   weighted.weights = {1.0, 0.0, 1.0};
   const std::string m = ErrorOf(y, y, weighted, &u);
-  EXPECT_NE(m.find("frequency domain weight 1"), std::string::npos) << m;
+  EXPECT_NE(m.find("frequency domain has weight 1"), std::string::npos) << m;
   EXPECT_NE(m.find("carry input power"), std::string::npos) << m;
 }
 

@@ -8,10 +8,11 @@
 namespace hiltwin::analysis {
 namespace {
 
-// Expects ParseCsv to fail with a message that contains every one of `parts`.
-void ExpectError(const std::string& text, std::initializer_list<std::string> parts) {
+// Expects ParseCsv (with `rules`) to fail with a message that contains every one of `parts`.
+void ExpectError(const std::string& text, std::initializer_list<std::string> parts,
+                 const CsvRules& rules = {}) {
   try {
-    (void)ParseCsv(text, "in.csv");
+    (void)ParseCsv(text, "in.csv", rules);
     ADD_FAILURE() << "no error for:\n" << text;
   } catch (const InputError& e) {
     const std::string message = e.what();
@@ -74,14 +75,60 @@ TEST(Csv, NanAndInfNameFileLineColumn) {
 
 TEST(Csv, TimeMustStrictlyIncrease) {
   ExpectError("time,a\n0,1\n0.5,2\n0.5,3\n", {"in.csv:4:1", "repeats", "strictly increasing"});
-  ExpectError("time,a\n0,1\n0.5,2\n0.25,3\n", {"in.csv:4:1", "goes backwards", "line 3"});
+  ExpectError("time,a\n0,1\n0.5,2\n0.25,3\n",
+              {"in.csv:4:1", "time 0.25 s is earlier than the previous row's 0.5 s (line 3)"});
+  // Times are quoted as written, not rounded to six decimals (1 MHz logs stay readable).
+  ExpectError("time,a\n0,1\n2e-7,2\n1e-7,3\n", {"time 1e-07 s", "row's 2e-07 s"});
+}
+
+TEST(Csv, StepsAllowedTakesTwoRowsPerTimeButNotThree) {
+  CsvRules steps;
+  steps.time_order = TimeOrder::kStepsAllowed;
+  const CsvTable t = ParseCsv("time,u\n0,0\n1,0\n1,1\n2,1\n", "s.csv", steps);
+  EXPECT_EQ(t.rows(), 4u);
+  try {
+    (void)ParseCsv("time,u\n0,0\n1,0\n1,1\n1,2\n", "s.csv", steps);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.csv:5:1: time 1 s is on a third row (lines 3, 4 and 5)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW((void)ParseCsv("time,u\n0,0\n1,0\n0.5,1\n", "s.csv", steps), InputError);
+}
+
+TEST(Csv, LayoutCheckRunsBeforeAnyDataRow) {
+  CsvRules rules;
+  std::size_t seen_line = 0;
+  rules.check_layout = [&seen_line](const CsvTable& table, std::size_t line) {
+    seen_line = line;
+    if (table.names.size() != 3) throw InputError(CsvLocation(table.path, line, 1) + ": want 3");
+  };
+  // The bad row 3 would fail on its own; the layout check must speak first.
+  ExpectError("time,a\n0,1\n1,x\n", {"in.csv:1:1: want 3"}, rules);
+  EXPECT_THROW((void)ParseCsv("# c\ntime,a\n0,1\n1,x\n", "in.csv", rules), InputError);
+  EXPECT_EQ(seen_line, 2u);
+  EXPECT_EQ(ParseCsv("time,a,b\n0,1,2\n1,2,3\n", "in.csv", rules).rows(), 2u);
+}
+
+TEST(Csv, RowOfTheWrongWidthPointsAtTheFirstMissingOrExtraCell) {
+  ExpectError("time,a,b\n0,1,2\n1,2\n", {"in.csv:3:3:", "row has 2 cells but the header has 3"});
+  ExpectError("0,1\n1,2,3\n", {"in.csv:2:3:", "row has 3 cells but the first row has 2"});
+}
+
+TEST(Csv, NumberTextIsShortestAndExact) {
+  EXPECT_EQ(NumberText(0.1), "0.1");
+  EXPECT_EQ(NumberText(2.0), "2");
+  EXPECT_EQ(NumberText(1.50000001), "1.50000001");
+  EXPECT_EQ(NumberText(-1e-7), "-1e-07");
 }
 
 TEST(Csv, NeedsTwoSamplesAndTwoColumns) {
   ExpectError("time,a\n0,1\n", {"in.csv:2", "1 data row", "at least two"});
   ExpectError("time,a\n", {"in.csv", "0 data rows"});
-  ExpectError("", {"in.csv", "empty file"});
-  ExpectError("time\n0\n1\n", {"in.csv:1", "one column"});
+  ExpectError("", {"in.csv:1:1", "empty file"});
+  ExpectError("time\n0\n1\n", {"in.csv:1:2", "one column"});
+  ExpectError("0\n1\n", {"in.csv:1:2", "the first row has one column"});
 }
 
 TEST(Csv, UnknownOrTimeColumnIsRefusedWithTheChoices) {

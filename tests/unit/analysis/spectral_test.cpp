@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -186,7 +188,17 @@ TEST(Spectral, SingleStepExcitesTooFewSegmentsForAScore) {
   const auto one = ScoreFrequency(u, y, y, 1e-3, 8192, 0.8, CredibilityParams{}, why);
   EXPECT_FALSE(one.has_value());
   EXPECT_NE(why.find("only 1 of 1 Welch segments"), std::string::npos) << why;
-  EXPECT_NE(why.find("shorter --welch-segment"), std::string::npos) << why;
+  EXPECT_NE(why.find("use shorter Welch segments or a longer record"), std::string::npos) << why;
+  EXPECT_EQ(why.find("--"), std::string::npos) << why;
+  // A command line names its flag through the namer; the library adds only the hint.
+  const OptionNamer flags = [](AssessOption option) -> std::string_view {
+    return option == AssessOption::kWelchSegment ? "--welch-segment" : "";
+  };
+  (void)ScoreFrequency(u, y, y, 1e-3, 8192, 0.8, CredibilityParams{}, why, 0.0,
+                       std::numeric_limits<double>::infinity(), flags);
+  EXPECT_NE(why.find("use shorter Welch segments (--welch-segment) or a longer record"),
+            std::string::npos)
+      << why;
 }
 
 TEST(Welch, DefaultSegment) {

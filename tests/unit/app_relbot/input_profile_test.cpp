@@ -152,30 +152,48 @@ struct BadCsv {
   const char* what;
 };
 
+// Columns count CSV fields from 1, as in every message of the shared reader (and of
+// `hiltwin assess`), so leading spaces do not move them.
 TEST(CsvProfile, ErrorsGiveLineColumnWhatAndWhatToDo) {
   const BadCsv cases[] = {
-      {"", "p.csv:1:1:", "empty"},
+      {"", "p.csv:1:1:", "empty file"},
       {"t,l,r\n0,0,0\n1,0,0\n", "p.csv:1:1:", "expected the header 'time,left,right'"},
-      {"time,left\n0,0\n1,0\n", "p.csv:1:10:", "expected the header"},
-      {"time,left,right,x\n", "p.csv:1:17:", "more than the three columns"},
-      {"time,left,right\n0,0,0\n1, abc,0\n", "p.csv:3:4:", "left duty 'abc' is not a number"},
-      {"time,left,right\n0,0,0\n1,0,\n", "p.csv:3:5:", "right duty '' is not a number"},
-      {"time,left,right\n0,nan,0\n1,0,0\n", "p.csv:2:3:", "not finite"},
-      {"time,left,right\n0,0,0\n1,0,inf\n", "p.csv:3:5:", "not finite"},
-      {"time,left,right\n0,0,0\n1,0,1.5\n", "p.csv:3:5:", "right duty 1.5 is outside [-1, 1]"},
+      {"0,0,0\n1,0,0\n", "p.csv:1:1:", "found a row of numbers"},
+      {"time,left\n0,0\n1,0\n", "p.csv:1:3:", "expected the header"},
+      {"time,left,right,x\n", "p.csv:1:4:", "more than the three columns"},
+      {"time,left,right\n0,0,0\n1, abc,0\n", "p.csv:3:2:", "column 'left': 'abc' is not a number"},
+      {"time,left,right\n0,0,0\n1,0,\n", "p.csv:3:3:", "column 'right': empty cell"},
+      {"time,left,right\n0,nan,0\n1,0,0\n", "p.csv:2:2:", "not finite"},
+      {"time,left,right\n0,0,0\n1,0,inf\n", "p.csv:3:3:", "not finite"},
+      {"time,left,right\n0,0,0\n1,1e999,0\n", "p.csv:3:2:", "not finite"},
+      {"time,left,right\n0,0,0\n1,0,1.5\n", "p.csv:3:3:", "right duty 1.5 is outside [-1, 1]"},
       {"time,left,right\n0,0,0\n2,0,0\n1,0,0\n", "p.csv:4:1:",
        "earlier than the previous row's 2 s (line 3)"},
-      {"time,left,right\n0,0,0\n1,0,0\n1,0.5,0\n1,0.2,0\n", "p.csv:5:1:", "a third row"},
-      {"time,left,right\n0,0\n1,0,0\n", "p.csv:2:4:", "found 2"},
-      {"time,left,right\n0,0,0,0\n1,0,0\n", "p.csv:2:7:", "found 4"},
+      {"time,left,right\n0,0,0\n1,0,0\n1,0.5,0\n1,0.2,0\n", "p.csv:5:1:",
+       "a third row (lines 3, 4 and 5)"},
+      {"time,left,right\n0,0\n1,0,0\n", "p.csv:2:3:", "row has 2 cells but the header has 3"},
+      {"time,left,right\n0,0,0,0\n1,0,0\n", "p.csv:2:4:", "row has 4 cells"},
       {"time,left,right\n-1,0,0\n1,0,0\n", "p.csv:2:1:", "negative"},
-      {"time,left,right\n0,0,0\n", "p.csv:", "at least two rows"},
+      {"time,left,right\n0,0,0\n", "p.csv:2:", "at least two rows for an input profile"},
+      {"time,left,right\n0,0,0\n0,1,1\n", "p.csv:3:1:", "the last time is 0 s"},
   };
   for (const BadCsv& c : cases) {
     const std::string message = ErrorOf(c.csv);
     EXPECT_EQ(message.rfind(c.where, 0), 0U) << c.csv << " -> " << message;
     EXPECT_NE(message.find(c.what), std::string::npos) << c.csv << " -> " << message;
     EXPECT_NE(message.find("; "), std::string::npos) << "no advice in: " << message;
+  }
+}
+
+TEST(CsvProfile, ReadsWhatTheAssessReaderReads) {
+  // Semicolons or tabs (as a spreadsheet in a comma-decimal locale exports), quoted names.
+  for (const char* csv : {"time;left;right\n0;0.5;0.5\n1;0.5;0.5\n",
+                          "time\tleft\tright\n0\t0.5\t0.5\n1\t0.5\t0.5\n",
+                          "\"time\",\"left\",\"right\"\n0,0.5,0.5\n1,0.5,0.5\n",
+                          "TIME_S,Left,RIGHT\n0,0.5,0.5\n1,0.5,0.5\n"}) {
+    const InputProfile profile = ParseCsvProfile(csv, "p.csv");
+    EXPECT_DOUBLE_EQ(profile.period_s(), 1.0) << csv;
+    EXPECT_EQ(profile.At(0.5).left, 0.5) << csv;
   }
 }
 
@@ -202,7 +220,7 @@ TEST(LoadInputProfile, BuiltInNameFileOrAClearError) {
     (void)LoadInputProfile(path.string());
     FAIL();
   } catch (const ProfileError& error) {
-    EXPECT_EQ(std::string(error.what()).rfind(path.string() + ":3:7:", 0), 0U) << error.what();
+    EXPECT_EQ(std::string(error.what()).rfind(path.string() + ":3:3:", 0), 0U) << error.what();
   }
   std::filesystem::remove(path);
 

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "hiltwin/analysis/assess_option.h"
 #include "hiltwin/analysis/credibility.h"
 #include "hiltwin/analysis/cross_checks.h"
 #include "hiltwin/analysis/csv.h"
@@ -45,6 +46,7 @@ struct AssessOptions {
   double coherence_min = 0.8;
   std::optional<std::pair<double, double>> band_hz;  ///< frequency domain band [lo, hi] Hz
   std::size_t iso_max_samples = 2000;   ///< ISO/TS 18571 runs on at most this many points
+  OptionNamer name_option = NoOptionNames;  ///< how advice in notes and errors names options
 };
 
 /// The result of Assess, in the order it is printed.
@@ -82,8 +84,10 @@ struct Assessment {
 };
 
 /// Runs the whole assessment. `input` (may be null) enables the frequency domain. Throws
-/// InputError for bad options or data (no overlap, constant experiment, a domain with
-/// weight > 0 that cannot be computed, ...), naming file, line, column or flag.
+/// OptionError for a bad option or a curve that cannot serve (constant experiment, a domain
+/// with weight > 0 that cannot be computed, ...) and InputError for data that do not fit
+/// together (no overlap), naming file, line and column; messages never name command-line
+/// flags (see OptionError::option and AssessOptions::name_option).
 [[nodiscard]] Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
                                 const AssessOptions& options);
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "hiltwin/analysis/assess_option.h"
 #include "hiltwin/analysis/credibility.h"
 
 namespace hiltwin::analysis {
@@ -65,11 +66,13 @@ struct FrequencyScore {
 };
 
 /// Uses bins in [band_lo_hz, band_hi_hz] only. Returns nullopt (with `why` filled) when fewer
-/// than kMinInputSegments segments carry input power or no bin passes both gates.
+/// than kMinInputSegments segments carry input power or no bin passes both gates; `why`
+/// names the options to change through `name_option`.
 [[nodiscard]] std::optional<FrequencyScore> ScoreFrequency(
     std::span<const double> u, std::span<const double> y_sim, std::span<const double> y_exp,
     double step_s, std::size_t segment_samples, double coherence_min,
     const CredibilityParams& params, std::string& why, double band_lo_hz = 0.0,
-    double band_hi_hz = std::numeric_limits<double>::infinity());
+    double band_hi_hz = std::numeric_limits<double>::infinity(),
+    OptionNamer name_option = NoOptionNames);
 
 }  // namespace hiltwin::analysis

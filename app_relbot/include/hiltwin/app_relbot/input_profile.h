@@ -64,8 +64,9 @@ class InputProfile {
 /// driving, turning in place, arcs and reversals, starting and ending at rest.
 [[nodiscard]] InputProfile OpenLoopProfile();
 
-/// Parses CSV text (header `time,left,right`, then one row per knot). `source_name` is used in
-/// messages ("file:line:column: ..."). Throws ProfileError.
+/// Parses CSV text with the reader of `hiltwin assess` (analysis::ParseCsv): header
+/// `time,left,right`, then one row per knot. `source_name` is used in messages
+/// ("file:line:column: ...", column = CSV field). Throws ProfileError.
 [[nodiscard]] InputProfile ParseCsvProfile(std::string_view text, std::string_view source_name);
 
 /// Reads and parses a CSV profile file. Throws ProfileError (also when it cannot be read).
