@@ -1,12 +1,8 @@
 #include "hiltwin/kernel_glue/rt_probe.h"
 
-#include <fcntl.h>
 #include <sched.h>
-#include <spawn.h>
 #include <sys/mman.h>
 #include <sys/utsname.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -20,11 +16,16 @@
 #include <system_error>
 #include <thread>
 
+#include "hiltwin/kernel_glue/process.h"
+
 namespace hiltwin::kernel_glue {
 namespace {
 
 constexpr std::string_view kGovernorCommand =
     "echo performance | sudo tee /sys/devices/system/cpu/cpu*/cpufreq/scaling_governor";
+
+// A tool that hangs (a stuck systemd) must not hang the doctor.
+constexpr std::chrono::milliseconds kToolTimeout{10'000};
 
 // Bits of the capability sets in /proc/<pid>/status (linux/capability.h).
 constexpr unsigned kCapIpcLock = 14;
@@ -113,43 +114,20 @@ class Machine {
     return std::nullopt;
   }
 
-  // Runs a tool and returns its standard output (nullopt when it cannot start). No shell,
-  // so paths need no quoting.
+  // Runs a tool and returns its standard output whatever its exit code (systemd-detect-virt
+  // prints "none" and exits 1); nullopt when it cannot start or hangs.
   [[nodiscard]] std::optional<std::string> RunTool(const std::vector<std::string>& argv) const {
     if (!options_.run_tools || argv.empty()) return std::nullopt;
-    int pipe_fds[2];
-    if (pipe2(pipe_fds, O_CLOEXEC) != 0) return std::nullopt;
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
-    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
-    std::vector<char*> args;
-    args.reserve(argv.size() + 1);
-    for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-    args.push_back(nullptr);
-    pid_t pid = 0;
-    const int spawn_error = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    close(pipe_fds[1]);
-    if (spawn_error != 0) {
-      close(pipe_fds[0]);
-      return std::nullopt;
+    ProcessOptions streams;
+    streams.out = OutputTarget::Capture();
+    streams.err = OutputTarget::Discard();
+    try {
+      ProcessResult result = RunProcess(argv, streams, kToolTimeout);
+      if (result.status.timed_out) return std::nullopt;
+      return std::move(result.out);
+    } catch (const SpawnError&) {
+      return std::nullopt;  // not installed: the check falls back to files
     }
-    std::string output;
-    char buffer[4096];
-    for (;;) {
-      const ssize_t got = read(pipe_fds[0], buffer, sizeof(buffer));
-      if (got > 0) {
-        output.append(buffer, static_cast<std::size_t>(got));
-      } else if (got == 0 || errno != EINTR) {
-        break;
-      }
-    }
-    close(pipe_fds[0]);
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    return output;
   }
 
   [[nodiscard]] bool real_root() const noexcept { return real_root_; }
