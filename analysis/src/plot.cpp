@@ -1,11 +1,9 @@
 #include "hiltwin/analysis/plot.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,10 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <sstream>
 #include <vector>
 
-extern char** environ;
+#include "hiltwin/kernel_glue/process.h"
 
 namespace hiltwin::analysis {
 namespace {
@@ -81,13 +78,31 @@ std::vector<std::size_t> RowsToDraw(const Assessment& a, std::size_t max_points)
   return rows;
 }
 
+// gnuplot renders in a few seconds even at max_points rows; a stuck one must not hang.
+constexpr std::chrono::seconds kGnuplotTimeout{120};
+
+// Runs gnuplot on `script`, its stdout and stderr together (its messages, for the error).
+kernel_glue::ProcessResult RunGnuplot(const std::filesystem::path& script) {
+  kernel_glue::ProcessOptions streams;
+  streams.out = kernel_glue::OutputTarget::Capture();
+  streams.err = kernel_glue::OutputTarget::SameAsStdout();
+  try {
+    return kernel_glue::RunProcess({"gnuplot", script.string()}, streams, kGnuplotTimeout);
+  } catch (const kernel_glue::SpawnError& e) {
+    if (e.NotFound()) {
+      throw InputError("gnuplot is not installed (not found on PATH): install the Debian "
+                       "package gnuplot-nox (apt-get install gnuplot-nox)");
+    }
+    throw PlotError(e.what());
+  }
+}
+
 }  // namespace
 
 void WritePlot(const Assessment& a, const std::string& png_path, std::size_t max_points) {
   const TempDir dir;
   const std::filesystem::path data = dir.path / "curves.dat";
   const std::filesystem::path script = dir.path / "plot.gp";
-  const std::filesystem::path log = dir.path / "gnuplot.log";
   {
     std::ofstream out(data);
     out << "# time y_sim y_exp diff diff_compensated\n";
@@ -136,38 +151,13 @@ void WritePlot(const Assessment& a, const std::string& png_path, std::size_t max
 
   std::error_code ec;
   std::filesystem::remove(png_path, ec);  // so an old picture cannot pass for a new one
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  const std::string log_path = log.string();
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::string program = "gnuplot";
-  std::string script_arg = script.string();
-  char* argv[] = {program.data(), script_arg.data(), nullptr};
-  pid_t pid = 0;
-  const int spawn_error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawn_error == ENOENT) {
-    throw InputError("--plot: gnuplot is not installed (not found on PATH); install the Debian "
-                     "package gnuplot-nox (apt-get install gnuplot-nox) or leave out --plot");
-  }
-  if (spawn_error != 0) {
-    throw PlotError("--plot: cannot start gnuplot: " + std::string(std::strerror(spawn_error)));
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw PlotError("--plot: lost track of gnuplot: " + std::string(std::strerror(errno)));
-  }
-  std::ifstream log_in(log);
-  std::stringstream output;
-  output << log_in.rdbuf();
-  const bool written = std::filesystem::exists(png_path, ec) && std::filesystem::file_size(png_path, ec) > 0;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !written) {
-    throw PlotError("--plot " + png_path + ": gnuplot failed" +
-                    (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")" : "") +
-                    ": " + output.str() + "check that the directory exists and is writable");
+  const kernel_glue::ProcessResult gnuplot = RunGnuplot(script);
+  const bool written =
+      std::filesystem::exists(png_path, ec) && std::filesystem::file_size(png_path, ec) > 0;
+  if (!gnuplot.status.Success() || !written) {
+    throw PlotError("cannot write " + png_path + ": gnuplot " +
+                    (gnuplot.status.Success() ? "wrote no picture" : gnuplot.status.Describe()) +
+                    ": " + gnuplot.out + "check that the directory exists and is writable");
   }
 }
 

@@ -190,7 +190,15 @@ int RunAssess(const AssessCliOptions& o) {
     if (input_spec) input = curve(*input_spec, "--input");
     const analysis::Assessment result =
         analysis::Assess(sim, exp, input ? &*input : nullptr, options);
-    if (!o.plot.empty()) analysis::WritePlot(result, o.plot);
+    if (!o.plot.empty()) {
+      try {
+        analysis::WritePlot(result, o.plot);
+      } catch (const analysis::InputError& e) {  // gnuplot is not installed
+        throw Usage(std::string("--plot: ") + e.what() + ", or leave out --plot");
+      } catch (const analysis::PlotError& e) {
+        throw CommandError(ExitCode::kIo, std::string("--plot: ") + e.what());
+      }
+    }
     if (o.json) {
       std::printf("%s\n", analysis::ToJson(result).dump(2).c_str());
     } else {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "hiltwin/app_relbot/commands.h"
+#include "hiltwin/app_relbot/doctor_format.h"
 #include "hiltwin/kernel_glue/rt_probe.h"
 
 namespace hiltwin::app {
@@ -24,11 +25,11 @@ int RunDoctor(const DoctorOptions& options) {
   probe.try_privileges = !options.no_try;
   const kernel_glue::ProbeReport report = kernel_glue::RunRtProbe(probe);
   if (options.json) {
-    std::printf("%s\n", kernel_glue::ToJson(report).dump(2).c_str());
+    std::printf("%s\n", DoctorJson(report).dump(2).c_str());
   } else {
     std::printf("hiltwin doctor: real-time readiness of this machine%s\n\n%s",
                 options.root == "/" ? "" : (" (files under " + options.root + ")").c_str(),
-                kernel_glue::FormatText(report).c_str());
+                DoctorText(report).c_str());
     std::printf(
         "See docs/realtime-setup.md for each step. Runs still work with warnings: the "
         "run report records which real-time settings were in effect.\n");

@@ -9,15 +9,16 @@
 // with the periods a stall swallowed skipped on both sides (the executive's own deadline-miss
 // count, end > release + period plus skipped releases, is printed too).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "hiltwin/kernel_glue/clock.h"
+#include "hiltwin/kernel_glue/process.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
 #include "hiltwin/scheduler/executive.h"
 
@@ -81,38 +82,49 @@ LatencyFigures RunHiltwin(double rate_hz, double seconds) {
   return f;
 }
 
+/// cyclictest's stdout (run by argv, no shell); exits with its stderr when it cannot run.
+std::string CyclictestOutput(const std::vector<std::string>& argv) {
+  hiltwin::kernel_glue::ProcessOptions streams;
+  streams.out = hiltwin::kernel_glue::OutputTarget::Capture();
+  streams.err = hiltwin::kernel_glue::OutputTarget::Capture();
+  hiltwin::kernel_glue::ProcessResult run;
+  try {
+    run = hiltwin::kernel_glue::RunProcess(argv, streams);
+  } catch (const hiltwin::kernel_glue::SpawnError& e) {
+    std::fprintf(stderr, "%s%s\n", e.what(), e.NotFound() ? " (apt-get install rt-tests)" : "");
+    std::exit(2);
+  }
+  if (!run.status.Success()) {
+    std::fprintf(stderr, "cyclictest failed (%s): %s\n", run.status.Describe().c_str(),
+                 run.err.c_str());
+    std::exit(2);
+  }
+  return std::move(run.out);
+}
+
 /// Runs cyclictest with a 1 µs-bucket histogram up to 20 ms and derives the same figures.
 LatencyFigures RunCyclictest(double rate_hz, double seconds, int priority) {
   const long interval_us = std::lround(1e6 / rate_hz);
   const long loops = std::lround(rate_hz * seconds);
   constexpr long kHistogramUs = 20'000;
-  const std::string command = "cyclictest -m -q -p" + std::to_string(priority) + " -i" +
-                              std::to_string(interval_us) + " -l" + std::to_string(loops) +
-                              " -h" + std::to_string(kHistogramUs) + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    std::fprintf(stderr, "cannot start cyclictest (apt-get install rt-tests)\n");
-    std::exit(2);
-  }
+  const std::vector<std::string> argv = {
+      "cyclictest", "-m", "-q", "-p" + std::to_string(priority), "-i" + std::to_string(interval_us),
+      "-l" + std::to_string(loops), "-h" + std::to_string(kHistogramUs)};
   std::vector<std::uint64_t> histogram(kHistogramUs, 0);
   std::uint64_t overflows = 0;
   LatencyFigures f;
-  std::array<char, 256> line{};
-  while (std::fgets(line.data(), line.size(), pipe) != nullptr) {
+  std::istringstream lines(CyclictestOutput(argv));
+  for (std::string line; std::getline(lines, line);) {
     long bucket = 0;
     unsigned long long count = 0;
-    if (line[0] != '#' && std::sscanf(line.data(), "%ld %llu", &bucket, &count) == 2) {
+    if (line[0] != '#' && std::sscanf(line.c_str(), "%ld %llu", &bucket, &count) == 2) {
       if (bucket >= 0 && bucket < kHistogramUs) histogram[static_cast<std::size_t>(bucket)] = count;
-    } else if (std::sscanf(line.data(), "# Min Latencies: %lf", &f.min_us) == 1) {
-    } else if (std::sscanf(line.data(), "# Avg Latencies: %lf", &f.avg_us) == 1) {
-    } else if (std::sscanf(line.data(), "# Max Latencies: %lf", &f.max_us) == 1) {
-    } else if (std::sscanf(line.data(), "# Histogram Overflows: %llu", &count) == 1) {
+    } else if (std::sscanf(line.c_str(), "# Min Latencies: %lf", &f.min_us) == 1) {
+    } else if (std::sscanf(line.c_str(), "# Avg Latencies: %lf", &f.avg_us) == 1) {
+    } else if (std::sscanf(line.c_str(), "# Max Latencies: %lf", &f.max_us) == 1) {
+    } else if (std::sscanf(line.c_str(), "# Histogram Overflows: %llu", &count) == 1) {
       overflows = count;
     }
-  }
-  if (pclose(pipe) != 0) {
-    std::fprintf(stderr, "cyclictest failed: %s\n", command.c_str());
-    std::exit(2);
   }
   std::uint64_t total = overflows;
   for (auto c : histogram) total += c;

@@ -1,15 +1,10 @@
 #include "hiltwin/kernel_glue/rt_probe.h"
 
-#include <fcntl.h>
 #include <sched.h>
-#include <spawn.h>
 #include <sys/mman.h>
 #include <sys/utsname.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
@@ -20,11 +15,16 @@
 #include <system_error>
 #include <thread>
 
+#include "hiltwin/kernel_glue/process.h"
+
 namespace hiltwin::kernel_glue {
 namespace {
 
 constexpr std::string_view kGovernorCommand =
     "echo performance | sudo tee /sys/devices/system/cpu/cpu*/cpufreq/scaling_governor";
+
+// A tool that hangs (a stuck systemd) must not hang the doctor.
+constexpr std::chrono::milliseconds kToolTimeout{10'000};
 
 // Bits of the capability sets in /proc/<pid>/status (linux/capability.h).
 constexpr unsigned kCapIpcLock = 14;
@@ -113,43 +113,20 @@ class Machine {
     return std::nullopt;
   }
 
-  // Runs a tool and returns its standard output (nullopt when it cannot start). No shell,
-  // so paths need no quoting.
+  // Runs a tool and returns its standard output whatever its exit code (systemd-detect-virt
+  // prints "none" and exits 1); nullopt when it cannot start or hangs.
   [[nodiscard]] std::optional<std::string> RunTool(const std::vector<std::string>& argv) const {
     if (!options_.run_tools || argv.empty()) return std::nullopt;
-    int pipe_fds[2];
-    if (pipe2(pipe_fds, O_CLOEXEC) != 0) return std::nullopt;
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
-    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
-    std::vector<char*> args;
-    args.reserve(argv.size() + 1);
-    for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-    args.push_back(nullptr);
-    pid_t pid = 0;
-    const int spawn_error = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    close(pipe_fds[1]);
-    if (spawn_error != 0) {
-      close(pipe_fds[0]);
-      return std::nullopt;
+    ProcessOptions streams;
+    streams.out = OutputTarget::Capture();
+    streams.err = OutputTarget::Discard();
+    try {
+      ProcessResult result = RunProcess(argv, streams, kToolTimeout);
+      if (result.status.timed_out) return std::nullopt;
+      return std::move(result.out);
+    } catch (const SpawnError&) {
+      return std::nullopt;  // not installed: the check falls back to files
     }
-    std::string output;
-    char buffer[4096];
-    for (;;) {
-      const ssize_t got = read(pipe_fds[0], buffer, sizeof(buffer));
-      if (got > 0) {
-        output.append(buffer, static_cast<std::size_t>(got));
-      } else if (got == 0 || errno != EINTR) {
-        break;
-      }
-    }
-    close(pipe_fds[0]);
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    return output;
   }
 
   [[nodiscard]] bool real_root() const noexcept { return real_root_; }
@@ -162,20 +139,34 @@ class Machine {
 
 ProbeCheck Make(std::string id, std::string name, std::string value, CheckStatus status,
                 std::string advice = {}) {
-  return ProbeCheck{std::move(id), std::move(name), std::move(value), status, std::move(advice)};
+  ProbeCheck check;
+  check.id = std::move(id);
+  check.name = std::move(name);
+  check.value = std::move(value);
+  check.status = status;
+  check.advice = std::move(advice);
+  return check;
 }
 
 ProbeCheck Unknown(std::string id, std::string name, std::string_view why,
                    std::string advice = {}) {
   // Every line that is not ok says what to do, unknown ones included.
   if (advice.empty()) {
-    advice = why == "not tried"
-                 ? "run 'hiltwin doctor' without --no-try to try it for real (it is undone at once)"
-                 : "could not be read: check that /proc and /sys are mounted (or that --root "
-                   "holds a full copy), or check it by hand as docs/realtime-setup.md describes";
+    advice =
+        "could not be read: check that /proc and /sys are mounted (or that the probed root "
+        "holds a full copy of them), or check it by hand as docs/realtime-setup.md describes";
   }
   return Make(std::move(id), std::move(name), "unknown (" + std::string(why) + ")",
               CheckStatus::kWarn, std::move(advice));
+}
+
+// A privilege try the options ruled out: a fact, no advice (only the caller knows how its
+// user asks for the try).
+ProbeCheck NotTried(std::string id, std::string name) {
+  ProbeCheck check =
+      Make(std::move(id), std::move(name), "unknown (not tried)", CheckStatus::kWarn);
+  check.not_tried = true;
+  return check;
 }
 
 // "key: value" lines of /proc/self/status.
@@ -332,7 +323,7 @@ ProbeCheck CheckPreemption(const Machine& machine) {
 ProbeCheck CheckSchedFifo(const Machine& machine, const OsCalls& os) {
   const std::string id = "sched_fifo";
   const std::string name = "SCHED_FIFO (tried)";
-  if (!machine.options().try_privileges) return Unknown(id, name, "not tried");
+  if (!machine.options().try_privileges) return NotTried(id, name);
   int error = 0;
   // A throwaway thread, so the caller's own policy is never touched.
   std::thread trial([&] {
@@ -361,7 +352,7 @@ ProbeCheck CheckMlockall(const Machine& machine, const OsCalls& os) {
       return Make(id, name, "already locked (VmLck " + *locked + ")", CheckStatus::kOk);
     }
   }
-  if (!machine.options().try_privileges) return Unknown(id, name, "not tried");
+  if (!machine.options().try_privileges) return NotTried(id, name);
   // MCL_ONFAULT: the same permission check as a full lock, without faulting everything in.
   const int error = os.LockAllMemory(MCL_CURRENT | MCL_ONFAULT);
   if (error == 0) {
@@ -437,7 +428,7 @@ ProbeCheck CheckCapabilities(const std::optional<Capabilities>& caps) {
 ProbeCheck CheckCpuDmaLatency(const Machine& machine, const OsCalls& os) {
   const std::string id = "cpu_dma_latency";
   const std::string name = "/dev/cpu_dma_latency";
-  if (!machine.options().try_privileges) return Unknown(id, name, "not tried");
+  if (!machine.options().try_privileges) return NotTried(id, name);
   int fd = -1;
   const int error = os.OpenCpuDmaLatency(0, fd);
   if (error == 0) {
@@ -675,23 +666,6 @@ ProbeCheck CheckVirtualisation(const Machine& machine) {
   return Make(id, name, value, CheckStatus::kWarn, advice);
 }
 
-// Words of an advice text, with each `command in backticks` kept as one token so a wrapped
-// line never splits a command the user will copy.
-std::vector<std::string> AdviceTokens(std::string_view advice) {
-  std::vector<std::string> tokens;
-  bool in_command = false;
-  for (auto& word : Words(advice)) {
-    if (in_command) {
-      tokens.back() += ' ' + word;
-    } else {
-      tokens.push_back(word);
-    }
-    const auto ticks = std::count(word.begin(), word.end(), '`');
-    if (ticks % 2 == 1) in_command = !in_command;
-  }
-  return tokens;
-}
-
 std::string Percent(double value) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.2f %%", value);
@@ -810,64 +784,6 @@ ProbeReport RunRtProbe(const ProbeOptions& options, const OsCalls& os) {
   report.checks.push_back(
       AssessSteal(steal_start, steal_start, steal_end, static_cast<int>(window_ms)));
   return report;
-}
-
-nlohmann::json ToJson(const ProbeReport& report) {
-  nlohmann::json checks = nlohmann::json::array();
-  for (const auto& check : report.checks) {
-    checks.push_back({{"id", check.id},
-                      {"name", check.name},
-                      {"value", check.value},
-                      {"status", ToString(check.status)},
-                      {"advice", check.advice}});
-  }
-  return {{"checks", checks},
-          {"summary",
-           {{"ok", report.Count(CheckStatus::kOk)},
-            {"warn", report.Count(CheckStatus::kWarn)},
-            {"bad", report.Count(CheckStatus::kBad)}}}};
-}
-
-std::string FormatText(const ProbeReport& report) {
-  constexpr std::size_t kLineWidth = 100;
-  std::size_t name_width = 5;  // "CHECK"
-  for (const auto& check : report.checks) name_width = std::max(name_width, check.name.size());
-  const std::size_t status_width = 8;
-  const std::size_t value_column = name_width + 2 + status_width;
-  auto pad = [](std::string text, std::size_t width) {
-    if (text.size() < width) text.append(width - text.size(), ' ');
-    return text;
-  };
-
-  std::string out = pad("CHECK", name_width + 2) + pad("STATUS", status_width) + "VALUE\n";
-  for (const auto& check : report.checks) {
-    std::string status(ToString(check.status));
-    if (check.status != CheckStatus::kOk) {
-      std::transform(status.begin(), status.end(), status.begin(),
-                     [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-    }
-    out += pad(check.name, name_width + 2) + pad(status, status_width) + check.value + "\n";
-    if (check.advice.empty()) continue;
-    // Advice wrapped under the value column, so the columns stay readable.
-    const std::string indent(value_column, ' ');
-    std::string line = indent + "-> ";
-    bool line_has_word = false;
-    for (const auto& word : AdviceTokens(check.advice)) {
-      if (line_has_word && line.size() + 1 + word.size() > kLineWidth) {
-        out += line + "\n";
-        line = indent + "   ";
-        line_has_word = false;
-      }
-      if (line_has_word) line += ' ';
-      line += word;
-      line_has_word = true;
-    }
-    out += line + "\n";
-  }
-  out += "\n" + std::to_string(report.Count(CheckStatus::kOk)) + " ok, " +
-         std::to_string(report.Count(CheckStatus::kWarn)) + " warn, " +
-         std::to_string(report.Count(CheckStatus::kBad)) + " bad\n";
-  return out;
 }
 
 }  // namespace hiltwin::kernel_glue

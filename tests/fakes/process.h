@@ -1,24 +1,23 @@
 #pragma once
-// Starting and stopping helper processes for integration tests (posix_spawn, no shell).
-
-#include <sys/types.h>
+// Helper processes for integration tests, over kernel_glue's process helper: the test's file
+// conventions (a peer's output in FILE and FILE.err) and a result shaped for assertions.
 
 #include <string>
 #include <vector>
 
+#include "hiltwin/kernel_glue/process.h"
+
 namespace hiltwin::test {
 
-/// Starts `argv[0]` with `argv`; stdout/stderr go to `output_path` when not empty. Returns the pid.
-pid_t Spawn(const std::vector<std::string>& argv, const std::string& output_path = "");
-/// Sends `signal` and reaps the process; returns its wait status.
-int KillAndWait(pid_t pid, int signal);
-/// Waits up to `timeout_ms` for the process to exit; returns the exit code, or -1 on timeout
-/// (the process is then killed) or when it died from a signal.
-int WaitExit(pid_t pid, int timeout_ms);
+/// Starts `argv[0]` with `argv`; stdout goes to `output_path` and stderr to `output_path`.err
+/// when a path is given. The handle kills and reaps the process if the test ends first.
+kernel_glue::Process Spawn(const std::vector<std::string>& argv,
+                           const std::string& output_path = "");
 
 /// Runs a command to completion, capturing stdout and stderr separately.
 struct RunResult {
-  int exit_code = -1;
+  int exit_code = -1;  ///< -1 when it timed out (and was killed) or died from a signal
+  kernel_glue::ExitStatus status;
   std::string out;
   std::string err;
 };

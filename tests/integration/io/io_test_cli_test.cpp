@@ -86,9 +86,10 @@ std::string WireName(const char* tag) {
 class Peer {
  public:
   explicit Peer(const std::vector<std::string>& argv)
-      : out_("/tmp/hiltwin-io-cli-peer-" + std::to_string(::getpid())), pid_(test::Spawn(argv, out_)) {}
+      : out_("/tmp/hiltwin-io-cli-peer-" + std::to_string(::getpid())),
+        process_(test::Spawn(argv, out_)) {}
   ~Peer() {
-    test::KillAndWait(pid_, SIGTERM);
+    process_.Kill(SIGTERM);
     ::unlink(out_.c_str());
     ::unlink((out_ + ".err").c_str());
   }
@@ -97,7 +98,7 @@ class Peer {
 
  private:
   std::string out_;
-  pid_t pid_;
+  kernel_glue::Process process_;
 };
 
 /// The other side of a wire bring-up: `hiltwin io-test` in the background, long enough to outlast

@@ -34,7 +34,8 @@ std::string UniqueName(const char* tag) {
   return std::string("itest-") + tag + "-" + std::to_string(::getpid());
 }
 
-pid_t StartPeer(const char* side, const std::string& name, double rate_hz = kTwinRateHz) {
+kernel_glue::Process StartPeer(const char* side, const std::string& name,
+                               double rate_hz = kTwinRateHz) {
   return test::Spawn({HILTWIN_WIRE_PEER, side, name, std::to_string(rate_hz)});
 }
 
@@ -69,7 +70,8 @@ EncoderPeriod MotionStart(const WireBus& bus, std::uint64_t newest, std::int32_t
 TEST(WireBackend, ValuesCrossAndTheEcsSeesTheTwinDelay) {
   const std::string name = UniqueName("delay");
   WireBus::Unlink(name);
-  const pid_t peer = StartPeer("twin", name);  // the peer starts first and creates the segment
+  kernel_glue::Process peer =
+      StartPeer("twin", name);  // the peer starts first and creates the segment
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   WireBus bus(name, Image::kIcoboard);
   IcoBoard ecs(bus);
@@ -136,7 +138,7 @@ TEST(WireBackend, ValuesCrossAndTheEcsSeesTheTwinDelay) {
     // The pulses are spread over the twin period that follows the sample.
     EXPECT_GT(motion.EdgeTimeNs(motion.pulses) - motion.EdgeTimeNs(1), kTwinPeriodNs * 9 / 10);
   }
-  test::KillAndWait(peer, SIGTERM);
+  peer.Kill(SIGTERM);
 
   EXPECT_LE(below_bound, 1);
   // In wall-clock twin periods: the twin's own periods jitter with its wake-ups on a shared
@@ -169,12 +171,12 @@ TEST(WireBackend, AfterBothSidesCrashedANewProcessSeesNoPeer) {
   const std::string name = UniqueName("bothcrash");
   WireBus::Unlink(name);
   const std::string out = "/tmp/hiltwin-" + name;
-  const pid_t twin = test::Spawn({HILTWIN_WIRE_PEER, "twin", name, "50"}, out + "-twin");
-  const pid_t ecs = test::Spawn({HILTWIN_WIRE_PEER, "ecs", name, "500"}, out + "-ecs");
+  kernel_glue::Process twin = test::Spawn({HILTWIN_WIRE_PEER, "twin", name, "50"}, out + "-twin");
+  kernel_glue::Process ecs = test::Spawn({HILTWIN_WIRE_PEER, "ecs", name, "500"}, out + "-ecs");
   const bool ready = WaitReady(out + "-twin") && WaitReady(out + "-ecs");
   std::this_thread::sleep_for(std::chrono::milliseconds(100));  // a few heartbeats each way
-  test::KillAndWait(twin, SIGKILL);
-  test::KillAndWait(ecs, SIGKILL);
+  twin.Kill(SIGKILL);
+  ecs.Kill(SIGKILL);
   for (const char* side : {"-twin", "-ecs"}) {
     ::unlink((out + side).c_str());
     ::unlink((out + side + ".err").c_str());
@@ -198,12 +200,12 @@ TEST(WireBackend, AfterBothSidesCrashedANewProcessSeesNoPeer) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
   }
   // A new twin is then seen as usual.
-  const pid_t again = StartPeer("twin", name);
+  kernel_glue::Process again = StartPeer("twin", name);
   ExchangeStatus status;
   EXPECT_TRUE(Poll(driver, {0, 0, 0, 0}, in, status, 5'000'000'000,
                    [](const ExchangeStatus& s, const EcsInputs&, std::int64_t) { return PeerAlive(s); }))
       << status.reason;
-  test::KillAndWait(again, SIGTERM);
+  again.Kill(SIGTERM);
 }
 
 TEST(WireBackend, AKilledPeerIsDetectedByItsHeartbeat) {
@@ -218,7 +220,7 @@ TEST(WireBackend, AKilledPeerIsDetectedByItsHeartbeat) {
   EXPECT_TRUE(status.peer_absent);  // no twin yet: not a fault, values idle
   EXPECT_EQ(bus.PeerStatus().result, BusResult::kPeerAbsent);
 
-  const pid_t peer = StartPeer("twin", name);
+  kernel_glue::Process peer = StartPeer("twin", name);
   // Alive is not enough: a twin that has attached but not yet sent INIT has published step 0,
   // so its timeout is the 100 ms floor. Wait until it has published two data periods (it is past
   // INIT and beating with its 20 ms step) so the timeout below is the 400 ms one.
@@ -229,7 +231,7 @@ TEST(WireBackend, AKilledPeerIsDetectedByItsHeartbeat) {
                    }))
       << status.reason;
 
-  test::KillAndWait(peer, SIGKILL);  // a crash: no chance to detach
+  peer.Kill(SIGKILL);  // a crash: no chance to detach
   kernel_glue::MonotonicClock clock;
   const std::int64_t t_kill = clock.NowNs();
   std::int64_t t_detected = 0;
@@ -249,11 +251,11 @@ TEST(WireBackend, AKilledPeerIsDetectedByItsHeartbeat) {
   EXPECT_GT(ecs.counters().faults, 0U);
 
   // A restarted twin is picked up again without restarting the ECS.
-  const pid_t again = StartPeer("twin", name);
+  kernel_glue::Process again = StartPeer("twin", name);
   EXPECT_TRUE(Poll(ecs, {0, 0, 0, 0}, in, status, 5'000'000'000,
                    [](const ExchangeStatus& s, const EcsInputs&, std::int64_t) { return PeerAlive(s); }))
       << status.reason;
-  test::KillAndWait(again, SIGTERM);
+  again.Kill(SIGTERM);
   // A peer that stops cleanly detaches, and that is reported too.
   status = ecs.Exchange({0, 0, 0, 0}, in);
   EXPECT_EQ(status.code, ExchangeStatus::Code::kFault);
@@ -264,7 +266,7 @@ TEST(WireBackend, TheLastProcessToLeaveRemovesTheSegment) {
   const std::string name = UniqueName("cleanup");
   WireBus::Unlink(name);
   const std::string path = "/dev/shm" + WireBus::SegmentName(name);
-  const pid_t crashed = StartPeer("twin", name);
+  kernel_glue::Process crashed = StartPeer("twin", name);
   {
     WireBus bus(name, Image::kIcoboard);
     IcoBoard ecs(bus);
@@ -273,7 +275,7 @@ TEST(WireBackend, TheLastProcessToLeaveRemovesTheSegment) {
     ExchangeStatus status;
     ASSERT_TRUE(Poll(ecs, {0, 0, 0, 0}, in, status, 5'000'000'000,
                      [](const ExchangeStatus& s, const EcsInputs&, std::int64_t) { return PeerAlive(s); }));
-    test::KillAndWait(crashed, SIGKILL);
+    crashed.Kill(SIGKILL);
     EXPECT_EQ(::access(path.c_str(), F_OK), 0);
   }
   EXPECT_NE(::access(path.c_str(), F_OK), 0) << path << " was left behind";
@@ -282,7 +284,7 @@ TEST(WireBackend, TheLastProcessToLeaveRemovesTheSegment) {
 TEST(WireBackend, TheTwinSideSeesTheEcsPwmAndASecondTwinIsRefused) {
   const std::string name = UniqueName("twin");
   WireBus::Unlink(name);
-  const pid_t peer = StartPeer("ecs", name, 500.0);
+  kernel_glue::Process peer = StartPeer("ecs", name, 500.0);
   WireBus bus(name, Image::kIcoboardInverse);
   IcoBoardInverse twin(bus);
   ASSERT_TRUE(twin.Init(kTwinPeriodNs).ok);
@@ -297,7 +299,7 @@ TEST(WireBackend, TheTwinSideSeesTheEcsPwmAndASecondTwinIsRefused) {
   }
   EXPECT_EQ(in.pwm, (std::array<std::int32_t, kChannels>{100, 200, 300, 400})) << status.reason;
   EXPECT_THROW(WireBus(name, Image::kIcoboardInverse), std::runtime_error);
-  test::KillAndWait(peer, SIGTERM);
+  peer.Kill(SIGTERM);
 }
 
 TEST(WireBackend, ATwinStartingWhileTheEcsIsStaleInitialisesAndThenReportsTheEcs) {

@@ -9,7 +9,8 @@
 
 namespace hiltwin::analysis {
 
-/// gnuplot ran but did not produce the picture (bad path, no space, ...); carries its output.
+/// gnuplot could not start or did not produce the picture (bad path, no space, ...); carries
+/// its output. Messages name the PNG path and gnuplot; the caller adds its flag.
 class PlotError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

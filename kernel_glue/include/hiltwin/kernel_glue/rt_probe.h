@@ -2,11 +2,11 @@
 /// The real-time readiness probe behind `hiltwin doctor`: kernel preemption model, RT
 /// privileges, CPU governor, isolation, RT throttling, SMT, clocksource, virtualisation and
 /// steal time. Files are read below a root prefix so tests can feed a fake /sys and /proc;
-/// a missing or unreadable file gives "unknown" with a warning, never an exception.
+/// a missing or unreadable file gives "unknown" with a warning, never an exception. The probe
+/// returns data; how it is shown (table, JSON) is up to the command.
 
 #include <cstdint>
 #include <filesystem>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -22,13 +22,16 @@ enum class CheckStatus { kOk, kWarn, kBad };
 /// "ok", "warn", "bad".
 [[nodiscard]] std::string_view ToString(CheckStatus status) noexcept;
 
-/// One line of the doctor's output.
+/// One finding.
 struct ProbeCheck {
   std::string id;     ///< stable key for scripts, e.g. "preemption"
   std::string name;   ///< human label, e.g. "preemption model"
   std::string value;  ///< what was found
   CheckStatus status = CheckStatus::kWarn;
-  std::string advice;  ///< what to do (empty when nothing is needed)
+  std::string advice;  ///< what to do (empty when nothing is needed, or when not_tried)
+  /// A privilege try skipped because ProbeOptions::try_privileges was false: the value is
+  /// unknown, and the caller words how to try it.
+  bool not_tried = false;
 };
 
 /// Where and how to probe.
@@ -53,12 +56,6 @@ struct ProbeReport {
 /// fake can refuse them. Never throws for missing files.
 [[nodiscard]] ProbeReport RunRtProbe(const ProbeOptions& options = {},
                                      const OsCalls& os = RealOsCalls());
-
-/// {"checks": [{id, name, value, status, advice}...], "summary": {ok, warn, bad}}.
-[[nodiscard]] nlohmann::json ToJson(const ProbeReport& report);
-
-/// Aligned columns (check, status, value) with the advice wrapped below each line.
-[[nodiscard]] std::string FormatText(const ProbeReport& report);
 
 /// Cumulative CPU time from the aggregate "cpu" line of /proc/stat, in clock ticks.
 struct CpuTicks {
