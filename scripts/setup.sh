@@ -13,6 +13,7 @@ packages=(
   liblttng-ust-dev lttng-tools babeltrace2      # tracepoints and trace tests
   libgtest-dev libgmock-dev                     # tests
   rt-tests valgrind bc                          # cyclictest peer, callgrind counts, bench arithmetic
+  clang-tidy                                    # scripts/tidy.sh: the function-size rule
   gnuplot-nox                                   # `hiltwin assess --plot`
 )
 

@@ -14,4 +14,5 @@ run_suite() {
 }
 
 run_suite "$root/build"
+bash "$root/scripts/tidy.sh" "$root/build"
 run_suite "$root/build-asan" -DHILTWIN_SANITIZE=ON -DHILTWIN_BUILD_BENCH=OFF

@@ -64,7 +64,9 @@ std::string Num(double value) {
   return text;
 }
 
-[[noreturn]] void Usage(const std::string& message) { throw CommandError(ExitCode::kUsage, message); }
+[[noreturn]] void Usage(const std::string& message) {
+  throw CommandError(ExitCode::kUsage, message);
+}
 
 qos::QosConfig MakeQosConfig(const RunOptions& o, std::uint64_t planned_cycles) {
   qos::QosConfig config;
@@ -109,7 +111,8 @@ void Validate(const RunOptions& o) {
     Usage("--input-rate: the controller rate must be positive and not above --rate (" +
           Num(o.rate_hz) + " Hz)");
   }
-  if (!std::isfinite(o.deadline_us) || o.deadline_us < 0.0 || o.deadline_us * 1e3 > 1e9 / o.rate_hz) {
+  if (!std::isfinite(o.deadline_us) || o.deadline_us < 0.0 ||
+      o.deadline_us * 1e3 > 1e9 / o.rate_hz) {
     Usage("--deadline-us: must be between 0 (= the period) and the period (" +
           Num(1e6 / o.rate_hz) + " us)");
   }
@@ -168,14 +171,16 @@ std::unique_ptr<Twin> BuildTwin(const RunOptions& o, kernel_glue::TimeNs period_
   twin->pwm_source = std::make_unique<ProfilePwmSource>(*twin->profile, o.controller_rate_hz);
   // Only the mock board plays the profile; on a wire or real SPI the controller drives the PWM.
   const bool profile_drives = twin->backend->kind() == io::BackendSpec::Kind::kMock;
-  if (io::EmulatedFpga* board = twin->backend->emulated_board(); board != nullptr && profile_drives) {
+  if (io::EmulatedFpga* board = twin->backend->emulated_board();
+      board != nullptr && profile_drives) {
     board->SetPwmSource(twin->pwm_source.get());
   }
   twin->input_name = profile_drives ? twin->profile->name() : "the controller on " + o.io;
   twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
   const io::InitResult init = twin->driver->Init(period_ns);
   if (!init.ok) {
-    throw CommandError(ExitCode::kIo, init.message.empty() ? "Failed to initialise FPGA" : init.message);
+    throw CommandError(ExitCode::kIo,
+                       init.message.empty() ? "Failed to initialise FPGA" : init.message);
   }
   twin->geometry = WheelGeometryOf(twin->params);
   twin->task.emplace(*twin->driver, *twin->model, twin->geometry);
@@ -185,7 +190,8 @@ std::unique_ptr<Twin> BuildTwin(const RunOptions& o, kernel_glue::TimeNs period_
 runtime::OverrunInjector MakeInjector(const RunOptions& o, std::uint64_t planned) {
   runtime::OverrunInjector injector;
   try {
-    for (const std::string& spec : o.inject_overrun) injector.Add(runtime::ParseOverrunInjection(spec));
+    for (const std::string& spec : o.inject_overrun)
+      injector.Add(runtime::ParseOverrunInjection(spec));
     injector.CheckFiresWithin(planned);
   } catch (const std::exception& e) {  // invalid_argument, length_error: both the user's input
     Usage(std::string("--inject-overrun ") + e.what());
@@ -195,24 +201,30 @@ runtime::OverrunInjector MakeInjector(const RunOptions& o, std::uint64_t planned
 
 void PrintStartLines(const RunOptions& o, std::uint64_t planned, const std::string& input,
                      const kernel_glue::RtSetupRecord* rt) {
-  std::fprintf(stdout, "hiltwin run: RELbot twin at %.0f Hz for %.3f s (%llu cycles), io %s, input %s, %s clock\n",
-               o.rate_hz, o.duration_s, static_cast<unsigned long long>(planned), o.io.c_str(),
-               input.c_str(), o.clock.c_str());
-  if (rt != nullptr) std::fprintf(stdout, "real-time set-up: %s\n", kernel_glue::Summary(*rt).c_str());
+  std::fprintf(
+      stdout,
+      "hiltwin run: RELbot twin at %.0f Hz for %.3f s (%llu cycles), io %s, input %s, %s clock\n",
+      o.rate_hz, o.duration_s, static_cast<unsigned long long>(planned), o.io.c_str(),
+      input.c_str(), o.clock.c_str());
+  if (rt != nullptr)
+    std::fprintf(stdout, "real-time set-up: %s\n", kernel_glue::Summary(*rt).c_str());
   std::fflush(stdout);
 }
 
-runtime::SessionConfig MakeSessionConfig(const RunOptions& o, const Twin& twin, std::uint64_t planned,
-                                         kernel_glue::TimeNs period_ns) {
+runtime::SessionConfig MakeSessionConfig(const RunOptions& o, const Twin& twin,
+                                         std::uint64_t planned, kernel_glue::TimeNs period_ns) {
   runtime::SessionConfig config;
   config.task_name = "RELbot twin";
   config.io = o.io;
   config.peer_name = "controller";
-  config.details = {{"input", twin.input_name}, {"integrator", std::string(IntegratorName(twin.integrator))}};
-  config.clock = o.clock == "virtual" ? runtime::ClockKind::kVirtual : runtime::ClockKind::kRealtime;
+  config.details = {{"input", twin.input_name},
+                    {"integrator", std::string(IntegratorName(twin.integrator))}};
+  config.clock =
+      o.clock == "virtual" ? runtime::ClockKind::kVirtual : runtime::ClockKind::kRealtime;
   config.rate_hz = o.rate_hz;
   config.executive.period_ns = period_ns;
-  config.executive.deadline_ns = static_cast<kernel_glue::TimeNs>(std::llround(o.deadline_us * 1e3));
+  config.executive.deadline_ns =
+      static_cast<kernel_glue::TimeNs>(std::llround(o.deadline_us * 1e3));
   config.executive.max_cycles = planned;
   if (const auto policy = scheduler::ParseOverrunPolicy(o.overrun_policy)) {
     config.executive.overrun_policy = *policy;
@@ -243,13 +255,16 @@ std::ofstream OpenReport(const std::string& path) {
   return file;
 }
 
-void PrintOutcome(const RunOptions& o, const runtime::RunReport& report, std::ofstream& report_file) {
+void PrintOutcome(const RunOptions& o, const runtime::RunReport& report,
+                  std::ofstream& report_file) {
   if (report_file.is_open()) {
     report_file << runtime::ToJson(report).dump(2) << '\n';
     report_file.flush();
     if (!report_file) {
-      throw CommandError(ExitCode::kIo, "--report " + o.report_path +
-                                            ": cannot write the run report; check the folder exists and is writable");
+      throw CommandError(
+          ExitCode::kIo,
+          "--report " + o.report_path +
+              ": cannot write the run report; check the folder exists and is writable");
     }
   }
   std::fputs(runtime::FormatSummary(report).c_str(), stdout);
@@ -258,7 +273,9 @@ void PrintOutcome(const RunOptions& o, const runtime::RunReport& report, std::of
     std::fprintf(stderr, "hiltwin run: %s\n", line.c_str());
   }
   if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault) {
-    std::fprintf(stderr, "hiltwin run: try a higher --rate, --integrator rk4 or check the parameters in --config\n");
+    std::fprintf(
+        stderr,
+        "hiltwin run: try a higher --rate, --integrator rk4 or check the parameters in --config\n");
   }
 }
 
@@ -296,10 +313,13 @@ Command AddRunCommand(CLI::App& parent) {
       "The twin runs at --rate behind the FPGA link (--io) and is driven by --input played into\n"
       "the emulated board's PWM reader at --input-rate (mock) or by a controller (wire/spidev).\n"
       "Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault/internal.");
-  app->add_option("--rate", o->rate_hz, "twin update rate in Hz (1 .. 50000)")->capture_default_str();
+  app->add_option("--rate", o->rate_hz, "twin update rate in Hz (1 .. 50000)")
+      ->capture_default_str();
   app->add_option("--duration", o->duration_s, "run length in seconds")->capture_default_str();
-  app->add_option("--io", o->io, "FPGA link: mock | wire:NAME | spidev:/dev/spidevB.C")->capture_default_str();
-  app->add_option("--input", o->input, "input profile: a built-in name (openloop) or a CSV file time,left,right")
+  app->add_option("--io", o->io, "FPGA link: mock | wire:NAME | spidev:/dev/spidevB.C")
+      ->capture_default_str();
+  app->add_option("--input", o->input,
+                  "input profile: a built-in name (openloop) or a CSV file time,left,right")
       ->capture_default_str();
   app->add_option("--input-rate", o->controller_rate_hz,
                   "rate in Hz at which the input is played into the PWM reader (the ECS's rate; "
@@ -307,33 +327,44 @@ Command AddRunCommand(CLI::App& parent) {
   app->add_option("--qos", o->mk_rules,
                   "(m,k)-firm rule M:K: at least M deadlines met in any K cycles (repeatable; "
                   "replaces the default (k-1,k) rule)");
-  app->add_option("--max-misses", o->window_rules, "rule N:K: at most N misses in any K cycles (repeatable)");
-  app->add_option("--max-consecutive-misses", o->max_consecutive_misses, "rule: at most N consecutive misses");
-  app->add_option("--max-miss-pct", o->max_miss_pct, "rule: overall miss ratio below P percent (0: off)")
+  app->add_option("--max-misses", o->window_rules,
+                  "rule N:K: at most N misses in any K cycles (repeatable)");
+  app->add_option("--max-consecutive-misses", o->max_consecutive_misses,
+                  "rule: at most N consecutive misses");
+  app->add_option("--max-miss-pct", o->max_miss_pct,
+                  "rule: overall miss ratio below P percent (0: off)")
       ->capture_default_str();
-  app->add_option("--grace-cycles", o->grace_cycles, "ignore the first N cycles (start-up); fewer than the run's cycles")
+  app->add_option("--grace-cycles", o->grace_cycles,
+                  "ignore the first N cycles (start-up); fewer than the run's cycles")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app->add_option("--on-violation", o->on_violation, "flag: finish and mark unreliable (exit 3); abort: stop at once (exit 4)")
+  app->add_option("--on-violation", o->on_violation,
+                  "flag: finish and mark unreliable (exit 3); abort: stop at once (exit 4)")
       ->check(CLI::IsMember({"flag", "abort"}))
       ->capture_default_str();
-  app->add_option("--clock", o->clock, "realtime, or virtual: the identical loop as fast as possible")
+  app->add_option("--clock", o->clock,
+                  "realtime, or virtual: the identical loop as fast as possible")
       ->check(CLI::IsMember({"realtime", "virtual"}))
       ->capture_default_str();
   app->add_option("--overrun-policy", o->overrun_policy,
-                  "after an overrun: catch-up (run skipped steps back to back) or skip (count them as misses)")
+                  "after an overrun: catch-up (run skipped steps back to back) or skip (count them "
+                  "as misses)")
       ->check(CLI::IsMember({"catch-up", "skip"}))
       ->capture_default_str();
-  app->add_option("--deadline-us", o->deadline_us, "deadline in microseconds (0: the period)")->capture_default_str();
+  app->add_option("--deadline-us", o->deadline_us, "deadline in microseconds (0: the period)")
+      ->capture_default_str();
   app->add_option("--log", o->log_path, "write a CSV log (20-sim DataFromFile / MATLAB readable)");
-  app->add_option("--log-decimation", o->log_decimation, "log every Nth cycle")->capture_default_str();
+  app->add_option("--log-decimation", o->log_decimation, "log every Nth cycle")
+      ->capture_default_str();
   app->add_option("--report", o->report_path, "write the JSON run report to this file");
   app->add_option("--inject-overrun", o->inject_overrun,
                   "add compute time to chosen cycles, e.g. at=20000,count=5,extra-us=600 or "
                   "every=1000,extra-us=300 (repeatable)");
-  app->add_option("--config", o->config_path, "RELbot parameter file (TOML, see app_relbot/relbot.toml)");
+  app->add_option("--config", o->config_path,
+                  "RELbot parameter file (TOML, see app_relbot/relbot.toml)");
   app->add_option("--integrator", o->integrator, "euler | rk2 | rk4")->capture_default_str();
-  app->add_option("--priority", o->priority, "SCHED_FIFO priority of the loop (0: none)")->capture_default_str();
+  app->add_option("--priority", o->priority, "SCHED_FIFO priority of the loop (0: none)")
+      ->capture_default_str();
   app->add_option("--cpu", o->cpus, "pin the loop to these CPUs");
   app->add_flag("--no-progress", o->no_progress, "no progress line on the terminal");
   return {app, [o] { return RunTwin(*o); }};

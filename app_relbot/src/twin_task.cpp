@@ -53,16 +53,15 @@ std::vector<std::string> TwinTask::LogColumns() const {
 }
 
 void TwinTask::FillLogRow(std::span<double> values) const noexcept {
-  const std::array<double, 9> row = {
-      last_.duty.left,
-      last_.duty.right,
-      last_.outputs.wheel_left_m,
-      last_.outputs.wheel_right_m,
-      last_.outputs.x_m,
-      last_.outputs.y_m,
-      last_.outputs.theta_rad,
-      static_cast<double>(last_.encoder_counts[kLeftChannel]),
-      static_cast<double>(last_.encoder_counts[kRightChannel])};
+  const std::array<double, 9> row = {last_.duty.left,
+                                     last_.duty.right,
+                                     last_.outputs.wheel_left_m,
+                                     last_.outputs.wheel_right_m,
+                                     last_.outputs.x_m,
+                                     last_.outputs.y_m,
+                                     last_.outputs.theta_rad,
+                                     static_cast<double>(last_.encoder_counts[kLeftChannel]),
+                                     static_cast<double>(last_.encoder_counts[kRightChannel])};
   std::copy_n(row.begin(), std::min(row.size(), values.size()), values.begin());
 }
 

@@ -67,7 +67,8 @@ NamedThread::NamedThread(const ThreadSpec& spec, std::function<void()> body) {
   ThreadAttributes attr;
   sched_param param{};
   param.sched_priority = 0;
-  Check(pthread_attr_setinheritsched(attr.get(), PTHREAD_EXPLICIT_SCHED), "pthread_attr_setinheritsched");
+  Check(pthread_attr_setinheritsched(attr.get(), PTHREAD_EXPLICIT_SCHED),
+        "pthread_attr_setinheritsched");
   Check(pthread_attr_setschedpolicy(attr.get(), SCHED_OTHER), "pthread_attr_setschedpolicy");
   Check(pthread_attr_setschedparam(attr.get(), &param), "pthread_attr_setschedparam");
   Check(pthread_attr_setaffinity_np(attr.get(), sizeof cpus, &cpus), "pthread_attr_setaffinity_np");
@@ -126,7 +127,8 @@ int SetCallingThreadCpus(std::span<const int> cpus) noexcept {
 std::vector<int> HelperCpus(std::span<const int> allowed, std::span<const int> loop_cpus) {
   std::vector<int> helpers;
   for (const int cpu : allowed) {
-    if (std::find(loop_cpus.begin(), loop_cpus.end(), cpu) == loop_cpus.end()) helpers.push_back(cpu);
+    if (std::find(loop_cpus.begin(), loop_cpus.end(), cpu) == loop_cpus.end())
+      helpers.push_back(cpu);
   }
   if (helpers.empty()) helpers.assign(allowed.begin(), allowed.end());
   return helpers;

@@ -174,7 +174,7 @@ std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
   return ClampDistance(j);
 }
 
-bool QosMonitor::UpdateWindowRule(Engine& engine, RuleStatus& status, std::uint64_t t,
+[[gnu::always_inline]] inline bool QosMonitor::UpdateWindowRule(Engine& engine, RuleStatus& status, std::uint64_t t,
                                   bool missed) noexcept {
   // Cycle t - k leaves the window (before the first k judged cycles it is the met
   // pre-history); the ring still holds it because its capacity is >= k.
@@ -197,7 +197,7 @@ bool QosMonitor::UpdateWindowRule(Engine& engine, RuleStatus& status, std::uint6
   return engine.misses_in_window > engine.allowed_misses;
 }
 
-void QosMonitor::UpdateRatioRule(const Engine& engine, RuleStatus& status, std::size_t rule,
+[[gnu::always_inline]] inline void QosMonitor::UpdateRatioRule(const Engine& engine, RuleStatus& status, std::size_t rule,
                                  std::uint64_t cycle) noexcept {
   status.violated = RatioFails(misses_, judged_cycles_, engine.max_miss_pct);
   status.violations = status.violated ? 1 : 0;

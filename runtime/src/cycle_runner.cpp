@@ -62,7 +62,8 @@ scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sampl
                                             : scheduler::CycleAction::kStop;
 }
 
-[[gnu::always_inline]] inline void CycleRunner::RecordQos(const scheduler::TimingSample& sample) noexcept {
+[[gnu::always_inline]] inline void CycleRunner::RecordQos(
+    const scheduler::TimingSample& sample) noexcept {
   // Skipped releases are misses too, but once the monitor says abort the run has ended:
   // releases after that one are not judged.
   qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
@@ -82,10 +83,12 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
   row_[n + 2] = static_cast<double>(sample.end_ns - sample.start_ns - sample.io_ns) * 1e-3;
   row_[n + 3] = static_cast<double>(sample.io_ns) * 1e-3;
   row_[n + 4] = sample.missed ? 1.0 : 0.0;
-  logger_->TryLog(task_.LogTimeS(), std::span<const double>(row_.data(), n + kTimingLogColumns.size()));
+  logger_->TryLog(task_.LogTimeS(),
+                  std::span<const double>(row_.data(), n + kTimingLogColumns.size()));
 }
 
-[[gnu::always_inline]] inline bool CycleRunner::PostEvents(const scheduler::TimingSample& sample) noexcept {
+[[gnu::always_inline]] inline bool CycleRunner::PostEvents(
+    const scheduler::TimingSample& sample) noexcept {
   const std::uint64_t next_release = sample.cycle + 1 + sample.releases_skipped;
   const bool plan_done = planned_releases_ != 0 && next_release >= planned_releases_;
   // The common cycle: nothing happened and nothing was asked. A relaxed load first; the
@@ -95,13 +98,16 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
                      !kernel_glue::StopRequested();
   if (quiet) return false;
   const std::uint8_t commands = commands_.exchange(0, std::memory_order_acq_rel);
-  const auto asked = [commands](CommandBit bit) { return (commands & static_cast<std::uint8_t>(bit)) != 0; };
+  const auto asked = [commands](CommandBit bit) {
+    return (commands & static_cast<std::uint8_t>(bit)) != 0;
+  };
   // Faults first: when several causes meet in one cycle the report names the one that makes
   // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
   if (io_fault_) lifecycle_.Handle(Event::kIoFault);
   if (step_status_.code == StepStatus::Code::kModelFault) lifecycle_.Handle(Event::kModelFault);
   if (qos_abort_) lifecycle_.Handle(Event::kQosAbort);
-  if (kernel_glue::StopRequested() || asked(CommandBit::kStop)) lifecycle_.Handle(Event::kStopRequest);
+  if (kernel_glue::StopRequested() || asked(CommandBit::kStop))
+    lifecycle_.Handle(Event::kStopRequest);
   if (plan_done || step_status_.code == StepStatus::Code::kFinished) {
     lifecycle_.Handle(Event::kFinishReached);
   }

@@ -39,17 +39,16 @@ struct LoopCounts {
 };
 
 /// Timing columns the session appends to every task's log row.
-inline constexpr std::array<const char*, 5> kTimingLogColumns = {
-    "cycle", "latency_us", "compute_us", "io_us", "missed"};
+inline constexpr std::array<const char*, 5> kTimingLogColumns = {"cycle", "latency_us",
+                                                                 "compute_us", "io_us", "missed"};
 
 class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleObserver {
  public:
   /// None of the references is owned. `logger` may be null (no log). `planned_releases` 0:
   /// until stopped.
   CycleRunner(RunTask& task, kernel_glue::Clock& clock, statemachine::Lifecycle& lifecycle,
-              qos::QosMonitor& monitor, const OverrunInjector& injector,
-              tracing::CsvLogger* logger, std::uint64_t planned_releases,
-              std::size_t task_log_columns) noexcept;
+              qos::QosMonitor& monitor, const OverrunInjector& injector, tracing::CsvLogger* logger,
+              std::uint64_t planned_releases, std::size_t task_log_columns) noexcept;
 
   scheduler::CycleAction Step(const scheduler::CycleContext& context) noexcept override;
   [[nodiscard]] kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }

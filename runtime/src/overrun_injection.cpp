@@ -11,15 +11,15 @@ constexpr const char* kForms =
     "e.g. 'at=40000,count=5,extra-us=600' or 'every=1000,extra-us=300'";
 
 [[noreturn]] void Fail(std::string_view spec, const std::string& what) {
-  throw std::invalid_argument("'" + std::string(spec) + "': " + what + "; " +
-                              kForms);
+  throw std::invalid_argument("'" + std::string(spec) + "': " + what + "; " + kForms);
 }
 
 std::uint64_t ParseCount(std::string_view spec, std::string_view key, std::string_view text) {
   std::uint64_t value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
-    Fail(spec, "'" + std::string(key) + "' needs a whole number ≥ 0, got '" + std::string(text) + "'");
+    Fail(spec,
+         "'" + std::string(key) + "' needs a whole number ≥ 0, got '" + std::string(text) + "'");
   }
   return value;
 }
@@ -96,10 +96,10 @@ void OverrunInjector::CheckFiresWithin(std::uint64_t planned_cycles) const {
     const std::uint64_t first =
         inj.kind == OverrunInjection::Kind::kAt ? inj.first_cycle : inj.offset;
     if (first < planned_cycles) continue;
-    throw std::invalid_argument(
-        "'" + Describe(inj) + "' first fires at cycle " + std::to_string(first) +
-        ", but the run's cycles are 0 to " + std::to_string(planned_cycles - 1) +
-        "; choose a cycle inside the run or lengthen it");
+    throw std::invalid_argument("'" + Describe(inj) + "' first fires at cycle " +
+                                std::to_string(first) + ", but the run's cycles are 0 to " +
+                                std::to_string(planned_cycles - 1) +
+                                "; choose a cycle inside the run or lengthen it");
   }
 }
 

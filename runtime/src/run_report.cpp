@@ -10,8 +10,8 @@ using Json = nlohmann::ordered_json;
 using statemachine::StopReason;
 
 Json Timing(const scheduler::TimingSummary& s) {
-  return {{"min", s.min_ns}, {"mean", s.mean_ns}, {"p50", s.p50_ns}, {"p99", s.p99_ns},
-          {"p999", s.p999_ns}, {"max", s.max_ns}, {"count", s.count}};
+  return {{"min", s.min_ns},   {"mean", s.mean_ns}, {"p50", s.p50_ns}, {"p99", s.p99_ns},
+          {"p999", s.p999_ns}, {"max", s.max_ns},   {"count", s.count}};
 }
 
 template <typename T>
@@ -22,10 +22,18 @@ Json OrNull(const std::optional<T>& value) {
 Json Constraint(const qos::RuleStatus& status) {
   Json parameters;
   switch (status.spec.kind) {
-    case qos::RuleKind::kMkFirm: parameters = {{"m", status.spec.m}, {"k", status.spec.k}}; break;
-    case qos::RuleKind::kMissesInWindow: parameters = {{"n", status.spec.n}, {"k", status.spec.k}}; break;
-    case qos::RuleKind::kConsecutiveMisses: parameters = {{"n", status.spec.n}}; break;
-    case qos::RuleKind::kMissRatio: parameters = {{"max_miss_pct", status.spec.max_miss_pct}}; break;
+    case qos::RuleKind::kMkFirm:
+      parameters = {{"m", status.spec.m}, {"k", status.spec.k}};
+      break;
+    case qos::RuleKind::kMissesInWindow:
+      parameters = {{"n", status.spec.n}, {"k", status.spec.k}};
+      break;
+    case qos::RuleKind::kConsecutiveMisses:
+      parameters = {{"n", status.spec.n}};
+      break;
+    case qos::RuleKind::kMissRatio:
+      parameters = {{"max_miss_pct", status.spec.max_miss_pct}};
+      break;
   }
   Json c = {{"kind", qos::ToString(status.spec.kind)},
             {"description", qos::Describe(status.spec)},
@@ -34,7 +42,8 @@ Json Constraint(const qos::RuleStatus& status) {
             {"violations", status.violations},
             {"first_violation_cycle", OrNull(status.first_violation_cycle)}};
   if (status.spec.kind == qos::RuleKind::kMkFirm) c["min_met_in_window"] = status.min_met_in_window;
-  if (status.spec.kind == qos::RuleKind::kMkFirm || status.spec.kind == qos::RuleKind::kMissesInWindow) {
+  if (status.spec.kind == qos::RuleKind::kMkFirm ||
+      status.spec.kind == qos::RuleKind::kMissesInWindow) {
     c["max_misses_in_window"] = status.max_misses_in_window;
   }
   return c;
@@ -130,7 +139,8 @@ using ull = unsigned long long;
 
 void AppendMisses(std::string& out, const RunReport& r) {
   const MissLedger& m = r.misses;
-  Append(out, "misses     %llu of %llu releases (%.3f %%), longest run %llu, skipped releases %llu\n",
+  Append(out,
+         "misses     %llu of %llu releases (%.3f %%), longest run %llu, skipped releases %llu\n",
          static_cast<ull>(m.deadline_misses), static_cast<ull>(m.releases), m.miss_pct,
          static_cast<ull>(m.max_consecutive_misses), static_cast<ull>(r.releases_skipped));
   if (m.grace_cycles > 0) {
@@ -160,7 +170,8 @@ void AppendRules(std::string& out, const RunReport& r) {
 
 std::string VerdictLine(const RunReport& r) {
   std::string line = std::string("verdict    ") + qos::ToString(r.verdict);
-  if (r.verdict == qos::Verdict::kFlagged) line += " (deadline constraints violated: results unreliable)";
+  if (r.verdict == qos::Verdict::kFlagged)
+    line += " (deadline constraints violated: results unreliable)";
   if (r.verdict == qos::Verdict::kAborted) {
     line += r.outputs_safe
                 ? " (stopped at the first violation; outputs put in their safe state)"
@@ -176,7 +187,8 @@ std::string FormatSummary(const RunReport& r) {
   Append(out, "cycles     %llu of %llu at %.0f Hz (%s clock), stop: %s\n",
          static_cast<ull>(r.cycles_run), static_cast<ull>(r.cycles_planned), r.rate_hz,
          ToString(r.clock), statemachine::ToString(r.stop_reason));
-  if (r.cycles_paused > 0) Append(out, "paused     %llu cycles\n", static_cast<ull>(r.cycles_paused));
+  if (r.cycles_paused > 0)
+    Append(out, "paused     %llu cycles\n", static_cast<ull>(r.cycles_paused));
   AppendMisses(out, r);
   AppendTiming(out, "latency", r.latency);
   AppendTiming(out, "compute", r.compute);
@@ -212,8 +224,9 @@ std::vector<std::string> Problems(const RunReport& r) {
   if (r.link.peer_absent_cycles > 0) {
     lines.push_back("warning: no " + r.link.peer_name + " was attached to " + r.io + " in " +
                     std::to_string(r.link.peer_absent_cycles) + " of " +
-                    std::to_string(r.cycles_run) + " cycles; the inputs were idle then. Start the " +
-                    r.link.peer_name + " process on the same wire before or during the run.");
+                    std::to_string(r.cycles_run) +
+                    " cycles; the inputs were idle then. Start the " + r.link.peer_name +
+                    " process on the same wire before or during the run.");
   }
   if (r.log && !r.log->error.empty()) {
     lines.push_back("the log " + r.log->path + " is incomplete: " + r.log->error);
@@ -222,17 +235,21 @@ std::vector<std::string> Problems(const RunReport& r) {
 }
 
 ExitCode ExitCodeFor(const RunReport& r) noexcept {
-  const bool io_fault = r.stop_reason == StopReason::kIoFault ||
-                        r.fault_while_stopping == StopReason::kIoFault;
+  const bool io_fault =
+      r.stop_reason == StopReason::kIoFault || r.fault_while_stopping == StopReason::kIoFault;
   if (io_fault) return ExitCode::kIo;
-  if (r.stop_reason == StopReason::kModelFault || r.fault_while_stopping == StopReason::kModelFault) {
+  if (r.stop_reason == StopReason::kModelFault ||
+      r.fault_while_stopping == StopReason::kModelFault) {
     return ExitCode::kInternal;
   }
   if (r.log && !r.log->error.empty()) return ExitCode::kIo;
   switch (r.verdict) {
-    case qos::Verdict::kPass: return ExitCode::kPass;
-    case qos::Verdict::kFlagged: return ExitCode::kFlagged;
-    case qos::Verdict::kAborted: return ExitCode::kAborted;
+    case qos::Verdict::kPass:
+      return ExitCode::kPass;
+    case qos::Verdict::kFlagged:
+      return ExitCode::kFlagged;
+    case qos::Verdict::kAborted:
+      return ExitCode::kAborted;
   }
   return ExitCode::kInternal;
 }

@@ -44,7 +44,8 @@ void CheckConfig(const SessionConfig& config) {
   }
   if (config.qos.planned_cycles != planned) {
     throw std::invalid_argument("the QoS plan (" + std::to_string(config.qos.planned_cycles) +
-                                " releases) differs from the run's (" + std::to_string(planned) + ")");
+                                " releases) differs from the run's (" + std::to_string(planned) +
+                                ")");
   }
   config.injector.CheckFiresWithin(planned);
   if (config.rt.fifo_priority < 0 || config.rt.fifo_priority > 99) {
@@ -94,9 +95,15 @@ RunSession::~RunSession() = default;
 
 void RunSession::Post(SessionCommand command) noexcept {
   switch (command) {
-    case SessionCommand::kStop: runner_->Post(CommandBit::kStop); break;
-    case SessionCommand::kPause: runner_->Post(CommandBit::kPause); break;
-    case SessionCommand::kResume: runner_->Post(CommandBit::kResume); break;
+    case SessionCommand::kStop:
+      runner_->Post(CommandBit::kStop);
+      break;
+    case SessionCommand::kPause:
+      runner_->Post(CommandBit::kPause);
+      break;
+    case SessionCommand::kResume:
+      runner_->Post(CommandBit::kResume);
+      break;
   }
 }
 
@@ -132,11 +139,13 @@ RunReport RunSession::Run() {
   ran_ = true;
   kernel_glue::InstallStopSignalHandlers();
   LoopResult result;
-  kernel_glue::NamedThread loop({"hiltwin-loop", allowed_cpus_}, [this, &result] { LoopThreadMain(result); });
+  kernel_glue::NamedThread loop({"hiltwin-loop", allowed_cpus_},
+                                [this, &result] { LoopThreadMain(result); });
   std::unique_lock lock(result.mutex);
   result.changed.wait(lock, [&] { return result.ready; });
   try {
-    if (!result.setup_error.empty()) throw std::runtime_error("real-time set-up: " + result.setup_error);
+    if (!result.setup_error.empty())
+      throw std::runtime_error("real-time set-up: " + result.setup_error);
     if (logger_) logger_->Start();  // after the RT set-up: see LoopThreadMain
     if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
   } catch (...) {
@@ -157,7 +166,8 @@ RunReport RunSession::Run() {
   lifecycle_.Handle(statemachine::Event::kStart);
   result.go = true;
   result.changed.notify_all();
-  while (!result.changed.wait_for(lock, std::chrono::milliseconds(250), [&] { return result.done; })) {
+  while (
+      !result.changed.wait_for(lock, std::chrono::milliseconds(250), [&] { return result.done; })) {
     if (config_.progress) PrintProgress();
   }
   lock.unlock();
@@ -175,8 +185,9 @@ RunReport RunSession::Run() {
 
 void RunSession::PrintProgress() const {
   const qos::LiveQos q = monitor_.Live();
-  const std::string distance =
-      q.distance_to_failure == qos::kNeverFails ? std::string("-") : std::to_string(q.distance_to_failure);
+  const std::string distance = q.distance_to_failure == qos::kNeverFails
+                                   ? std::string("-")
+                                   : std::to_string(q.distance_to_failure);
   std::fprintf(stderr,
                "\r  %llu/%llu cycles  %s  misses %llu  worst latency %.1f us  verdict so far %s  "
                "misses to failure %s   ",
@@ -241,11 +252,14 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
   r.response = stats.response.Summary();
   r.period_jitter = stats.period_jitter.Summary();
   const LoopCounts& counts = runner_->counts();
-  r.link = {counts.io_errors, counts.peer_absent_cycles, counts.pulse_limit_cycles, config_.peer_name};
-  if (const auto& fault = runner_->fault()) r.fault = RunFault{fault->kind, fault->cycle, fault->reason};
+  r.link = {counts.io_errors, counts.peer_absent_cycles, counts.pulse_limit_cycles,
+            config_.peer_name};
+  if (const auto& fault = runner_->fault())
+    r.fault = RunFault{fault->kind, fault->cycle, fault->reason};
   r.outputs_safe = result.outputs_safe;
   if (logger_) {
-    r.log = LogFigures{logger_->path(), logger_->rows_written(), logger_->rows_dropped(), logger_->error()};
+    r.log = LogFigures{logger_->path(), logger_->rows_written(), logger_->rows_dropped(),
+                       logger_->error()};
   }
   r.wall_time_s = wall_time_s;
   if (result.rt) r.rt_setup = result.rt->record();

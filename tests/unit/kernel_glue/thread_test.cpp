@@ -84,7 +84,8 @@ TEST(HelperCpus, AreTheAllowedOnesWithoutTheLoopsAndNeverNone) {
   const std::vector<int> allowed = {0, 1, 2, 3};
   EXPECT_EQ(HelperCpus(allowed, std::vector<int>{3}), (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(HelperCpus(allowed, std::vector<int>{}), allowed);
-  EXPECT_EQ(HelperCpus(allowed, std::vector<int>{0, 1, 2, 3}), allowed);  // a helper must run somewhere
+  EXPECT_EQ(HelperCpus(allowed, std::vector<int>{0, 1, 2, 3}),
+            allowed);  // a helper must run somewhere
 }
 
 }  // namespace

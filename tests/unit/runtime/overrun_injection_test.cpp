@@ -32,11 +32,11 @@ TEST(OverrunInjection, OffsetAndDefaults) {
 }
 
 TEST(OverrunInjection, RejectsMalformedSpecsWithTheAcceptedForms) {
-  for (const char* bad : {"", "at=1", "extra-us=5", "at=1,every=2,extra-us=5", "at=x,extra-us=5",
-                          "at=1,extra-us=0", "at=1,extra-us=-3", "every=0,extra-us=5",
-                          "every=4,offset=4,extra-us=5", "at=1,offset=1,extra-us=5",
-                          "every=4,count=2,extra-us=5", "at=1,count=0,extra-us=5", "at=1,foo=2,extra-us=5",
-                          "at"}) {
+  for (const char* bad :
+       {"", "at=1", "extra-us=5", "at=1,every=2,extra-us=5", "at=x,extra-us=5", "at=1,extra-us=0",
+        "at=1,extra-us=-3", "every=0,extra-us=5", "every=4,offset=4,extra-us=5",
+        "at=1,offset=1,extra-us=5", "every=4,count=2,extra-us=5", "at=1,count=0,extra-us=5",
+        "at=1,foo=2,extra-us=5", "at"}) {
     try {
       (void)ParseOverrunInjection(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";

@@ -68,7 +68,8 @@ TEST(FormatSummary, MissFiguresAreTheLedgersAndSayWhatWasJudged) {
   r.misses.grace_misses = 71;
   r.misses.cycles_judged = 39'800;
   const std::string summary = FormatSummary(r);
-  EXPECT_NE(summary.find("misses     71 of 40000 releases (0.177 %)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("misses     71 of 40000 releases (0.177 %)"), std::string::npos)
+      << summary;
   EXPECT_NE(summary.find("judged     0 misses of 39800 releases"), std::string::npos) << summary;
   const auto json = ToJson(r);
   EXPECT_EQ(json["deadline_misses"], 71);
@@ -80,15 +81,17 @@ TEST(FormatSummary, MissFiguresAreTheLedgersAndSayWhatWasJudged) {
 TEST(ToJson, KeepsTheContractKeysFirstAndInOrder) {
   const auto json = ToJson(Finished(qos::Verdict::kPass));
   const std::vector<std::string> contract = {
-      "verdict",     "stop_reason", "rate_hz",        "period_ns",      "cycles_planned",
-      "cycles_run",  "deadline_misses", "miss_pct",   "max_consecutive_misses", "constraints",
-      "latency_ns",  "compute_ns",  "response_ns",    "log_rows_written", "log_rows_dropped"};
+      "verdict",         "stop_reason",      "rate_hz",
+      "period_ns",       "cycles_planned",   "cycles_run",
+      "deadline_misses", "miss_pct",         "max_consecutive_misses",
+      "constraints",     "latency_ns",       "compute_ns",
+      "response_ns",     "log_rows_written", "log_rows_dropped"};
   std::vector<std::string> first;
   for (auto it = json.begin(); it != json.end() && first.size() < contract.size(); ++it) {
     first.push_back(it.key());
   }
   EXPECT_EQ(first, contract);
-  EXPECT_TRUE(json.contains("io_ns"));  // I/O time beside compute time
+  EXPECT_TRUE(json.contains("io_ns"));      // I/O time beside compute time
   EXPECT_TRUE(json["rt_setup"].is_null());  // virtual clock: no RT set-up was made
 }
 
@@ -103,7 +106,8 @@ TEST(Problems, NameTheFaultTheAbsentPeerAndTheIncompleteLog) {
   const auto lines = Problems(r);
   ASSERT_EQ(lines.size(), 3U);
   EXPECT_EQ(lines[0], "I/O fault at cycle 12: wire peer lost");
-  EXPECT_NE(lines[1].find("no controller was attached to wire:lab in 400 of 40000 cycles"), std::string::npos);
+  EXPECT_NE(lines[1].find("no controller was attached to wire:lab in 400 of 40000 cycles"),
+            std::string::npos);
   EXPECT_EQ(lines[2], "the log run.csv is incomplete: disk full");
 }
 

@@ -32,7 +32,8 @@ class ScriptedTask final : public RunTask {
     if (session != nullptr && n == pause_at) session->Post(SessionCommand::kPause);
     if (session != nullptr && n == resume_at) session->Post(SessionCommand::kResume);
     if (session != nullptr && n == stop_at) session->Post(SessionCommand::kStop);
-    if (n >= io_fault_from) return {.code = io::ExchangeStatus::Code::kFault, .reason = "the link went down"};
+    if (n >= io_fault_from)
+      return {.code = io::ExchangeStatus::Code::kFault, .reason = "the link went down"};
     return {};
   }
   StepStatus Step(const scheduler::CycleContext& context) noexcept override {
@@ -97,7 +98,7 @@ TEST(RunSession, PauseKeepsTheLinkWithSafeOutputsFreezesTheModelAndIsNotJudged) 
   EXPECT_EQ(r.cycles_paused, 200U);
   EXPECT_EQ(task.steps, 800U);
   EXPECT_EQ(task.live_exchanges, 800U);
-  EXPECT_EQ(task.safe_exchanges, 201U);  // 200 paused cycles + the final safe outputs
+  EXPECT_EQ(task.safe_exchanges, 201U);     // 200 paused cycles + the final safe outputs
   EXPECT_EQ(r.misses.cycles_judged, 800U);  // paused cycles are not judged
   EXPECT_EQ(r.stop_reason, StopReason::kFinished);
   EXPECT_EQ(r.final_state, State::kStopped);
@@ -181,7 +182,8 @@ TEST(RunSession, RefusesAConfigurationThatCouldNotJudgeOrInjectAnything) {
 
 TEST(RunSession, TheLogHasTheTaskColumnsThenTheTimingColumns) {
   const std::string path = (std::filesystem::temp_directory_path() /
-                            ("hiltwin_session_log_" + std::to_string(getpid()) + ".csv")).string();
+                            ("hiltwin_session_log_" + std::to_string(getpid()) + ".csv"))
+                               .string();
   ScriptedTask task;
   SessionConfig config = VirtualConfig(20);
   config.log = LogConfig{path, 1};
@@ -239,13 +241,14 @@ TEST(RunSessionThreads, OnlyTheLoopRunsAtItsPriorityAndOnItsCpu) {
     if (CPU_ISSET(static_cast<std::size_t>(cpu), &allowed)) loop_cpu = cpu;  // the last one
   }
   const std::string path = (std::filesystem::temp_directory_path() /
-                            ("hiltwin_session_threads_" + std::to_string(getpid()) + ".csv")).string();
+                            ("hiltwin_session_threads_" + std::to_string(getpid()) + ".csv"))
+                               .string();
   ScriptedTask task;
   SessionConfig config = VirtualConfig(200);
   config.clock = ClockKind::kRealtime;
   config.rt.fifo_priority = 10;
   config.rt.cpus = {loop_cpu};
-  config.rt.lock_memory = false;  // not under test; keeps the test light on small limits
+  config.rt.lock_memory = false;    // not under test; keeps the test light on small limits
   config.log = LogConfig{path, 1};  // so that the writer thread exists
   RunSession session(std::move(config), task);
   ThreadCensus census;
@@ -274,7 +277,8 @@ TEST(RunSessionThreads, OnlyTheLoopRunsAtItsPriorityAndOnItsCpu) {
     // not ours to place (docs/architecture.md). Every thread hiltwin starts must be off the
     // loop's CPU.
     if (t.name.ends_with("-ust")) continue;
-    EXPECT_EQ(std::count(t.cpus.begin(), t.cpus.end(), loop_cpu), 0) << "a helper on the loop's CPU";
+    EXPECT_EQ(std::count(t.cpus.begin(), t.cpus.end(), loop_cpu), 0)
+        << "a helper on the loop's CPU";
   }
   EXPECT_TRUE(saw_loop);
   EXPECT_TRUE(saw_writer);

@@ -46,7 +46,8 @@ class ProfilePwmSource final : public io::PwmSignalSource {
 class TwinTask final : public runtime::RunTask {
  public:
   /// Neither reference is owned; both must outlive the task.
-  TwinTask(io::IcoBoardInverse& board, RelbotModel& model, const io::WheelGeometry& geometry) noexcept;
+  TwinTask(io::IcoBoardInverse& board, RelbotModel& model,
+           const io::WheelGeometry& geometry) noexcept;
 
   /// Live: sends the positions of the last step. Safe: repeats the positions last sent, so
   /// the encoder emulator emits no further pulses (a robot at rest, not a jump to zero).

@@ -10,7 +10,7 @@ enum class ExitCode : int {
   kUsage = 2,     ///< bad flag, configuration or input file
   kFlagged = 3,   ///< run completed but QoS FLAGGED (results unreliable)
   kAborted = 4,   ///< run ABORTED by the QoS policy
-  kIo = 5,        ///< hardware / I/O error (e.g. the wrong FPGA image, a log that could not be written)
+  kIo = 5,  ///< hardware / I/O error (e.g. the wrong FPGA image, a log that could not be written)
 };
 
 }  // namespace hiltwin::runtime

@@ -44,8 +44,9 @@ struct MissLedger {
 struct LinkFigures {
   std::uint64_t io_errors = 0;           ///< corrupted or missed frames (inputs held)
   std::uint64_t peer_absent_cycles = 0;  ///< wire: cycles with no peer process attached
-  std::uint64_t pulse_limit_cycles = 0;  ///< cycles with an encoder change above one period's pulses
-  std::string peer_name = "peer";        ///< who sits on the other side ("controller", "twin")
+  std::uint64_t pulse_limit_cycles =
+      0;                           ///< cycles with an encoder change above one period's pulses
+  std::string peer_name = "peer";  ///< who sits on the other side ("controller", "twin")
 };
 
 /// The fault that stopped the run (I/O or model).
