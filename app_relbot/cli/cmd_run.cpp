@@ -237,6 +237,7 @@ runtime::SessionConfig MakeSessionConfig(const RunOptions& o, const Twin& twin,
   config.injector = MakeInjector(o, planned);
   if (!o.log_path.empty()) config.log = runtime::LogConfig{o.log_path, o.log_decimation};
   config.progress = !o.no_progress && isatty(STDERR_FILENO) == 1;
+  config.pause_signals = true;  // kill -USR1 pauses, -USR2 resumes (documented in --help)
   config.on_ready = [o, planned, input = twin.input_name](const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, input, rt);
   };
@@ -312,7 +313,9 @@ Command AddRunCommand(CLI::App& parent) {
       "Run the RELbot twin with a QoS verdict.\n"
       "The twin runs at --rate behind the FPGA link (--io) and is driven by --input played into\n"
       "the emulated board's PWM reader at --input-rate (mock) or by a controller (wire/spidev).\n"
-      "Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault/internal.");
+      "Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault/internal.\n"
+      "While it runs: SIGINT/SIGTERM stop it cleanly (report and log written), SIGUSR1 pauses\n"
+      "(link kept, safe outputs, model frozen, not judged) and SIGUSR2 resumes.");
   app->add_option("--rate", o->rate_hz, "twin update rate in Hz (1 .. 50000)")
       ->capture_default_str();
   app->add_option("--duration", o->duration_s, "run length in seconds")->capture_default_str();

@@ -14,6 +14,14 @@ std::atomic<int> g_stop_signal{0};
 static_assert(std::atomic<int>::is_always_lock_free);
 std::atomic<bool> g_handlers_installed{false};
 
+// The latest PauseRequest, as an int (lock-free, so the handler may write it).
+std::atomic<int> g_pause_request{0};
+
+extern "C" void OnPauseSignal(int signal_number) {
+  g_pause_request.store(static_cast<int>(signal_number == SIGUSR1 ? PauseRequest::kPause
+                                                                  : PauseRequest::kResume));
+}
+
 extern "C" void OnStopSignal(int signal_number) {
   int expected = 0;
   // Keep the first cause when two different signals arrive.
@@ -33,6 +41,22 @@ void Install(int signal_number) {
 }
 
 }  // namespace
+
+void InstallPauseSignalHandlers() {
+  for (const int signal_number : {SIGUSR1, SIGUSR2}) {
+    struct sigaction action {};
+    action.sa_handler = &OnPauseSignal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART;  // repeatable: pause and resume as often as wanted
+    if (sigaction(signal_number, &action, nullptr) != 0) {
+      throw std::system_error(errno, std::generic_category(), "sigaction for pause signals");
+    }
+  }
+}
+
+PauseRequest TakePauseRequest() noexcept {
+  return static_cast<PauseRequest>(g_pause_request.exchange(0));
+}
 
 void InstallStopSignalHandlers() {
   Install(SIGINT);

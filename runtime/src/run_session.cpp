@@ -138,6 +138,7 @@ RunReport RunSession::Run() {
   if (ran_) throw std::logic_error("RunSession::Run called twice");
   ran_ = true;
   kernel_glue::InstallStopSignalHandlers();
+  if (config_.pause_signals) kernel_glue::InstallPauseSignalHandlers();
   LoopResult result;
   kernel_glue::NamedThread loop({"hiltwin-loop", allowed_cpus_},
                                 [this, &result] { LoopThreadMain(result); });
@@ -166,9 +167,13 @@ RunReport RunSession::Run() {
   lifecycle_.Handle(statemachine::Event::kStart);
   result.go = true;
   result.changed.notify_all();
-  while (
-      !result.changed.wait_for(lock, std::chrono::milliseconds(250), [&] { return result.done; })) {
-    if (config_.progress) PrintProgress();
+  // The control thread's duty while the loop runs: forward signal commands every 100 ms and
+  // print the progress line every 300 ms.
+  const auto loop_done = [&] { return result.done; };
+  for (int tick = 1; !result.changed.wait_for(lock, std::chrono::milliseconds(100), loop_done);
+       ++tick) {
+    if (config_.pause_signals) ForwardPauseSignal();
+    if (config_.progress && tick % 3 == 0) PrintProgress();
   }
   lock.unlock();
   loop.Join();
@@ -181,6 +186,19 @@ RunReport RunSession::Run() {
   if (logger_) logger_->Stop();
   lifecycle_.Handle(statemachine::Event::kDrained);
   return BuildReport(result, wall_time_s);
+}
+
+void RunSession::ForwardPauseSignal() noexcept {
+  switch (kernel_glue::TakePauseRequest()) {
+    case kernel_glue::PauseRequest::kPause:
+      Post(SessionCommand::kPause);
+      break;
+    case kernel_glue::PauseRequest::kResume:
+      Post(SessionCommand::kResume);
+      break;
+    case kernel_glue::PauseRequest::kNone:
+      break;
+  }
 }
 
 void RunSession::PrintProgress() const {

@@ -211,6 +211,30 @@ TEST_F(RunCli, SigtermMidRunStopsCleanlyWithReportAndCompleteLog) {
   EXPECT_EQ(static_cast<std::uint64_t>(rows.back()[10]), report["releases"].get<std::uint64_t>() - 1);
 }
 
+TEST_F(RunCli, Sigusr1PausesAndSigusr2ResumesARealTimeRun) {
+  // 3 s at 1 kHz; paused from about 1 s to about 2 s. A noisy machine moves those moments by
+  // tens of milliseconds, so the test asserts the shape, not exact counts.
+  hiltwin::kernel_glue::Process run = hiltwin::test::Spawn(
+      Args({"--duration", "3", "--rate", "1000", "--priority", "0", "--report", Path("r.json")}),
+      Path("out.txt"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  ASSERT_EQ(kill(run.pid(), SIGUSR1), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  ASSERT_EQ(kill(run.pid(), SIGUSR2), 0);
+  const auto status = run.WaitFor(std::chrono::seconds(20));
+  ASSERT_TRUE(status.has_value()) << "still running";
+  EXPECT_TRUE(status->Success() || (status->exited && status->code == 3)) << status->Describe();
+  const auto report = ReadJson(Path("r.json"));
+  EXPECT_EQ(report["stop_reason"], "finished");  // paused cycles count towards the plan
+  EXPECT_EQ(report["final_state"], "stopped");
+  const auto paused = report["cycles_paused"].get<std::uint64_t>();
+  EXPECT_GT(paused, 500U);
+  EXPECT_LT(paused, 1500U);
+  // Paused cycles are not judged: the ledger holds the others.
+  EXPECT_EQ(report["releases_recorded"].get<std::uint64_t>() + paused,
+            report["releases"].get<std::uint64_t>());
+}
+
 struct BadInput {
   std::vector<std::string> args;
   std::string expect_in_message;

@@ -78,6 +78,18 @@ TEST_F(StopSignal, FirstSignalDisarmsItsHandlerAndResetRearmsIt) {
 
 using StopSignalDeathTest = StopSignal;
 
+TEST(PauseSignal, Sigusr1PausesSigusr2ResumesAndTheLatestRequestWins) {
+  InstallPauseSignalHandlers();
+  EXPECT_EQ(TakePauseRequest(), PauseRequest::kNone);
+  ASSERT_EQ(raise(SIGUSR1), 0);
+  EXPECT_EQ(TakePauseRequest(), PauseRequest::kPause);
+  EXPECT_EQ(TakePauseRequest(), PauseRequest::kNone);  // taken: cleared
+  ASSERT_EQ(raise(SIGUSR1), 0);
+  ASSERT_EQ(raise(SIGUSR2), 0);
+  EXPECT_EQ(TakePauseRequest(), PauseRequest::kResume);
+  EXPECT_FALSE(StopRequested());  // pausing is not stopping
+}
+
 TEST_F(StopSignalDeathTest, SecondSigintKillsAStuckProgram) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(

@@ -26,4 +26,14 @@ void RequestStop() noexcept;
 /// programs that run several loops in turn).
 void ResetStopRequest();
 
+/// A pause or resume asked for by signal: SIGUSR1 pauses, SIGUSR2 resumes (`kill -USR1 PID`).
+enum class PauseRequest { kNone, kPause, kResume };
+
+/// Installs the SIGUSR1/SIGUSR2 handlers, which only record the latest request in a lock-free
+/// flag. Throws std::system_error when sigaction fails.
+void InstallPauseSignalHandlers();
+
+/// The latest pause or resume request since the last call, and clears it. Async-signal-safe.
+[[nodiscard]] PauseRequest TakePauseRequest() noexcept;
+
 }  // namespace hiltwin::kernel_glue

@@ -51,6 +51,9 @@ struct SessionConfig {
   OverrunInjector injector;
   std::optional<LogConfig> log;
   bool progress = false;  ///< a throttled progress line on stderr, from the control thread
+  /// SIGUSR1 pauses and SIGUSR2 resumes the run (forwarded by the control thread within
+  /// 100 ms). Off by default: the handlers are process-wide, the command decides.
+  bool pause_signals = false;
   /// Called on the control thread once the loop thread is set up, before the first cycle:
   /// the RT set-up record (null on the virtual clock). For the command's start-up lines.
   std::function<void(const kernel_glue::RtSetupRecord*)> on_ready;
@@ -95,6 +98,7 @@ class RunSession {
   struct LoopResult;
   void LoopThreadMain(LoopResult& result) noexcept;
   void PrintProgress() const;
+  void ForwardPauseSignal() noexcept;
   [[nodiscard]] RunReport BuildReport(const LoopResult& result, double wall_time_s) const;
 
   SessionConfig config_;
