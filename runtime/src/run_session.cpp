@@ -66,12 +66,11 @@ struct RunSession::LoopResult {
   bool done = false;
   std::optional<kernel_glue::RtSession> rt;
   std::string setup_error;
-  scheduler::StopCause cause = scheduler::StopCause::kCycleLimit;
   bool outputs_safe = false;
 };
 
 RunSession::RunSession(SessionConfig config, RunTask& task)
-    : config_((CheckConfig(config), std::move(config))),
+    : config_((CheckConfig(config), std::move(config))),  // checked before anything is built
       task_(task),
       clock_(MakeClock(config_.clock)),
       monitor_(config_.qos),
@@ -125,7 +124,9 @@ void RunSession::LoopThreadMain(LoopResult& result) noexcept {
     if (result.cancelled) return;
   }
   if (hooks_ != nullptr) hooks_->BeforeLoop();
-  result.cause = executive_.Run(*runner_);
+  // Why the loop ended is the lifecycle's to say (the runner posted the event that ended it);
+  // the executive's own stop cause adds nothing.
+  static_cast<void>(executive_.Run(*runner_));
   // Leaving run or paused: the outputs go safe at once, from the loop thread.
   result.outputs_safe = runner_->WriteSafeOutputs();
   if (hooks_ != nullptr) hooks_->AfterLoop();
