@@ -128,17 +128,17 @@ Curve ExtractCurve(const CsvTable& table, std::size_t column) {
   return c;
 }
 
-Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
-                  const AssessOptions& options) {
-  CheckOptions(options);
-  Assessment a;
-  a.options = options;
-  a.sim_label = sim.label;
-  a.exp_label = exp.label;
-  if (input != nullptr) a.input_label = input->label;
-  a.same_time_base = sim.t_s == exp.t_s;
+namespace {
 
-  // Overlap, on the experiment's time base (the thesis compares at the logged samples).
+// Samples [first, last) of the experiment inside the time range both curves cover.
+struct Overlap {
+  std::size_t first = 0;
+  std::size_t last = 0;
+};
+
+// The overlap on the experiment's time base (the thesis compares at the logged samples); fills
+// the aligned series of `a`.
+Overlap AlignOnOverlap(const Curve& sim, const Curve& exp, Assessment& a) {
   const double lo = std::max(sim.t_s.front(), exp.t_s.front());
   const double hi = std::min(sim.t_s.back(), exp.t_s.back());
   const auto [first, last] = Inside(exp.t_s, lo, hi);
@@ -167,173 +167,192 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
                       std::to_string(a.samples) + " samples in the overlap [" +
                       Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) + "] s");
   }
+  return {first, last};
+}
 
+// A constant experiment makes eps_t zero, and then no time-domain score exists.
+void RequireMovingExperiment(const Curve& exp, const Overlap& overlap, const Assessment& a) {
   const auto [lo_it, hi_it] = std::minmax_element(a.y_exp.begin(), a.y_exp.end());
   if (!(*hi_it > *lo_it)) {
     throw OptionError(AssessOption::kExp,
-                      Lines(exp, first, last - 1, exp.column) + ": the experiment curve (" +
-                          exp.label + ") is constant (" + Num(*lo_it) +
+                      Lines(exp, overlap.first, overlap.last - 1, exp.column) +
+                          ": the experiment curve (" + exp.label + ") is constant (" +
+                          Num(*lo_it) +
                           ") over the compared range, so the error threshold eps_t = "
                           "Kp*(max - min) is 0 and no score exists; pick the column that moves");
   }
-  a.time = ScoreTimeDomain(a.y_sim, a.y_exp, options.params);
+}
 
-  // One uniform grid for the delay, the spectra and ISO 18571.
+// Both curves on one uniform grid: the delay, the spectra and ISO 18571 need one.
+struct GridCurves {
+  std::vector<double> t_s;
+  std::vector<double> sim;
+  std::vector<double> exp;
+};
+
+GridCurves OnUniformGrid(const Curve& sim, const Curve& exp, Assessment& a) {
   a.grid_step_s = MedianStep(a.t_s);
   a.uniform_time_base = IsUniform(a.t_s);
-  std::vector<double> grid;
-  std::vector<double> grid_sim;
-  std::vector<double> grid_exp;
-  if (a.uniform_time_base) {
-    grid = a.t_s;
-    grid_sim = a.y_sim;
-    grid_exp = a.y_exp;
-  } else {
-    grid = UniformGrid(a.overlap_t0_s, a.overlap_t1_s, a.grid_step_s);
-    grid_sim = InterpolateAt(sim.t_s, sim.y, grid);
-    grid_exp = InterpolateAt(exp.t_s, exp.y, grid);
-    a.notes.push_back("time base not uniform: delay, spectra and ISO 18571 use a uniform grid of " +
-                      Num(a.grid_step_s) + " s (the median step)");
-  }
+  if (a.uniform_time_base) return {a.t_s, a.y_sim, a.y_exp};
+  GridCurves grid;
+  grid.t_s = UniformGrid(a.overlap_t0_s, a.overlap_t1_s, a.grid_step_s);
+  grid.sim = InterpolateAt(sim.t_s, sim.y, grid.t_s);
+  grid.exp = InterpolateAt(exp.t_s, exp.y, grid.t_s);
+  a.notes.push_back("time base not uniform: delay, spectra and ISO 18571 use a uniform grid of " +
+                    Num(a.grid_step_s) + " s (the median step)");
+  return grid;
+}
 
-  // Delay and the delay-compensated time-domain score.
+void EstimateGridDelay(const GridCurves& grid, const AssessOptions& options, Assessment& a) {
   const double duration_s = a.overlap_t1_s - a.overlap_t0_s;
   const double max_delay_s = options.max_delay_s.value_or(0.1 * duration_s);
-  if (grid.size() >= 4) {
-    a.delay = EstimateDelay(grid_sim, grid_exp, a.grid_step_s, max_delay_s);
+  if (grid.t_s.size() >= 4) {
+    a.delay = EstimateDelay(grid.sim, grid.exp, a.grid_step_s, max_delay_s);
   }
   if (a.delay.at_search_limit) {
     a.notes.push_back("the delay estimate sits at the edge of the search range (+-" +
                       Num(max_delay_s) + " s); widen the search range" +
                       OptionHint(options.name_option, AssessOption::kMaxDelay));
   }
-  {
-    std::vector<double> queries;
-    std::vector<double> y_exp_used;
-    a.y_sim_compensated.assign(a.samples, std::numeric_limits<double>::quiet_NaN());
-    const double s_lo = sim.t_s.front();
-    const double s_hi = sim.t_s.back();
-    std::size_t first_used = exp.t_s.size();
-    for (std::size_t i = 0; i < exp.t_s.size(); ++i) {
-      const double q = exp.t_s[i] - a.delay.delay_s;
-      if (q < s_lo || q > s_hi) continue;
-      if (first_used == exp.t_s.size()) first_used = i;
-      queries.push_back(q);
-      y_exp_used.push_back(exp.y[i]);
-    }
-    if (queries.size() < 2) {
-      a.time_compensated = a.time;
-    } else {
-      const std::vector<double> shifted = InterpolateAt(sim.t_s, sim.y, queries);
-      const auto [clo, chi] = std::minmax_element(y_exp_used.begin(), y_exp_used.end());
-      a.time_compensated = *chi > *clo ? ScoreTimeDomain(shifted, y_exp_used, options.params) : a.time;
-      for (std::size_t k = 0; k < shifted.size(); ++k) {
-        const std::size_t i = first_used + k;  // the used samples are contiguous
-        if (i >= first && i < last) a.y_sim_compensated[i - first] = shifted[k];
-      }
+}
+
+// The time-domain score against the simulation shifted by the estimated delay, over the
+// experiment samples the shifted simulation still covers.
+void ScoreCompensated(const Curve& sim, const Curve& exp, const Overlap& overlap,
+                      const AssessOptions& options, Assessment& a) {
+  std::vector<double> queries;
+  std::vector<double> y_exp_used;
+  a.y_sim_compensated.assign(a.samples, std::numeric_limits<double>::quiet_NaN());
+  const double s_lo = sim.t_s.front();
+  const double s_hi = sim.t_s.back();
+  std::size_t first_used = exp.t_s.size();
+  for (std::size_t i = 0; i < exp.t_s.size(); ++i) {
+    const double q = exp.t_s[i] - a.delay.delay_s;
+    if (q < s_lo || q > s_hi) continue;
+    if (first_used == exp.t_s.size()) first_used = i;
+    queries.push_back(q);
+    y_exp_used.push_back(exp.y[i]);
+  }
+  if (queries.size() < 2) {
+    a.time_compensated = a.time;
+    return;
+  }
+  const std::vector<double> shifted = InterpolateAt(sim.t_s, sim.y, queries);
+  const auto [clo, chi] = std::minmax_element(y_exp_used.begin(), y_exp_used.end());
+  a.time_compensated = *chi > *clo ? ScoreTimeDomain(shifted, y_exp_used, options.params) : a.time;
+  for (std::size_t k = 0; k < shifted.size(); ++k) {
+    const std::size_t i = first_used + k;  // the used samples are contiguous
+    if (i >= overlap.first && i < overlap.last) a.y_sim_compensated[i - overlap.first] = shifted[k];
+  }
+}
+
+void ScorePerformanceDomain(const AssessOptions& options, Assessment& a) {
+  std::size_t p_first = 0;
+  std::size_t p_last = a.samples;
+  if (options.segment) {
+    std::tie(p_first, p_last) = Inside(a.t_s, options.segment->first, options.segment->second);
+    if (p_last - p_first < 3) {
+      throw OptionError(AssessOption::kSegment,
+                        "segment " + FromTo(*options.segment, "s") + " holds " +
+                            std::to_string(p_last - p_first) +
+                            " samples of the compared range [" + Num(a.overlap_t0_s) + ", " +
+                            Num(a.overlap_t1_s) + "] s; need at least 3 (start it at the step)");
     }
   }
-
-  // Performance domain.
-  {
-    std::size_t p_first = 0;
-    std::size_t p_last = a.samples;
-    if (options.segment) {
-      std::tie(p_first, p_last) = Inside(a.t_s, options.segment->first, options.segment->second);
-      if (p_last - p_first < 3) {
-        throw OptionError(AssessOption::kSegment,
-                          "segment " + FromTo(*options.segment, "s") + " holds " +
-                              std::to_string(p_last - p_first) +
-                              " samples of the compared range [" + Num(a.overlap_t0_s) + ", " +
-                              Num(a.overlap_t1_s) + "] s; need at least 3 (start it at the step)");
-      }
-    }
-    const auto count = p_last - p_first;
-    const std::span<const double> t_seg(a.t_s.data() + p_first, count);
-    const std::span<const double> sim_seg(a.y_sim.data() + p_first, count);
-    const std::span<const double> exp_seg(a.y_exp.data() + p_first, count);
-    if (count >= 3) {
-      a.performance = ScorePerformance(t_seg, sim_seg, exp_seg, options.setpoint, options.params);
-    }
-    if (count < 3) {
-      a.performance_note = "fewer than 3 samples to compare";
-    } else if (!a.performance) {
-      a.performance_note = "the experiment shows no step in [" + Num(t_seg.front()) + ", " +
-                           Num(t_seg.back()) + "] s (final value equals initial value); " +
-                           "choose the step's start and end times" +
-                           OptionHint(options.name_option, AssessOption::kSegment);
-    }
+  const auto count = p_last - p_first;
+  const std::span<const double> t_seg(a.t_s.data() + p_first, count);
+  const std::span<const double> sim_seg(a.y_sim.data() + p_first, count);
+  const std::span<const double> exp_seg(a.y_exp.data() + p_first, count);
+  if (count >= 3) {
+    a.performance = ScorePerformance(t_seg, sim_seg, exp_seg, options.setpoint, options.params);
   }
+  if (count < 3) {
+    a.performance_note = "fewer than 3 samples to compare";
+  } else if (!a.performance) {
+    a.performance_note = "the experiment shows no step in [" + Num(t_seg.front()) + ", " +
+                         Num(t_seg.back()) + "] s (final value equals initial value); " +
+                         "choose the step's start and end times" +
+                         OptionHint(options.name_option, AssessOption::kSegment);
+  }
+}
 
-  // Frequency domain (needs the input the two systems were given).
+// A constant input excites no frequency. The message names the input samples the
+// interpolation used: from the last one at or before the range's start to the first one at
+// or after its end.
+[[noreturn]] void ThrowConstantInput(const Curve& input, std::span<const double> g, double u) {
+  const auto& ut = input.t_s;
+  const auto after_start = std::upper_bound(ut.begin(), ut.end(), g.front()) - ut.begin();
+  const auto at_end = std::lower_bound(ut.begin(), ut.end(), g.back()) - ut.begin();
+  const auto u_first = static_cast<std::size_t>(std::max<std::ptrdiff_t>(after_start - 1, 0));
+  const auto u_last = std::min(static_cast<std::size_t>(at_end), ut.size() - 1);
+  throw OptionError(AssessOption::kInput,
+                    Lines(input, u_first, u_last, input.column) + ": the input curve (" +
+                        input.label + ") is constant (" + Num(u) +
+                        ") over the compared range [" + Num(g.front()) + ", " +
+                        Num(g.back()) + "] s, so it excites no frequency; give the column "
+                        "that drove both systems");
+}
+
+// The frequency domain needs the input the two systems were given.
+void ScoreFrequencyDomain(const Curve* input, const GridCurves& grid,
+                          const AssessOptions& options, Assessment& a) {
   if (input == nullptr) {
     a.frequency_note =
         "no input curve given" + OptionHint(options.name_option, AssessOption::kInput);
-  } else {
-    const double f_lo = std::max(grid.front(), input->t_s.front());
-    const double f_hi = std::min(grid.back(), input->t_s.back());
-    const auto [g_first, g_last] = Inside(grid, f_lo, f_hi);
-    if (!(f_lo < f_hi) || g_last - g_first < 16) {
-      throw OptionError(AssessOption::kInput,
-                        "the input curve " + input->label + " covers " + Range(*input) +
-                            ", which leaves fewer than 16 samples of the compared range [" +
-                            Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) +
-                            "] s; give the input that drove both runs");
-    }
-    const std::span<const double> g(grid.data() + g_first, g_last - g_first);
-    const std::vector<double> u = InterpolateAt(input->t_s, input->y, g);
-    const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
-    if (!(*uhi > *ulo)) {
-      // The input samples the interpolation used: from the last one at or before the range's
-      // start to the first one at or after its end.
-      const auto& ut = input->t_s;
-      const auto after_start = std::upper_bound(ut.begin(), ut.end(), g.front()) - ut.begin();
-      const auto at_end = std::lower_bound(ut.begin(), ut.end(), g.back()) - ut.begin();
-      const auto u_first = static_cast<std::size_t>(std::max<std::ptrdiff_t>(after_start - 1, 0));
-      const auto u_last = std::min(static_cast<std::size_t>(at_end), ut.size() - 1);
-      throw OptionError(AssessOption::kInput,
-                        Lines(*input, u_first, u_last, input->column) + ": the input curve (" +
-                            input->label + ") is constant (" + Num(*ulo) +
-                            ") over the compared range [" + Num(g.front()) + ", " +
-                            Num(g.back()) + "] s, so it excites no frequency; give the column "
-                            "that drove both systems");
-    }
-    const std::size_t segment =
-        options.welch_segment > 0 ? options.welch_segment : DefaultWelchSegment(g.size());
-    if (segment < 8 || segment > g.size()) {
-      throw OptionError(AssessOption::kWelchSegment,
-                        "Welch segment of " + std::to_string(segment) +
-                            " samples: must lie in [8, " + std::to_string(g.size()) +
-                            "] (the samples available)");
-    }
-    const std::span<const double> gs(grid_sim.data() + g_first, g.size());
-    const std::span<const double> ge(grid_exp.data() + g_first, g.size());
-    a.frequency = ScoreFrequency(
-        u, gs, ge, a.grid_step_s, segment, options.coherence_min, options.params,
-        a.frequency_note, options.band_hz ? options.band_hz->first : 0.0,
-        options.band_hz ? options.band_hz->second : std::numeric_limits<double>::infinity(),
-        options.name_option);
+    return;
   }
+  const double f_lo = std::max(grid.t_s.front(), input->t_s.front());
+  const double f_hi = std::min(grid.t_s.back(), input->t_s.back());
+  const auto [g_first, g_last] = Inside(grid.t_s, f_lo, f_hi);
+  if (!(f_lo < f_hi) || g_last - g_first < 16) {
+    throw OptionError(AssessOption::kInput,
+                      "the input curve " + input->label + " covers " + Range(*input) +
+                          ", which leaves fewer than 16 samples of the compared range [" +
+                          Num(a.overlap_t0_s) + ", " + Num(a.overlap_t1_s) +
+                          "] s; give the input that drove both runs");
+  }
+  const std::span<const double> g(grid.t_s.data() + g_first, g_last - g_first);
+  const std::vector<double> u = InterpolateAt(input->t_s, input->y, g);
+  const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
+  if (!(*uhi > *ulo)) ThrowConstantInput(*input, g, *ulo);
+  const std::size_t segment =
+      options.welch_segment > 0 ? options.welch_segment : DefaultWelchSegment(g.size());
+  if (segment < 8 || segment > g.size()) {
+    throw OptionError(AssessOption::kWelchSegment,
+                      "Welch segment of " + std::to_string(segment) +
+                          " samples: must lie in [8, " + std::to_string(g.size()) +
+                          "] (the samples available)");
+  }
+  const std::span<const double> gs(grid.sim.data() + g_first, g.size());
+  const std::span<const double> ge(grid.exp.data() + g_first, g.size());
+  a.frequency = ScoreFrequency(
+      u, gs, ge, a.grid_step_s, segment, options.coherence_min, options.params,
+      a.frequency_note, options.band_hz ? options.band_hz->first : 0.0,
+      options.band_hz ? options.band_hz->second : std::numeric_limits<double>::infinity(),
+      options.name_option);
+}
 
-  // Cross-checks.
+void CrossCheck(const GridCurves& grid, const AssessOptions& options, Assessment& a) {
   a.theil = TheilInequality(a.y_sim, a.y_exp);
-  if (grid.size() < 20) {
+  const std::vector<double>& t = grid.t_s;
+  if (t.size() < 20) {
     // The rating's phase shift and moving averages need a record; a number would mislead.
-    a.iso_note = "the compared range holds " + std::to_string(grid.size()) +
+    a.iso_note = "the compared range holds " + std::to_string(t.size()) +
                  " samples on the uniform grid; ISO/TS 18571 needs at least 20";
+  } else if (t.size() > options.iso_max_samples && options.iso_max_samples >= 20) {
+    const double step = (t.back() - t.front()) / static_cast<double>(options.iso_max_samples - 1);
+    std::vector<double> coarse(options.iso_max_samples);
+    for (std::size_t i = 0; i < coarse.size(); ++i) coarse[i] = t.front() + static_cast<double>(i) * step;
+    coarse.back() = t.back();
+    a.iso = Iso18571Rating(InterpolateAt(t, grid.exp, coarse), InterpolateAt(t, grid.sim, coarse));
   } else {
-    if (grid.size() > options.iso_max_samples && options.iso_max_samples >= 20) {
-      const double step = (grid.back() - grid.front()) / static_cast<double>(options.iso_max_samples - 1);
-      std::vector<double> coarse(options.iso_max_samples);
-      for (std::size_t i = 0; i < coarse.size(); ++i) coarse[i] = grid.front() + static_cast<double>(i) * step;
-      coarse.back() = grid.back();
-      a.iso = Iso18571Rating(InterpolateAt(grid, grid_exp, coarse), InterpolateAt(grid, grid_sim, coarse));
-    } else {
-      a.iso = Iso18571Rating(grid_exp, grid_sim);
-    }
+    a.iso = Iso18571Rating(grid.exp, grid.sim);
   }
+}
 
-  // Total: the weighted mean of the domains that carry weight.
+// The total is the weighted mean of the domains that carry weight; a weighted domain that
+// could not be computed is an error, not a silent zero.
+void WeighTotal(const AssessOptions& options, Assessment& a) {
   const auto& w = options.weights;
   if (w[1] > 0.0 && !a.performance) {
     throw OptionError(AssessOption::kWeights, "the performance domain has weight " + Num(w[1]) +
@@ -358,75 +377,82 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
   }
   a.total = sum / weight;
   a.pass = a.total >= options.params.eta_pass;
-  return a;
 }
 
-nlohmann::json ToJson(const Assessment& a) {
-  nlohmann::json j;
-  j["inputs"] = {{"sim", a.sim_label},
-                 {"exp", a.exp_label},
-                 {"input", a.input_label.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.input_label)},
-                 {"same_time_base", a.same_time_base},
-                 {"overlap_s", {a.overlap_t0_s, a.overlap_t1_s}},
-                 {"samples", a.samples},
-                 {"step_s", a.grid_step_s},
-                 {"uniform_time_base", a.uniform_time_base}};
-  j["parameters"] = {{"kp", a.options.params.kp},
-                     {"eta_pass", a.options.params.eta_pass},
-                     {"weights", {{"time", a.options.weights[0]},
-                                  {"performance", a.options.weights[1]},
-                                  {"frequency", a.options.weights[2]}}},
-                     {"total_uses_compensated", a.options.total_uses_compensated}};
-  j["time_domain"] = TimeJson(a.time);
-  j["delay_s"] = a.delay.delay_s;
-  j["delay"] = {{"delay_s", a.delay.delay_s},
-                {"samples", a.delay.delay_samples},
-                {"search_range_samples", a.delay.max_lag_samples},
-                {"at_search_limit", a.delay.at_search_limit}};
-  j["time_domain_compensated"] = TimeJson(a.time_compensated);
-  if (a.performance) {
-    const PerformanceScore& p = *a.performance;
-    nlohmann::json metrics = nlohmann::json::object();
-    for (const MetricScore& m : p.metrics) {
-      metrics[m.name] = {{"sim", Opt(m.sim)},
-                         {"exp", Opt(m.exp)},
-                         {"scored", m.scored},
-                         {"error", m.scored && m.sim && m.exp ? nlohmann::json(m.error) : nlohmann::json(nullptr)},
-                         {"threshold", m.scored && m.sim && m.exp ? nlohmann::json(m.threshold) : nlohmann::json(nullptr)},
-                         {"eta", m.scored ? nlohmann::json(m.eta) : nlohmann::json(nullptr)}};
-    }
-    j["performance_domain"] = {{"segment_s", {p.t0_s, p.t1_s}},
-                               {"samples", p.samples},
-                               {"setpoint", p.setpoint},
-                               {"setpoint_given", p.setpoint_given},
-                               {"metrics", metrics},
-                               {"eta", p.eta}};
-  } else {
-    j["performance_domain"] = nullptr;
+nlohmann::json InputsJson(const Assessment& a) {
+  return {{"sim", a.sim_label},
+          {"exp", a.exp_label},
+          {"input", a.input_label.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.input_label)},
+          {"same_time_base", a.same_time_base},
+          {"overlap_s", {a.overlap_t0_s, a.overlap_t1_s}},
+          {"samples", a.samples},
+          {"step_s", a.grid_step_s},
+          {"uniform_time_base", a.uniform_time_base}};
+}
+
+nlohmann::json ParametersJson(const AssessOptions& o) {
+  return {{"kp", o.params.kp},
+          {"eta_pass", o.params.eta_pass},
+          {"weights", {{"time", o.weights[0]},
+                       {"performance", o.weights[1]},
+                       {"frequency", o.weights[2]}}},
+          {"total_uses_compensated", o.total_uses_compensated}};
+}
+
+nlohmann::json DelayJson(const DelayEstimate& d) {
+  return {{"delay_s", d.delay_s},
+          {"samples", d.delay_samples},
+          {"search_range_samples", d.max_lag_samples},
+          {"at_search_limit", d.at_search_limit}};
+}
+
+nlohmann::json PerformanceJson(const std::optional<PerformanceScore>& performance) {
+  if (!performance) return nullptr;
+  const PerformanceScore& p = *performance;
+  nlohmann::json metrics = nlohmann::json::object();
+  for (const MetricScore& m : p.metrics) {
+    metrics[m.name] = {{"sim", Opt(m.sim)},
+                       {"exp", Opt(m.exp)},
+                       {"scored", m.scored},
+                       {"error", m.scored && m.sim && m.exp ? nlohmann::json(m.error) : nlohmann::json(nullptr)},
+                       {"threshold", m.scored && m.sim && m.exp ? nlohmann::json(m.threshold) : nlohmann::json(nullptr)},
+                       {"eta", m.scored ? nlohmann::json(m.eta) : nlohmann::json(nullptr)}};
   }
-  if (a.frequency) {
-    const FrequencyScore& f = *a.frequency;
-    j["frequency_domain"] = {{"welch_segment_samples", f.segment_samples},
-                             {"welch_segments", f.segments},
-                             {"welch_segments_total", f.segments_total},
-                             {"coherence_min", f.coherence_min},
-                             {"input_power_min_fraction", kInputPowerFraction},
-                             {"bins_used", f.bins_used},
-                             {"bins_low_input", f.bins_low_input},
-                             {"bins_total", f.bins_total},
-                             {"band_hz", {f.f_min_hz, f.f_max_hz}},
-                             {"magnitude_db", DomainJson(f.magnitude)},
-                             {"phase_deg", DomainJson(f.phase)},
-                             {"eta", f.eta}};
-  } else {
-    j["frequency_domain"] = nullptr;
-  }
+  return {{"segment_s", {p.t0_s, p.t1_s}},
+          {"samples", p.samples},
+          {"setpoint", p.setpoint},
+          {"setpoint_given", p.setpoint_given},
+          {"metrics", metrics},
+          {"eta", p.eta}};
+}
+
+nlohmann::json FrequencyJson(const std::optional<FrequencyScore>& frequency) {
+  if (!frequency) return nullptr;
+  const FrequencyScore& f = *frequency;
+  return {{"welch_segment_samples", f.segment_samples},
+          {"welch_segments", f.segments},
+          {"welch_segments_total", f.segments_total},
+          {"coherence_min", f.coherence_min},
+          {"input_power_min_fraction", kInputPowerFraction},
+          {"bins_used", f.bins_used},
+          {"bins_low_input", f.bins_low_input},
+          {"bins_total", f.bins_total},
+          {"band_hz", {f.f_min_hz, f.f_max_hz}},
+          {"magnitude_db", DomainJson(f.magnitude)},
+          {"phase_deg", DomainJson(f.phase)},
+          {"eta", f.eta}};
+}
+
+nlohmann::json NotComputedJson(const Assessment& a) {
   nlohmann::json why = nlohmann::json::object();
   if (!a.performance) why["performance_domain"] = a.performance_note;
   if (!a.frequency) why["frequency_domain"] = a.frequency_note;
   if (!a.iso) why["iso18571"] = a.iso_note;
-  j["not_computed"] = why;
-  j["cross_checks"] = {
+  return why;
+}
+
+nlohmann::json CrossChecksJson(const Assessment& a) {
+  return {
       {"theil", {{"u", a.theil.u}, {"bias", a.theil.bias}, {"variance", a.theil.variance},
                  {"covariance", a.theil.covariance}}},
       {"iso18571", a.iso ? nlohmann::json{{"corridor", a.iso->corridor},
@@ -438,6 +464,45 @@ nlohmann::json ToJson(const Assessment& a) {
                                           {"phase_shift_samples", a.iso->phase_shift_samples},
                                           {"samples", a.iso->samples}}
                          : nlohmann::json(nullptr)}};
+}
+
+}  // namespace
+
+Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
+                  const AssessOptions& options) {
+  CheckOptions(options);
+  Assessment a;
+  a.options = options;
+  a.sim_label = sim.label;
+  a.exp_label = exp.label;
+  if (input != nullptr) a.input_label = input->label;
+  a.same_time_base = sim.t_s == exp.t_s;
+
+  const Overlap overlap = AlignOnOverlap(sim, exp, a);
+  RequireMovingExperiment(exp, overlap, a);
+  a.time = ScoreTimeDomain(a.y_sim, a.y_exp, options.params);
+  const GridCurves grid = OnUniformGrid(sim, exp, a);
+  EstimateGridDelay(grid, options, a);
+  ScoreCompensated(sim, exp, overlap, options, a);
+  ScorePerformanceDomain(options, a);
+  ScoreFrequencyDomain(input, grid, options, a);
+  CrossCheck(grid, options, a);
+  WeighTotal(options, a);
+  return a;
+}
+
+nlohmann::json ToJson(const Assessment& a) {
+  nlohmann::json j;
+  j["inputs"] = InputsJson(a);
+  j["parameters"] = ParametersJson(a.options);
+  j["time_domain"] = TimeJson(a.time);
+  j["delay_s"] = a.delay.delay_s;
+  j["delay"] = DelayJson(a.delay);
+  j["time_domain_compensated"] = TimeJson(a.time_compensated);
+  j["performance_domain"] = PerformanceJson(a.performance);
+  j["frequency_domain"] = FrequencyJson(a.frequency);
+  j["not_computed"] = NotComputedJson(a);
+  j["cross_checks"] = CrossChecksJson(a);
   j["notes"] = a.notes;
   j["total"] = a.total;
   j["pass"] = a.pass;

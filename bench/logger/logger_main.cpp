@@ -48,6 +48,89 @@ std::array<double, kColumns> Row(int k) {
   return row;
 }
 
+// Producer cost per row of each burst, and what the queue dropped.
+struct ProducerCost {
+  std::vector<double> ns_per_row;
+  std::uint64_t dropped = 0;
+};
+
+ProducerCost MeasureCsvLogger(int bursts, const std::filesystem::path& dir,
+                              const std::vector<std::string>& names) {
+  ProducerCost cost;
+  hiltwin::tracing::CsvLoggerConfig config;
+  config.path = (dir / "ours.csv").string();
+  config.columns = names;
+  hiltwin::tracing::CsvLogger logger(config);
+  logger.Start();
+  int k = 0;
+  for (int b = 0; b < bursts; ++b) {
+    const auto start = Clock::now();
+    for (int i = 0; i < kBurstRows; ++i, ++k) {
+      const auto row = Row(k);
+      logger.TryLog(k * 0.00025, row);
+    }
+    const auto end = Clock::now();
+    cost.ns_per_row.push_back(NsPerCall(start, end, kBurstRows));
+    logger.Flush();
+  }
+  logger.Stop();
+  cost.dropped = logger.rows_dropped();
+  return cost;
+}
+
+// Peer: spdlog async logger, same row, "{},{},..." with the same shortest-round-trip
+// formatting fmt uses by default for doubles.
+std::vector<double> MeasureSpdlog(int bursts, const std::filesystem::path& dir) {
+  std::vector<double> peer;
+  spdlog::init_thread_pool(1 << 16, 1);
+  auto logger =
+      spdlog::basic_logger_mt<spdlog::async_factory>("peer", (dir / "peer.csv").string(), true);
+  logger->set_pattern("%v");
+  int k = 0;
+  for (int b = 0; b < bursts; ++b) {
+    const auto start = Clock::now();
+    for (int i = 0; i < kBurstRows; ++i, ++k) {
+      const auto r = Row(k);
+      logger->info("{},{},{},{},{},{},{},{},{}", k * 0.00025, r[0], r[1], r[2], r[3], r[4], r[5],
+                   r[6], r[7]);
+    }
+    const auto end = Clock::now();
+    peer.push_back(NsPerCall(start, end, kBurstRows));
+    while (spdlog::thread_pool()->queue_size() != 0)
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  spdlog::shutdown();
+  return peer;
+}
+
+// Writer drain rate: a full queue formatted and written by Stop.
+double MeasureDrainRowsPerS(const std::filesystem::path& dir,
+                            const std::vector<std::string>& names) {
+  hiltwin::tracing::CsvLoggerConfig config;
+  config.path = (dir / "drain.csv").string();
+  config.columns = names;
+  hiltwin::tracing::CsvLogger logger(config);
+  const int rows = static_cast<int>(config.queue_capacity_rows);
+  for (int k = 0; k < rows; ++k) logger.TryLog(k * 0.00025, Row(k));
+  const auto start = Clock::now();
+  logger.Stop();
+  const auto end = Clock::now();
+  return rows / std::chrono::duration<double>(end - start).count();
+}
+
+// A compiled-in tracepoint with no session recording (one branch).
+double MeasureIdleTraceNs() {
+  constexpr int kCalls = 10'000'000;
+  const auto start = Clock::now();
+  for (int k = 0; k < kCalls; ++k) {
+    const auto k64 = static_cast<std::uint64_t>(k);
+    const auto t = static_cast<std::int64_t>(k);
+    HILTWIN_TRACE(cycle, k64, t, t + 1, t + 2, t + 3, std::uint32_t{0}, std::uint8_t{0});
+    asm volatile("" ::: "memory");
+  }
+  return NsPerCall(start, Clock::now(), kCalls);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,89 +141,17 @@ int main(int argc, char** argv) {
   std::vector<std::string> names;
   for (std::size_t c = 0; c < kColumns; ++c) names.push_back("v" + std::to_string(c));
 
-  // hiltwin CsvLogger.
-  std::vector<double> ours;
-  std::uint64_t ours_dropped = 0;
-  {
-    hiltwin::tracing::CsvLoggerConfig config;
-    config.path = (dir / "ours.csv").string();
-    config.columns = names;
-    hiltwin::tracing::CsvLogger logger(config);
-    logger.Start();
-    int k = 0;
-    for (int b = 0; b < bursts; ++b) {
-      const auto start = Clock::now();
-      for (int i = 0; i < kBurstRows; ++i, ++k) {
-        const auto row = Row(k);
-        logger.TryLog(k * 0.00025, row);
-      }
-      const auto end = Clock::now();
-      ours.push_back(NsPerCall(start, end, kBurstRows));
-      logger.Flush();
-    }
-    logger.Stop();
-    ours_dropped = logger.rows_dropped();
-  }
-
-  // Peer: spdlog async logger, same row, "{},{},..." with the same shortest-round-trip
-  // formatting fmt uses by default for doubles.
-  std::vector<double> peer;
-  {
-    spdlog::init_thread_pool(1 << 16, 1);
-    auto logger =
-        spdlog::basic_logger_mt<spdlog::async_factory>("peer", (dir / "peer.csv").string(), true);
-    logger->set_pattern("%v");
-    int k = 0;
-    for (int b = 0; b < bursts; ++b) {
-      const auto start = Clock::now();
-      for (int i = 0; i < kBurstRows; ++i, ++k) {
-        const auto r = Row(k);
-        logger->info("{},{},{},{},{},{},{},{},{}", k * 0.00025, r[0], r[1], r[2], r[3], r[4], r[5],
-                     r[6], r[7]);
-      }
-      const auto end = Clock::now();
-      peer.push_back(NsPerCall(start, end, kBurstRows));
-      while (spdlog::thread_pool()->queue_size() != 0)
-        std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-    spdlog::shutdown();
-  }
-
-  // Writer drain rate: a full queue formatted and written by Stop.
-  double drain_rows_per_s = 0.0;
-  {
-    hiltwin::tracing::CsvLoggerConfig config;
-    config.path = (dir / "drain.csv").string();
-    config.columns = names;
-    hiltwin::tracing::CsvLogger logger(config);
-    const int rows = static_cast<int>(config.queue_capacity_rows);
-    for (int k = 0; k < rows; ++k) logger.TryLog(k * 0.00025, Row(k));
-    const auto start = Clock::now();
-    logger.Stop();
-    const auto end = Clock::now();
-    drain_rows_per_s = rows / std::chrono::duration<double>(end - start).count();
-  }
-
-  // A compiled-in tracepoint with no session recording (one branch).
-  double trace_ns = 0.0;
-  {
-    constexpr int kCalls = 10'000'000;
-    const auto start = Clock::now();
-    for (int k = 0; k < kCalls; ++k) {
-      const auto k64 = static_cast<std::uint64_t>(k);
-      const auto t = static_cast<std::int64_t>(k);
-      HILTWIN_TRACE(cycle, k64, t, t + 1, t + 2, t + 3, std::uint32_t{0}, std::uint8_t{0});
-      asm volatile("" ::: "memory");
-    }
-    trace_ns = NsPerCall(start, Clock::now(), kCalls);
-  }
+  const ProducerCost ours = MeasureCsvLogger(bursts, dir, names);
+  const std::vector<double> peer = MeasureSpdlog(bursts, dir);
+  const double drain_rows_per_s = MeasureDrainRowsPerS(dir, names);
+  const double trace_ns = MeasureIdleTraceNs();
 
   std::filesystem::remove_all(dir);
-  const double ours_ns = Median(ours);
+  const double ours_ns = Median(ours.ns_per_row);
   const double peer_ns = Median(peer);
   std::printf("rows: %d bursts x %d rows, time + %zu columns\n", bursts, kBurstRows, kColumns);
   std::printf("hiltwin CsvLogger::TryLog     median %.1f ns/row (dropped %llu)\n", ours_ns,
-              static_cast<unsigned long long>(ours_dropped));
+              static_cast<unsigned long long>(ours.dropped));
   std::printf("peer spdlog async info(...)   median %.1f ns/row\n", peer_ns);
   std::printf("ratio hiltwin/peer            %.3f\n", ours_ns / peer_ns);
   std::printf("writer drain (format+write)   %.0f rows/s\n", drain_rows_per_s);

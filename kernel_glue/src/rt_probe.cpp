@@ -228,6 +228,70 @@ std::optional<Capabilities> ParseCapabilities(const std::optional<std::string>& 
   return Capabilities{((*mask >> kCapSysNice) & 1U) != 0, ((*mask >> kCapIpcLock) & 1U) != 0};
 }
 
+bool ConfigHas(const std::optional<std::string>& config, std::string_view line) {
+  return config && config->find(std::string(line) + "\n") != std::string::npos;
+}
+
+// A preemption mode ("full") and where it was read; an empty mode means not found.
+struct PreemptMode {
+  std::string mode;
+  std::string source;
+};
+
+// A PREEMPT_DYNAMIC kernel picks its mode at boot, so the build configuration may not be the
+// mode that runs: ask the live kernel first.
+PreemptMode LiveDynamicMode(const Machine& machine) {
+  // debugfs shows the live mode as "none voluntary (full) lazy".
+  if (const auto live = machine.ReadTrimmed("sys/kernel/debug/sched/preempt")) {
+    const auto open = live->find('(');
+    const auto close = live->find(')', open);
+    if (open != std::string::npos && close != std::string::npos) {
+      PreemptMode debugfs{live->substr(open + 1, close - open - 1), "debugfs sched/preempt"};
+      if (!debugfs.mode.empty()) return debugfs;
+    }
+  }
+  PreemptMode found;
+  if (const auto cmdline = machine.ReadTrimmed("proc/cmdline")) {
+    for (const auto& word : Words(*cmdline)) {
+      if (word.rfind("preempt=", 0) == 0) found = {word.substr(8), "boot option " + word};
+    }
+  }
+  return found;
+}
+
+PreemptMode ConfigMode(const std::optional<std::string>& config, bool dynamic) {
+  std::string mode;
+  if (ConfigHas(config, "CONFIG_PREEMPT_LAZY=y")) {
+    mode = "lazy";
+  } else if (ConfigHas(config, "CONFIG_PREEMPT=y")) {
+    mode = "full";
+  } else if (ConfigHas(config, "CONFIG_PREEMPT_VOLUNTARY=y")) {
+    mode = "voluntary";
+  } else if (ConfigHas(config, "CONFIG_PREEMPT_NONE=y")) {
+    mode = "none";
+  }
+  if (mode.empty()) return {};
+  return {mode, dynamic ? "kernel config default; debugfs not mounted" : "kernel config"};
+}
+
+// uname -v names PREEMPT and PREEMPT_LAZY only, so it cannot tell none from voluntary.
+PreemptMode UnameMode(const std::string& version) {
+  if (HasWord(version, "PREEMPT_LAZY")) return {"lazy", "uname -v"};
+  if (HasWord(version, "PREEMPT")) return {"full", "uname -v"};
+  return {"none or voluntary", "uname -v"};
+}
+
+// The most direct source wins: the live mode, then the build configuration, then uname -v
+// (whose PREEMPT says nothing about a dynamic kernel's live mode).
+PreemptMode FindPreemptMode(const Machine& machine, const std::optional<std::string>& version,
+                            const std::optional<std::string>& config, bool dynamic) {
+  PreemptMode found;
+  if (dynamic) found = LiveDynamicMode(machine);
+  if (found.mode.empty()) found = ConfigMode(config, dynamic);
+  if (found.mode.empty() && !dynamic && version) found = UnameMode(*version);
+  return found;
+}
+
 ProbeCheck CheckPreemption(const Machine& machine) {
   const std::string id = "preemption";
   const std::string name = "preemption model";
@@ -237,67 +301,18 @@ ProbeCheck CheckPreemption(const Machine& machine) {
   const auto realtime = machine.ReadTrimmed("sys/kernel/realtime");
   const auto version = machine.KernelVersion();
   const auto config = machine.KernelConfig();
-  auto config_has = [&](std::string_view line) {
-    return config && config->find(std::string(line) + "\n") != std::string::npos;
-  };
 
   const bool rt = (realtime && *realtime == "1") || (version && HasWord(*version, "PREEMPT_RT")) ||
-                  config_has("CONFIG_PREEMPT_RT=y");
+                  ConfigHas(config, "CONFIG_PREEMPT_RT=y");
   if (rt) {
     return Make(id, name, "PREEMPT_RT (fully preemptible kernel)", CheckStatus::kOk);
   }
 
-  const bool dynamic =
-      (version && HasWord(*version, "PREEMPT_DYNAMIC")) || config_has("CONFIG_PREEMPT_DYNAMIC=y");
-  std::string mode;
-  std::string source;
-  if (dynamic) {
-    // debugfs shows the live mode as "none voluntary (full) lazy".
-    if (const auto live = machine.ReadTrimmed("sys/kernel/debug/sched/preempt")) {
-      const auto open = live->find('(');
-      const auto close = live->find(')', open);
-      if (open != std::string::npos && close != std::string::npos) {
-        mode = live->substr(open + 1, close - open - 1);
-        source = "debugfs sched/preempt";
-      }
-    }
-    if (mode.empty()) {
-      if (const auto cmdline = machine.ReadTrimmed("proc/cmdline")) {
-        for (const auto& word : Words(*cmdline)) {
-          if (word.rfind("preempt=", 0) == 0) {
-            mode = word.substr(8);
-            source = "boot option " + word;
-          }
-        }
-      }
-    }
-  }
-  if (mode.empty() && config) {
-    if (config_has("CONFIG_PREEMPT_LAZY=y")) {
-      mode = "lazy";
-    } else if (config_has("CONFIG_PREEMPT=y")) {
-      mode = "full";
-    } else if (config_has("CONFIG_PREEMPT_VOLUNTARY=y")) {
-      mode = "voluntary";
-    } else if (config_has("CONFIG_PREEMPT_NONE=y")) {
-      mode = "none";
-    }
-    if (!mode.empty())
-      source = dynamic ? "kernel config default; debugfs not mounted" : "kernel config";
-  }
-  if (mode.empty() && !dynamic && version) {
-    source = "uname -v";
-    if (HasWord(*version, "PREEMPT_LAZY")) {
-      mode = "lazy";
-    } else if (HasWord(*version, "PREEMPT")) {
-      mode = "full";
-    } else {
-      mode = "none or voluntary";
-    }
-  }
-
+  const bool dynamic = (version && HasWord(*version, "PREEMPT_DYNAMIC")) ||
+                       ConfigHas(config, "CONFIG_PREEMPT_DYNAMIC=y");
+  const PreemptMode found = FindPreemptMode(machine, version, config, dynamic);
   const std::string prefix = dynamic ? "PREEMPT_DYNAMIC, mode " : "";
-  if (mode.empty()) {
+  if (found.mode.empty()) {
     if (!version && !config) return Unknown(id, name, "no uname -v, no kernel config", rt_advice);
     return Make(id, name, prefix + "unknown (debugfs not mounted, no kernel config)",
                 CheckStatus::kWarn,
@@ -305,8 +320,8 @@ ProbeCheck CheckPreemption(const Machine& machine) {
                 "/sys/kernel/debug/sched/preempt`. " +
                     rt_advice);
   }
-  const std::string value = prefix + mode + " (" + source + ")";
-  if (mode == "full" || mode == "lazy") {
+  const std::string value = prefix + found.mode + " (" + found.source + ")";
+  if (found.mode == "full" || found.mode == "lazy") {
     return Make(id, name, value, CheckStatus::kWarn,
                 "fine for millisecond deadlines; " + rt_advice);
   }
