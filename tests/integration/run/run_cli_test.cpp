@@ -18,7 +18,9 @@
 namespace {
 
 namespace fs = std::filesystem;
-hiltwin::test::RunResult Hiltwin(const std::vector<std::string>& argv) { return hiltwin::test::Run(argv); }
+hiltwin::test::RunResult Hiltwin(const std::vector<std::string>& argv) {
+  return hiltwin::test::Run(argv);
+}
 
 class RunCli : public ::testing::Test {
  protected:
@@ -58,6 +60,11 @@ class RunCli : public ::testing::Test {
     return rows;
   }
 
+  static std::string ReadText(const std::string& path) {
+    std::ifstream in(path);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
   void WriteFile(const std::string& name, const std::string& text) const {
     std::ofstream(Path(name)) << text;
   }
@@ -66,7 +73,8 @@ class RunCli : public ::testing::Test {
 };
 
 TEST_F(RunCli, VirtualClockWithoutInjectionPassesWithExactCycleCounts) {
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "2.5", "--report", Path("r.json")}));
+  const auto r =
+      Hiltwin(Args({"--clock", "virtual", "--duration", "2.5", "--report", Path("r.json")}));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["verdict"], "PASS");
@@ -97,8 +105,8 @@ TEST_F(RunCli, VirtualClockWithoutInjectionPassesWithExactCycleCounts) {
 
 TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
   const std::string wire = "wire:hiltwin_run_solo_" + std::to_string(getpid());
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "0.1", "--io", wire,
-                               "--report", Path("r.json")}));
+  const auto r = Hiltwin(
+      Args({"--clock", "virtual", "--duration", "0.1", "--io", wire, "--report", Path("r.json")}));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["peer_absent_cycles"], 400);
@@ -109,10 +117,15 @@ TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
 }
 
 TEST_F(RunCli, VirtualRunIsDeterministic) {
-  ASSERT_EQ(Hiltwin(Args({"--clock", "virtual", "--duration", "1", "--log", Path("a.csv")})).exit_code, 0);
-  ASSERT_EQ(Hiltwin(Args({"--clock", "virtual", "--duration", "1", "--log", Path("b.csv")})).exit_code, 0);
+  ASSERT_EQ(
+      Hiltwin(Args({"--clock", "virtual", "--duration", "1", "--log", Path("a.csv")})).exit_code,
+      0);
+  ASSERT_EQ(
+      Hiltwin(Args({"--clock", "virtual", "--duration", "1", "--log", Path("b.csv")})).exit_code,
+      0);
   std::ifstream a(Path("a.csv")), b(Path("b.csv"));
-  const std::string ta((std::istreambuf_iterator<char>(a)), {}), tb((std::istreambuf_iterator<char>(b)), {});
+  const std::string ta((std::istreambuf_iterator<char>(a)), {}),
+      tb((std::istreambuf_iterator<char>(b)), {});
   EXPECT_GT(ta.size(), 1000U);
   EXPECT_EQ(ta, tb);
 }
@@ -124,9 +137,10 @@ TEST_F(RunCli, VirtualRunIsDeterministic) {
 constexpr int kK = 6000;
 
 TEST_F(RunCli, InjectedOverrunsAreFlaggedAtTheExactFirstViolatingCycle) {
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "2", "--qos", "9:10",
-                           "--inject-overrun", "at=" + std::to_string(kK) + ",count=2,extra-us=600",
-                           "--report", Path("r.json"), "--log", Path("log.csv")}));
+  const auto r =
+      Hiltwin(Args({"--clock", "virtual", "--duration", "2", "--qos", "9:10", "--inject-overrun",
+                    "at=" + std::to_string(kK) + ",count=2,extra-us=600", "--report",
+                    Path("r.json"), "--log", Path("log.csv")}));
   ASSERT_EQ(r.exit_code, 3) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["verdict"], "FLAGGED");
@@ -159,10 +173,10 @@ TEST_F(RunCli, InjectedOverrunsAreFlaggedAtTheExactFirstViolatingCycle) {
 }
 
 TEST_F(RunCli, AbortPolicyStopsAtTheViolatingCycleWithSafeOutputsAndACompleteLog) {
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "2", "--qos", "9:10",
-                           "--on-violation", "abort", "--inject-overrun",
-                           "at=" + std::to_string(kK) + ",count=2,extra-us=600", "--report",
-                           Path("r.json"), "--log", Path("log.csv")}));
+  const auto r = Hiltwin(
+      Args({"--clock", "virtual", "--duration", "2", "--qos", "9:10", "--on-violation", "abort",
+            "--inject-overrun", "at=" + std::to_string(kK) + ",count=2,extra-us=600", "--report",
+            Path("r.json"), "--log", Path("log.csv")}));
   ASSERT_EQ(r.exit_code, 4) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["verdict"], "ABORTED");
@@ -208,15 +222,23 @@ TEST_F(RunCli, SigtermMidRunStopsCleanlyWithReportAndCompleteLog) {
   std::string header;
   const auto rows = ReadCsv(Path("log.csv"), &header);
   ASSERT_EQ(rows.size(), cycles);
-  EXPECT_EQ(static_cast<std::uint64_t>(rows.back()[10]), report["releases"].get<std::uint64_t>() - 1);
+  EXPECT_EQ(static_cast<std::uint64_t>(rows.back()[10]),
+            report["releases"].get<std::uint64_t>() - 1);
 }
 
 TEST_F(RunCli, Sigusr1PausesAndSigusr2ResumesARealTimeRun) {
-  // 3 s at 1 kHz; paused from about 1 s to about 2 s. A noisy machine moves those moments by
-  // tens of milliseconds, so the test asserts the shape, not exact counts.
+  // 4 s at 1 kHz; paused from about 1 s to about 2 s after the run started. A noisy machine
+  // moves those moments by tens of milliseconds, so the test asserts the shape, not counts.
   hiltwin::kernel_glue::Process run = hiltwin::test::Spawn(
-      Args({"--duration", "3", "--rate", "1000", "--priority", "0", "--report", Path("r.json")}),
+      Args({"--duration", "4", "--rate", "1000", "--priority", "0", "--report", Path("r.json")}),
       Path("out.txt"));
+  // The start line is printed once the handlers are installed: before it, SIGUSR1's default
+  // action would end the process.
+  for (int i = 0; i < 200 && ReadText(Path("out.txt")).find("hiltwin run:") == std::string::npos;
+       ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_NE(ReadText(Path("out.txt")).find("hiltwin run:"), std::string::npos) << "never started";
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
   ASSERT_EQ(kill(run.pid(), SIGUSR1), 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
@@ -279,19 +301,22 @@ TEST_F(RunCli, BadInputOnEveryEntryPointExitsTwoWithAHelpfulMessage) {
     if (args[0] != "--duration") args.insert(args.end(), {"--duration", "0.01"});
     const auto r = Hiltwin(Args(args));
     EXPECT_EQ(r.out.find("verdict"), std::string::npos) << "stopped before the run: " << r.out;
-    EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << (c.args.size() > 1 ? c.args[1] : "") << "\n" << r.err;
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << (c.args.size() > 1 ? c.args[1] : "") << "\n"
+                              << r.err;
     EXPECT_NE(r.err.find(c.expect_in_message), std::string::npos)
-        << "message for " << c.args[0] << " should mention '" << c.expect_in_message << "': " << r.err;
+        << "message for " << c.args[0] << " should mention '" << c.expect_in_message
+        << "': " << r.err;
   }
 }
 
 TEST_F(RunCli, ARateTheModelCannotIntegrateStablyIsRefusedWithTheReason) {
   // 20 Hz Euler used to run into NaN mid-run (a model fault, exit 1); now it never starts.
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--rate", "20", "--duration", "5",
-                               "--integrator", "euler"}));
+  const auto r = Hiltwin(
+      Args({"--clock", "virtual", "--rate", "20", "--duration", "5", "--integrator", "euler"}));
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   EXPECT_EQ(r.out.find("verdict"), std::string::npos) << r.out;
-  EXPECT_NE(r.err.find("--rate 20: the RELbot model diverges with euler"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--rate 20: the RELbot model diverges with euler"), std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("update rate of at least"), std::string::npos) << r.err;
 }
 
@@ -312,18 +337,20 @@ TEST_F(RunCli, MissesInsideTheGracePeriodAreReportedApartFromTheJudgedOnes) {
   EXPECT_EQ(report["qos"]["cycles_judged"], 40000 - 200);
   EXPECT_EQ(report["releases_recorded"], 40000);
   EXPECT_NE(r.out.find("judged     0 misses of 39800 releases"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("the first 200 releases (" + std::to_string(misses) + " misses) are not judged"),
-            std::string::npos) << r.out;
+  EXPECT_NE(
+      r.out.find("the first 200 releases (" + std::to_string(misses) + " misses) are not judged"),
+      std::string::npos)
+      << r.out;
 }
 
 TEST_F(RunCli, AbortUnderSkipJudgesNoReleaseAfterTheAbortCycle) {
   // 20 kHz (50 us): cycle 777 overruns by 1 ms, so releases 778..796 pass while it runs and
   // are skipped. The window of 20 ending at 782 holds 6 misses (777..782): (15,20) fails
   // there, the run aborts, and releases 783..796 are not judged.
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--rate", "20000", "--duration", "1",
-                               "--inject-overrun", "at=777,extra-us=1000", "--qos", "15:20",
-                               "--overrun-policy", "skip", "--on-violation", "abort", "--report",
-                               Path("r.json")}));
+  const auto r =
+      Hiltwin(Args({"--clock", "virtual", "--rate", "20000", "--duration", "1", "--inject-overrun",
+                    "at=777,extra-us=1000", "--qos", "15:20", "--overrun-policy", "skip",
+                    "--on-violation", "abort", "--report", Path("r.json")}));
   ASSERT_EQ(r.exit_code, 4) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["verdict"], "ABORTED");
@@ -342,9 +369,10 @@ TEST_F(RunCli, AbortUnderSkipJudgesNoReleaseAfterTheAbortCycle) {
 TEST_F(RunCli, HelpDocumentsEveryContractFlag) {
   const auto r = Hiltwin({HILTWIN_BINARY, "run", "--help"});
   ASSERT_EQ(r.exit_code, 0);
-  for (const char* flag : {"--rate", "--duration", "--io", "--input", "--qos", "--max-consecutive-misses",
-                           "--max-miss-pct", "--grace-cycles", "--on-violation", "--clock", "--log",
-                           "--report", "--inject-overrun", "--config"}) {
+  for (const char* flag :
+       {"--rate", "--duration", "--io", "--input", "--qos", "--max-consecutive-misses",
+        "--max-miss-pct", "--grace-cycles", "--on-violation", "--clock", "--log", "--report",
+        "--inject-overrun", "--config"}) {
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
   }
 }
