@@ -40,6 +40,7 @@ class ScriptedTask final : public RunTask {
     ++steps;
     last_cycle = context.cycle;
     if (context.cycle == model_fault_at) return StepStatus::ModelFault("the state became NaN");
+    if (context.cycle == finished_at) return {StepStatus::Code::kFinished, ""};
     return StepStatus::Ok();
   }
   std::vector<std::string> LogColumns() const override { return {"steps"}; }
@@ -50,7 +51,7 @@ class ScriptedTask final : public RunTask {
 
   RunSession* session = nullptr;
   std::uint64_t pause_at = kNever, resume_at = kNever, stop_at = kNever;
-  std::uint64_t io_fault_from = kNever, model_fault_at = kNever;
+  std::uint64_t io_fault_from = kNever, model_fault_at = kNever, finished_at = kNever;
   std::uint64_t live_exchanges = 0, safe_exchanges = 0, steps = 0, last_cycle = 0;
 
  private:
@@ -113,6 +114,16 @@ TEST(RunSession, TheRunEndsAtItsPlanEvenWhilePaused) {
   EXPECT_EQ(r.cycles_paused, 250U);
   EXPECT_EQ(r.stop_reason, StopReason::kFinished);
   EXPECT_EQ(r.final_state, State::kStopped);
+}
+
+TEST(RunSession, ATaskThatFinishesEndsTheRunBeforeItsPlan) {
+  ScriptedTask task;
+  task.finished_at = 120;  // e.g. a controller whose setpoint profile has ended
+  const RunReport r = RunScripted(task, VirtualConfig(1000));
+  EXPECT_EQ(r.cycles_run, 121U);
+  EXPECT_EQ(r.stop_reason, StopReason::kFinished);
+  EXPECT_EQ(r.final_state, State::kStopped);
+  EXPECT_EQ(ExitCodeFor(r), ExitCode::kPass);
 }
 
 TEST(RunSession, AStopCommandEndsTheRunAfterItsCycle) {

@@ -89,11 +89,6 @@ class RunSession {
   void Post(SessionCommand command) noexcept;
   void SetLoopThreadHooks(LoopThreadHooks* hooks) noexcept { hooks_ = hooks; }
 
-  [[nodiscard]] const scheduler::Executive& executive() const noexcept { return executive_; }
-  [[nodiscard]] const qos::QosMonitor& monitor() const noexcept { return monitor_; }
-  [[nodiscard]] const statemachine::Lifecycle& lifecycle() const noexcept { return lifecycle_; }
-  [[nodiscard]] kernel_glue::Clock& clock() noexcept { return *clock_; }
-
  private:
   struct LoopResult;
   void LoopThreadMain(LoopResult& result) noexcept;
