@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/app_relbot/relbot_channels.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/emulated_fpga.h"
@@ -16,10 +17,6 @@
 #include "hiltwin/runtime/run_task.h"
 
 namespace hiltwin::app {
-
-/// Board channels the RELbot uses (thesis appendix G: motor/encoder 1 left, 2 right).
-constexpr std::size_t kLeftChannel = 0;
-constexpr std::size_t kRightChannel = 1;
 
 /// What the last step read, computed and will send: the log row's source.
 struct TwinCycleRecord {
