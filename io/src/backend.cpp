@@ -36,6 +36,7 @@ class WireBackend final : public IoBackend {
   SpiBus& bus() noexcept override { return bus_; }
   EmulatedFpga* emulated_board() noexcept override { return &bus_.board(); }
   BackendSpec::Kind kind() const noexcept override { return BackendSpec::Kind::kWire; }
+  PeerLink* peer_link() noexcept override { return &bus_; }
 
  private:
   WireBus bus_;

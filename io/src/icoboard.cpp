@@ -73,6 +73,7 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     return status;
   }
   status.peer_absent = transfer.result == BusResult::kPeerAbsent || peer_lost_at_init;
+  if (transfer.result == BusResult::kPeerStopped) status.peer_stopped = transfer.reason;
   if (IsIdle(rx_)) {
     ++counters_.frames_missed;
     status.code = ExchangeStatus::Code::kMissed;

@@ -1,5 +1,7 @@
 #include "hiltwin/io/spi_bus.h"
 
+#include "hiltwin/io/peer_link.h"
+
 namespace hiltwin::io {
 
 const char* ToString(BusResult result) noexcept {
@@ -8,6 +10,19 @@ const char* ToString(BusResult result) noexcept {
     case BusResult::kIoError: return "I/O error";
     case BusResult::kPeerLost: return "peer lost";
     case BusResult::kPeerAbsent: return "peer absent";
+    case BusResult::kPeerStopped: return "peer stopped";
+  }
+  return "?";
+}
+
+const char* ToString(StopCause cause) noexcept {
+  switch (cause) {
+    case StopCause::kNone: return "none";
+    case StopCause::kFinished: return "finished";
+    case StopCause::kStopRequested: return "stop_requested";
+    case StopCause::kQosAbort: return "qos_abort";
+    case StopCause::kFault: return "fault";
+    case StopCause::kPeerStopped: return "peer_stopped";
   }
   return "?";
 }

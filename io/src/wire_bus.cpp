@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <thread>
@@ -20,7 +21,7 @@ namespace hiltwin::io {
 
 namespace {
 constexpr std::uint64_t kMagic = 0x6869'6C74'7769'7265ULL;  // "hiltwire"
-constexpr std::uint32_t kLayoutVersion = 2;  // 2: encoder periods in a ring
+constexpr std::uint32_t kLayoutVersion = 3;  // 2: encoder periods in a ring; 3: stop causes
 constexpr std::uint32_t kFresh = 0;
 constexpr std::uint32_t kInitialising = 1;
 constexpr std::uint32_t kReady = 2;
@@ -36,6 +37,7 @@ struct WireSide {
   std::atomic<std::int32_t> pid;
   std::atomic<std::uint32_t> attached;
   std::atomic<std::uint32_t> sessions;
+  std::atomic<std::uint32_t> stop_cause;  ///< a StopCause; kNone while running
 };
 
 /// One encoder period in the ring; each slot is a single-writer seqlock of its own.
@@ -83,6 +85,25 @@ std::uint64_t Pack16(std::size_t c, std::uint16_t value) noexcept {
 }
 std::uint16_t Unpack16(std::uint64_t packed, std::size_t c) noexcept {
   return static_cast<std::uint16_t>((packed >> (16U * c)) & 0xFFFFU);
+}
+
+/// What this side reports when the peer announced `cause` (static text, for the run report).
+const char* PeerStopMessage(bool ecs_side, std::uint32_t cause) noexcept {
+  // Rows: StopCause (kNone unused); columns: seen from the twin, seen from the ECS.
+  static constexpr const char* kText[][2] = {
+      {"wire: the ECS stopped", "wire: the twin stopped"},
+      {"wire: the ECS finished its run", "wire: the twin finished its run"},
+      {"wire: the ECS was stopped (signal or stop command)",
+       "wire: the twin was stopped (signal or stop command)"},
+      {"wire: the ECS aborted its run on its QoS policy",
+       "wire: the twin aborted its run on its QoS policy"},
+      {"wire: the ECS stopped on a fault (see its report)",
+       "wire: the twin stopped on a fault (see its report)"},
+      {"wire: the ECS stopped because its peer had stopped",
+       "wire: the twin stopped because its peer had stopped"},
+  };
+  const std::size_t row = cause < std::size(kText) ? cause : 0;
+  return kText[row][ecs_side ? 1 : 0];
 }
 
 }  // namespace
@@ -275,6 +296,7 @@ void WireBus::Attach() {
   if (peer_pid > 0 && !ProcessAlive(peer_pid) && peer.pid.compare_exchange_strong(peer_pid, 0)) {
     peer.attached.store(0);
     peer.sessions.store(0);
+    peer.stop_cause.store(0);
     // A new peer stores its pid before its flags: if one arrived while these were cleared,
     // give its presence back.
     if (peer.pid.load() != 0) {
@@ -283,6 +305,7 @@ void WireBus::Attach() {
     }
   }
   self.pid.store(::getpid());
+  self.stop_cause.store(static_cast<std::uint32_t>(StopCause::kNone));
   self.step_ns.store(0);
   self.last_beat_ns.store(clock_.NowNs());
   self.heartbeat.fetch_add(1);
@@ -320,10 +343,24 @@ void WireBus::Publish(std::int64_t now_ns) noexcept {
     }
     seg.twin_pins.store(pins, std::memory_order_release);
   }
-  WireSide& self = side_ == Image::kIcoboard ? seg.ecs : seg.twin;
+  Beat(now_ns);
+}
+
+void WireBus::Beat(std::int64_t now_ns) noexcept {
+  WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
   self.step_ns.store(board_.step_ns(), std::memory_order_relaxed);
   self.last_beat_ns.store(now_ns, std::memory_order_relaxed);
   self.heartbeat.fetch_add(1, std::memory_order_release);
+}
+
+BusStatus WireBus::Poll() noexcept {
+  Beat(clock_.NowNs());
+  return PeerStatus();
+}
+
+void WireBus::AnnounceStop(StopCause cause) noexcept {
+  WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
+  self.stop_cause.store(static_cast<std::uint32_t>(cause), std::memory_order_release);
 }
 
 BusStatus WireBus::PeerStatus() const noexcept {
@@ -332,6 +369,9 @@ BusStatus WireBus::PeerStatus() const noexcept {
   if (peer.sessions.load(std::memory_order_acquire) == 0) {
     return {BusResult::kPeerAbsent, ecs_side ? "wire: no twin process has attached yet"
                                              : "wire: no ECS process has attached yet"};
+  }
+  if (const std::uint32_t cause = peer.stop_cause.load(std::memory_order_acquire); cause != 0) {
+    return {BusResult::kPeerStopped, PeerStopMessage(ecs_side, cause)};
   }
   if (peer.attached.load(std::memory_order_acquire) == 0) {
     return {BusResult::kPeerLost, ecs_side ? "wire: the twin process detached (it stopped); "

@@ -24,6 +24,7 @@ CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
 scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
   rules_ = lifecycle_.rules();
   stepped_ = false;
+  peer_stop_seen_ = false;
   step_status_ = StepStatus::Ok();
   const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
   const io::ExchangeStatus io = task_.Exchange(rules_.live_outputs);
@@ -36,6 +37,8 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   if (!io.ok()) ++counts_.io_errors;  // the task held its inputs
   if (io.peer_absent) ++counts_.peer_absent_cycles;
   if (io.pulse_limit) ++counts_.pulse_limit_cycles;
+  peer_stop_seen_ = io.peer_stopped != nullptr;
+  if (peer_stop_seen_ && peer_stopped_ == nullptr) peer_stopped_ = io.peer_stopped;
   if (!rules_.steps_model) {
     ++counts_.paused_cycles;
     return scheduler::CycleAction::kContinue;
@@ -94,8 +97,8 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
   // The common cycle: nothing happened and nothing was asked. A relaxed load first; the
   // exchange (a locked instruction) only when a command is there.
   const bool quiet = !io_fault_ && step_status_.code == StepStatus::Code::kOk && !qos_abort_ &&
-                     !plan_done && commands_.load(std::memory_order_relaxed) == 0 &&
-                     !kernel_glue::StopRequested();
+                     !plan_done && !peer_stop_seen_ &&
+                     commands_.load(std::memory_order_relaxed) == 0 && !kernel_glue::StopRequested();
   if (quiet) return false;
   const std::uint8_t commands = commands_.exchange(0, std::memory_order_acq_rel);
   const auto asked = [commands](CommandBit bit) {
@@ -111,6 +114,7 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
   if (plan_done || step_status_.code == StepStatus::Code::kFinished) {
     lifecycle_.Handle(Event::kFinishReached);
   }
+  if (peer_stop_seen_) lifecycle_.Handle(Event::kPeerStopped);
   if (asked(CommandBit::kPause)) lifecycle_.Handle(Event::kPause);
   if (asked(CommandBit::kResume)) lifecycle_.Handle(Event::kStart);
   return true;

@@ -62,6 +62,8 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
 
   [[nodiscard]] const LoopCounts& counts() const noexcept { return counts_; }
   [[nodiscard]] const std::optional<LoopFault>& fault() const noexcept { return fault_; }
+  /// Why the peer ended its run, when it did (wire); null otherwise. Static text.
+  [[nodiscard]] const char* peer_stopped() const noexcept { return peer_stopped_; }
 
  private:
   void RecordQos(const scheduler::TimingSample& sample) noexcept;
@@ -89,9 +91,11 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   bool io_fault_ = false;
   StepStatus step_status_;
   bool qos_abort_ = false;
+  bool peer_stop_seen_ = false;  ///< this cycle's exchange reported the peer's stop
 
   LoopCounts counts_;
   std::optional<LoopFault> fault_;
+  const char* peer_stopped_ = nullptr;
   std::atomic<std::uint8_t> commands_{0};
 };
 

@@ -108,6 +108,7 @@ Json ToJson(const RunReport& r) {
   json["pulse_limit_cycles"] = r.link.pulse_limit_cycles;
   json["peer"] = r.link.peer_name;
   json["peer_absent_cycles"] = r.link.peer_absent_cycles;
+  json["peer_stopped"] = r.link.peer_stopped.empty() ? Json(nullptr) : Json(r.link.peer_stopped);
   for (const auto& [key, value] : r.details) json[key] = value;
   json["log_path"] = r.log ? Json(r.log->path) : Json(nullptr);
   if (r.log && !r.log->error.empty()) json["log_error"] = r.log->error;
@@ -207,6 +208,7 @@ std::string FormatSummary(const RunReport& r) {
     Append(out, "log        %s: %llu rows written, %llu dropped\n", r.log->path.c_str(),
            static_cast<ull>(r.log->rows_written), static_cast<ull>(r.log->rows_dropped));
   }
+  if (!l.peer_stopped.empty()) Append(out, "peer       %s\n", l.peer_stopped.c_str());
   if (r.fault) {
     Append(out, "fault      %s at cycle %llu: %s\n", statemachine::ToString(r.fault->kind),
            static_cast<ull>(r.fault->cycle), r.fault->reason.c_str());

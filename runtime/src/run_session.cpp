@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
+#include <thread>
 
 #include "cycle_runner.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
@@ -34,6 +35,27 @@ std::unique_ptr<tracing::CsvLogger> MakeLogger(const SessionConfig& config, cons
   return std::make_unique<tracing::CsvLogger>(std::move(log));
 }
 
+io::StopCause StopCauseOf(statemachine::StopReason reason) noexcept {
+  using statemachine::StopReason;
+  switch (reason) {
+    case StopReason::kFinished: return io::StopCause::kFinished;
+    case StopReason::kStopRequested: return io::StopCause::kStopRequested;
+    case StopReason::kQosAbort: return io::StopCause::kQosAbort;
+    case StopReason::kIoFault:
+    case StopReason::kModelFault: return io::StopCause::kFault;
+    case StopReason::kPeerStopped: return io::StopCause::kPeerStopped;
+    case StopReason::kNone: break;
+  }
+  return io::StopCause::kFault;  // the loop ended without a cause: say something is wrong
+}
+
+/// "12.5" for messages.
+std::string Seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", s);
+  return text;
+}
+
 void CheckConfig(const SessionConfig& config) {
   const std::uint64_t planned = config.executive.max_cycles;
   if (planned != 0 && config.qos.grace_cycles >= planned) {
@@ -48,6 +70,9 @@ void CheckConfig(const SessionConfig& config) {
                                 ")");
   }
   config.injector.CheckFiresWithin(planned);
+  if (config.peer && (config.peer->link == nullptr || !(config.peer->timeout_s >= 0.0))) {
+    throw std::invalid_argument("waiting for the peer needs a link and a timeout of 0 s or more");
+  }
   if (config.rt.fifo_priority < 0 || config.rt.fifo_priority > 99) {
     throw std::invalid_argument("SCHED_FIFO priority " + std::to_string(config.rt.fifo_priority) +
                                 " is outside 0 (none) .. 99");
@@ -129,6 +154,8 @@ void RunSession::LoopThreadMain(LoopResult& result) noexcept {
   static_cast<void>(executive_.Run(*runner_));
   // Leaving run or paused: the outputs go safe at once, from the loop thread.
   result.outputs_safe = runner_->WriteSafeOutputs();
+  // Then the peer learns why: it stops cleanly instead of waiting for a heartbeat timeout.
+  if (config_.peer) config_.peer->link->AnnounceStop(StopCauseOf(lifecycle_.stop_reason()));
   if (hooks_ != nullptr) hooks_->AfterLoop();
   std::lock_guard lock(result.mutex);
   result.done = true;
@@ -152,12 +179,16 @@ RunReport RunSession::Run() {
     if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
   } catch (...) {
     // Release the waiting loop thread without running a cycle, then report the failure.
-    result.cancelled = true;
-    result.go = true;
-    result.changed.notify_all();
-    lock.unlock();
-    loop.Join();
+    CancelLoop(result, lock, loop);
     throw;
+  }
+  if (config_.peer && !WaitForPeer()) {
+    CancelLoop(result, lock, loop);
+    result.outputs_safe = true;  // never left the safe outputs
+    config_.peer->link->AnnounceStop(StopCauseOf(lifecycle_.stop_reason()));
+    if (logger_) logger_->Stop();
+    lifecycle_.Handle(statemachine::Event::kDrained);
+    return BuildReport(result, 0.0);
   }
   // The control thread is a helper too while the loop runs: off the loop's CPUs. Best effort:
   // a refusal leaves it where it was, which costs the loop nothing it did not have before.
@@ -187,6 +218,57 @@ RunReport RunSession::Run() {
   if (logger_) logger_->Stop();
   lifecycle_.Handle(statemachine::Event::kDrained);
   return BuildReport(result, wall_time_s);
+}
+
+void RunSession::CancelLoop(LoopResult& result, std::unique_lock<std::mutex>& lock,
+                            kernel_glue::NamedThread& loop) {
+  result.cancelled = true;
+  result.go = true;
+  result.changed.notify_all();
+  lock.unlock();
+  loop.Join();
+}
+
+bool RunSession::WaitForPeer() {
+  const PeerWait& wait = *config_.peer;
+  if (wait.timeout_s == 0.0) return true;
+  const kernel_glue::MonotonicClock clock;
+  const kernel_glue::TimeNs start_ns = clock.NowNs();
+  const auto timeout_ns = static_cast<kernel_glue::TimeNs>(wait.timeout_s * 1e9);
+  const std::string what = "the " + config_.peer_name + " on " + config_.io;
+  long long shown_s = -1;
+  for (;;) {
+    const io::BusStatus status = wait.link->Poll();
+    if (status.result == io::BusResult::kOk) {
+      if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
+      std::fprintf(stderr, "hiltwin: %s is up; starting\n", what.c_str());
+      return true;
+    }
+    if (kernel_glue::StopRequested()) {
+      lifecycle_.Handle(statemachine::Event::kStopRequest);
+      return false;
+    }
+    const kernel_glue::TimeNs waited_ns = clock.NowNs() - start_ns;
+    if (waited_ns >= timeout_ns) {
+      if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
+      wait_fault_ = RunFault{statemachine::StopReason::kIoFault, 0,
+                             "no " + config_.peer_name + " came up on " + config_.io + " within " +
+                                 Seconds(wait.timeout_s) + " s (" + status.reason +
+                                 "); start it with: " + wait.start_hint};
+      lifecycle_.Handle(statemachine::Event::kIoFault);
+      return false;
+    }
+    // A countdown: rewritten in place on a terminal, a line every 5 s otherwise.
+    const long long left_s = (timeout_ns - waited_ns + 999'999'999) / 1'000'000'000;
+    if (left_s != shown_s && (config_.progress || shown_s < 0 || left_s % 5 == 0)) {
+      std::fprintf(stderr, "%shiltwin: waiting for %s: %lld s left; start it with: %s%s",
+                   config_.progress ? "\r" : "", what.c_str(), left_s, wait.start_hint.c_str(),
+                   config_.progress ? "   " : "\n");
+      std::fflush(stderr);
+      shown_s = left_s;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
 }
 
 void RunSession::ForwardPauseSignal() noexcept {
@@ -272,9 +354,12 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
   r.period_jitter = stats.period_jitter.Summary();
   const LoopCounts& counts = runner_->counts();
   r.link = {counts.io_errors, counts.peer_absent_cycles, counts.pulse_limit_cycles,
-            config_.peer_name};
-  if (const auto& fault = runner_->fault())
+            config_.peer_name, runner_->peer_stopped() != nullptr ? runner_->peer_stopped() : ""};
+  if (const auto& fault = runner_->fault()) {
     r.fault = RunFault{fault->kind, fault->cycle, fault->reason};
+  } else if (wait_fault_) {
+    r.fault = wait_fault_;
+  }
   r.outputs_safe = result.outputs_safe;
   if (logger_) {
     r.log = LogFigures{logger_->path(), logger_->rows_written(), logger_->rows_dropped(),

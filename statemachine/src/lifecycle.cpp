@@ -34,6 +34,7 @@ Transition Next(State state, Event event) noexcept {
       if (Ending(state)) return Ignore(state);
       return To(state, State::kStopping);
     case Event::kFinishReached:
+    case Event::kPeerStopped:
       // Paused cycles are still released, so the planned releases can run out while paused.
       if (state == State::kRun || state == State::kPaused) return To(state, State::kStopping);
       return Ending(state) ? Ignore(state) : Reject(state);
@@ -63,6 +64,8 @@ StopReason ReasonOf(Event event) noexcept {
       return StopReason::kStopRequested;
     case Event::kFinishReached:
       return StopReason::kFinished;
+    case Event::kPeerStopped:
+      return StopReason::kPeerStopped;
     case Event::kQosAbort:
       return StopReason::kQosAbort;
     case Event::kIoFault:
@@ -141,6 +144,8 @@ const char* ToString(Event event) noexcept {
       return "drained";
     case Event::kReset:
       return "reset";
+    case Event::kPeerStopped:
+      return "peer_stopped";
   }
   return "unknown";
 }
@@ -159,6 +164,8 @@ const char* ToString(StopReason reason) noexcept {
       return "io_fault";
     case StopReason::kModelFault:
       return "model_fault";
+    case StopReason::kPeerStopped:
+      return "peer_stopped";
   }
   return "unknown";
 }

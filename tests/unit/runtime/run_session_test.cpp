@@ -34,6 +34,7 @@ class ScriptedTask final : public RunTask {
     if (session != nullptr && n == stop_at) session->Post(SessionCommand::kStop);
     if (n >= io_fault_from)
       return {.code = io::ExchangeStatus::Code::kFault, .reason = "the link went down"};
+    if (n >= peer_stopped_from) return {.peer_stopped = "wire: the ECS finished its run"};
     return {};
   }
   StepStatus Step(const scheduler::CycleContext& context) noexcept override {
@@ -52,6 +53,7 @@ class ScriptedTask final : public RunTask {
   RunSession* session = nullptr;
   std::uint64_t pause_at = kNever, resume_at = kNever, stop_at = kNever;
   std::uint64_t io_fault_from = kNever, model_fault_at = kNever, finished_at = kNever;
+  std::uint64_t peer_stopped_from = kNever;
   std::uint64_t live_exchanges = 0, safe_exchanges = 0, steps = 0, last_cycle = 0;
 
  private:
@@ -114,6 +116,87 @@ TEST(RunSession, TheRunEndsAtItsPlanEvenWhilePaused) {
   EXPECT_EQ(r.cycles_paused, 250U);
   EXPECT_EQ(r.stop_reason, StopReason::kFinished);
   EXPECT_EQ(r.final_state, State::kStopped);
+}
+
+/// A peer that comes up after a number of polls, and records what it was told.
+class FakePeer final : public io::PeerLink {
+ public:
+  io::BusStatus Poll() noexcept override {
+    ++polls;
+    if (polls > up_after) return {};
+    return {io::BusResult::kPeerAbsent, "wire: no ECS process has attached yet"};
+  }
+  void AnnounceStop(io::StopCause cause) noexcept override {
+    ++announcements;
+    announced = cause;
+  }
+  int up_after = 0;
+  int polls = 0;
+  int announcements = 0;
+  io::StopCause announced = io::StopCause::kNone;
+};
+
+SessionConfig WithPeer(SessionConfig config, FakePeer& peer, double timeout_s) {
+  config.io = "wire:lab";
+  config.peer_name = "controller";
+  config.peer = PeerWait{&peer, timeout_s, "hiltwin ecs --io wire:lab"};
+  return config;
+}
+
+TEST(RunSessionPeer, WaitsForThePeerThenRunsAndTellsItWhyItStopped) {
+  ScriptedTask task;
+  FakePeer peer;
+  peer.up_after = 3;  // three polls (about 60 ms) of waiting
+  const RunReport r = RunScripted(task, WithPeer(VirtualConfig(200), peer, 5.0));
+  EXPECT_EQ(peer.polls, 4);
+  EXPECT_EQ(r.cycles_run, 200U);
+  EXPECT_EQ(r.stop_reason, StopReason::kFinished);
+  EXPECT_EQ(peer.announcements, 1);
+  EXPECT_EQ(peer.announced, io::StopCause::kFinished);
+}
+
+TEST(RunSessionPeer, APeerThatNeverComesIsAnIoFaultThatNamesTheCommandToStartIt) {
+  ScriptedTask task;
+  FakePeer peer;
+  peer.up_after = 1'000'000;
+  const RunReport r = RunScripted(task, WithPeer(VirtualConfig(200), peer, 0.1));
+  EXPECT_EQ(r.cycles_run, 0U);
+  EXPECT_EQ(task.live_exchanges + task.safe_exchanges, 0U);
+  EXPECT_EQ(r.stop_reason, StopReason::kIoFault);
+  EXPECT_EQ(r.final_state, State::kSafeStop);
+  ASSERT_TRUE(r.fault.has_value());
+  EXPECT_EQ(r.fault->reason,
+            "no controller came up on wire:lab within 0.1 s (wire: no ECS process has attached "
+            "yet); start it with: hiltwin ecs --io wire:lab");
+  EXPECT_GE(peer.polls, 4);  // every 20 ms for 100 ms
+  EXPECT_EQ(peer.announced, io::StopCause::kFault);
+  EXPECT_TRUE(r.outputs_safe);
+  EXPECT_EQ(ExitCodeFor(r), ExitCode::kIo);
+}
+
+TEST(RunSessionPeer, APeerThatStopsEndsTheRunCleanlyWithItsReason) {
+  ScriptedTask task;
+  task.peer_stopped_from = 120;
+  FakePeer peer;
+  const RunReport r = RunScripted(task, WithPeer(VirtualConfig(1000), peer, 1.0));
+  EXPECT_EQ(r.cycles_run, 121U);  // the cycle that saw it still ran
+  EXPECT_EQ(r.stop_reason, StopReason::kPeerStopped);
+  EXPECT_EQ(r.final_state, State::kStopped);
+  EXPECT_EQ(r.link.peer_stopped, "wire: the ECS finished its run");
+  EXPECT_FALSE(r.fault.has_value());
+  EXPECT_EQ(peer.announced, io::StopCause::kPeerStopped);
+  EXPECT_EQ(ExitCodeFor(r), ExitCode::kPass);  // judged on what ran
+  EXPECT_NE(FormatSummary(r).find("peer       wire: the ECS finished its run"), std::string::npos);
+  EXPECT_EQ(ToJson(r)["peer_stopped"], "wire: the ECS finished its run");
+}
+
+TEST(RunSessionPeer, AnIoFaultIsAnnouncedAsAFault) {
+  ScriptedTask task;
+  task.io_fault_from = 10;
+  FakePeer peer;
+  const RunReport r = RunScripted(task, WithPeer(VirtualConfig(1000), peer, 1.0));
+  EXPECT_EQ(r.stop_reason, StopReason::kIoFault);
+  EXPECT_EQ(peer.announced, io::StopCause::kFault);
 }
 
 TEST(RunSession, ATaskThatFinishesEndsTheRunBeforeItsPlan) {

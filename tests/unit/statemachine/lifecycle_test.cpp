@@ -19,7 +19,7 @@ constexpr std::array kStates = {State::kInit,     State::kReady,   State::kRun, 
 constexpr std::array kEvents = {Event::kConfigured,  Event::kStart,         Event::kPause,
                                 Event::kStopRequest, Event::kFinishReached, Event::kQosAbort,
                                 Event::kIoFault,     Event::kModelFault,    Event::kDrained,
-                                Event::kReset};
+                                Event::kReset,       Event::kPeerStopped};
 
 using S = State;
 using E = Event;
@@ -38,12 +38,14 @@ const std::map<std::pair<State, Event>, State>& Legal() {
       {{S::kRun, E::kPause}, S::kPaused},
       {{S::kRun, E::kStopRequest}, S::kStopping},
       {{S::kRun, E::kFinishReached}, S::kStopping},
+      {{S::kRun, E::kPeerStopped}, S::kStopping},
       {{S::kRun, E::kQosAbort}, S::kError},
       {{S::kRun, E::kIoFault}, S::kError},
       {{S::kRun, E::kModelFault}, S::kError},
       {{S::kPaused, E::kStart}, S::kRun},
       {{S::kPaused, E::kStopRequest}, S::kStopping},
       {{S::kPaused, E::kFinishReached}, S::kStopping},  // the planned releases ran out
+      {{S::kPaused, E::kPeerStopped}, S::kStopping},
       {{S::kPaused, E::kIoFault}, S::kError},
       {{S::kPaused, E::kModelFault}, S::kError},
       {{S::kStopping, E::kDrained}, S::kStopped},
@@ -59,7 +61,10 @@ const std::map<std::pair<State, Event>, State>& Legal() {
 // Redundant stop causes once the run is already ending: accepted, no change.
 bool IsIgnored(State s, Event e) {
   const bool ending = s == S::kStopping || s == S::kStopped || s == S::kError || s == S::kSafeStop;
-  if (e == E::kStopRequest || e == E::kFinishReached || e == E::kQosAbort) return ending;
+  if (e == E::kStopRequest || e == E::kFinishReached || e == E::kQosAbort ||
+      e == E::kPeerStopped) {
+    return ending;
+  }
   if (e == E::kIoFault || e == E::kModelFault) {
     return s == S::kError || s == S::kStopped || s == S::kSafeStop;
   }
@@ -119,7 +124,7 @@ TEST(Lifecycle, EveryStateEventPairMatchesTheTable) {
   }
   EXPECT_EQ(transitions, Legal().size());
   EXPECT_EQ(transitions + ignored + rejected, kStates.size() * kEvents.size());
-  EXPECT_EQ(ignored, 18U);  // 3 stop causes x 4 ending states + 2 faults x 3
+  EXPECT_EQ(ignored, 22U);  // 4 stop causes x 4 ending states + 2 faults x 3
 }
 
 TEST(Lifecycle, StopReasonIsTheFirstCause) {
@@ -134,6 +139,9 @@ TEST(Lifecycle, StopReasonIsTheFirstCause) {
        S::kStopped},
       {{E::kConfigured, E::kStart, E::kStopRequest, E::kDrained},
        StopReason::kStopRequested,
+       S::kStopped},
+      {{E::kConfigured, E::kStart, E::kPeerStopped, E::kDrained},
+       StopReason::kPeerStopped,
        S::kStopped},
       {{E::kConfigured, E::kStart, E::kQosAbort, E::kDrained}, StopReason::kQosAbort, S::kSafeStop},
       {{E::kConfigured, E::kStart, E::kIoFault, E::kDrained}, StopReason::kIoFault, S::kSafeStop},
@@ -205,18 +213,20 @@ TEST(Lifecycle, Strings) {
       {StopReason::kStopRequested, "stop_requested"},
       {StopReason::kQosAbort, "qos_abort"},
       {StopReason::kIoFault, "io_fault"},
-      {StopReason::kModelFault, "model_fault"}};
+      {StopReason::kModelFault, "model_fault"},
+      {StopReason::kPeerStopped, "peer_stopped"}};
   for (const auto& [reason, text] : reasons) EXPECT_EQ(ToString(reason), text);
   const std::vector<std::string> states = {"init",     "ready",   "run",   "paused",
                                            "stopping", "stopped", "error", "safe_stop"};
   for (std::size_t i = 0; i < kStates.size(); ++i) EXPECT_EQ(ToString(kStates[i]), states[i]);
   const std::vector<std::string> events = {
       "configured", "start",    "pause",       "stop_request", "finish_reached",
-      "qos_abort",  "io_fault", "model_fault", "drained",      "reset"};
+      "qos_abort",  "io_fault", "model_fault", "drained",      "reset", "peer_stopped"};
   for (std::size_t i = 0; i < kEvents.size(); ++i) EXPECT_EQ(ToString(kEvents[i]), events[i]);
   EXPECT_STREQ(ToString(Outcome::kRejected), "rejected");
   EXPECT_EQ(ReasonOf(E::kStart), StopReason::kNone);
   EXPECT_EQ(ReasonOf(E::kFinishReached), StopReason::kFinished);
+  EXPECT_EQ(ReasonOf(E::kPeerStopped), StopReason::kPeerStopped);
 }
 
 // The seed ECS framework's commands (docs/lifecycle.md): initialise = set up, then

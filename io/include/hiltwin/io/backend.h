@@ -9,6 +9,7 @@
 
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/frame.h"
+#include "hiltwin/io/peer_link.h"
 #include "hiltwin/io/spi_bus.h"
 #include "hiltwin/io/spidev_bus.h"
 
@@ -50,6 +51,8 @@ class IoBackend {
   /// The local board model (mock, wire) for sources and fault injection; null for spidev.
   [[nodiscard]] virtual EmulatedFpga* emulated_board() noexcept = 0;
   [[nodiscard]] virtual BackendSpec::Kind kind() const noexcept = 0;
+  /// The process on the other end (wire); null when there is none to wait for (mock, spidev).
+  [[nodiscard]] virtual PeerLink* peer_link() noexcept { return nullptr; }
 };
 
 /// Opens the backend named by `spec`. Throws ConfigError for a bad string or option, and

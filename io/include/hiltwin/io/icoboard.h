@@ -28,6 +28,8 @@ struct ExchangeStatus {
   std::int64_t transfer_ns = 0;  ///< time the bus took
   bool pulse_limit = false;      ///< an encoder change exceeded what one period can emit
   bool peer_absent = false;      ///< wire: no peer attached yet (values are idle)
+  /// wire: the peer announced the end of its run; why (static text). Null while it runs.
+  const char* peer_stopped = nullptr;
   [[nodiscard]] bool ok() const noexcept { return code == Code::kOk; }
 };
 [[nodiscard]] const char* ToString(ExchangeStatus::Code code) noexcept;

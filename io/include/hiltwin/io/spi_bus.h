@@ -17,6 +17,7 @@ enum class BusResult : std::uint8_t {
   kIoError,     ///< the transfer itself failed (ioctl error, short transfer)
   kPeerLost,    ///< wire: the other process stopped updating its heartbeat
   kPeerAbsent,  ///< wire: no peer has attached yet (the local board still answered)
+  kPeerStopped, ///< wire: the peer announced the end of its run (the local board still answered)
 };
 [[nodiscard]] const char* ToString(BusResult result) noexcept;
 

@@ -11,13 +11,17 @@
 /// quadrature readers replay edge by edge (a slot overwritten before it was read is counted as a
 /// resync, never waited for), so neither loop ever waits. Either side may start first or
 /// restart; each side beats a heartbeat on every transfer and a peer whose heartbeat stops is
-/// reported as kPeerLost. A peer that crashed is forgotten when a new process attaches.
+/// reported as kPeerLost. A peer that ends its run announces why (PeerLink::AnnounceStop) and is
+/// then reported as kPeerStopped, so the other side can stop cleanly rather than as a fault.
+/// While a side waits to start it keeps its heartbeat fresh with PeerLink::Poll. A peer that
+/// crashed is forgotten when a new process attaches.
 
 #include <cstdint>
 #include <memory>
 #include <string>
 
 #include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/io/peer_link.h"
 #include "hiltwin/io/spi_bus.h"
 #include "hiltwin/kernel_glue/clock.h"
 
@@ -25,10 +29,12 @@ namespace hiltwin::io {
 
 struct WireSegment;
 
-/// A peer counts as stopped when its heartbeat is older than max(this, 20 peer steps).
-constexpr std::int64_t kWireMinHeartbeatTimeoutNs = 100'000'000;
+/// A peer counts as lost when its heartbeat is older than max(this, 20 peer steps): long enough
+/// that a SCHED_OTHER process on a loaded machine is not declared dead by a scheduling delay,
+/// short enough that a crash ends the other side well within a second.
+constexpr std::int64_t kWireMinHeartbeatTimeoutNs = 250'000'000;
 
-class WireBus final : public SpiBus {
+class WireBus final : public SpiBus, public PeerLink {
  public:
   /// Attaches to (or creates) the segment of `name` as the side that owns a board of `side`
   /// (icoboard = ECS, icoboard_inverse = twin). Throws std::invalid_argument for a bad name
@@ -46,6 +52,8 @@ class WireBus final : public SpiBus {
   [[nodiscard]] EmulatedFpga& board() noexcept { return board_; }
   /// Heartbeat status of the other side right now (no transfer).
   [[nodiscard]] BusStatus PeerStatus() const noexcept;
+  BusStatus Poll() noexcept override;
+  void AnnounceStop(StopCause cause) noexcept override;
   /// The twin emulator's period `index` as published on the wire (tests, diagnostics); false
   /// when it is not, or no longer, in the ring.
   [[nodiscard]] bool ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept;
@@ -62,6 +70,7 @@ class WireBus final : public SpiBus {
   /// the flags of a peer that crashed without detaching.
   void Attach();
   void Publish(std::int64_t now_ns) noexcept;
+  void Beat(std::int64_t now_ns) noexcept;
 
   std::string label_;
   std::string segment_name_;

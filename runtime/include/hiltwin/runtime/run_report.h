@@ -47,6 +47,7 @@ struct LinkFigures {
   std::uint64_t pulse_limit_cycles =
       0;                           ///< cycles with an encoder change above one period's pulses
   std::string peer_name = "peer";  ///< who sits on the other side ("controller", "twin")
+  std::string peer_stopped;        ///< wire: why the peer ended its run (stop peer_stopped)
 };
 
 /// The fault that stopped the run (I/O or model).

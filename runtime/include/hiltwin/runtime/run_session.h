@@ -12,13 +12,16 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "hiltwin/io/peer_link.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
+#include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_report.h"
@@ -35,6 +38,16 @@ class CycleRunner;
 struct LogConfig {
   std::string path;
   std::uint32_t decimation = 1;  ///< every Nth cycle
+};
+
+/// The process on the other end of the link (wire): the session waits for it in `ready`, with a
+/// countdown, and tells it why this side stopped once the outputs are safe.
+struct PeerWait {
+  io::PeerLink* link = nullptr;  ///< not owned; must outlive the session
+  /// Waiting longer than this ends the run as an I/O fault; 0: start at once without waiting
+  /// (cycles without a peer are then counted as peer_absent_cycles).
+  double timeout_s = 30.0;
+  std::string start_hint;        ///< the command that starts the other side, for messages
 };
 
 /// A validated run, as plain data (cactus-rt style config struct).
@@ -54,6 +67,8 @@ struct SessionConfig {
   /// SIGUSR1 pauses and SIGUSR2 resumes the run (forwarded by the control thread within
   /// 100 ms). Off by default: the handlers are process-wide, the command decides.
   bool pause_signals = false;
+  /// Set when the link has a process on its other end (wire); empty otherwise.
+  std::optional<PeerWait> peer;
   /// Called on the control thread once the loop thread is set up, before the first cycle:
   /// the RT set-up record (null on the virtual clock). For the command's start-up lines.
   std::function<void(const kernel_glue::RtSetupRecord*)> on_ready;
@@ -93,7 +108,13 @@ class RunSession {
   struct LoopResult;
   void LoopThreadMain(LoopResult& result) noexcept;
   void PrintProgress() const;
+  /// Control thread, in `ready`: polls the peer until it is up (true), the wait times out
+  /// (io_fault) or a stop signal arrives (stop_requested).
+  [[nodiscard]] bool WaitForPeer();
   void ForwardPauseSignal() noexcept;
+  /// Releases the parked loop thread without running a cycle and joins it.
+  static void CancelLoop(LoopResult& result, std::unique_lock<std::mutex>& lock,
+                         kernel_glue::NamedThread& loop);
   [[nodiscard]] RunReport BuildReport(const LoopResult& result, double wall_time_s) const;
 
   SessionConfig config_;
@@ -106,6 +127,7 @@ class RunSession {
   std::unique_ptr<CycleRunner> runner_;
   std::vector<int> allowed_cpus_;  ///< the process's CPUs, read before anything is pinned
   LoopThreadHooks* hooks_ = nullptr;
+  std::optional<RunFault> wait_fault_;  ///< the peer never came
   bool ran_ = false;
 };
 

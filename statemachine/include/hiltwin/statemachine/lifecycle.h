@@ -29,11 +29,13 @@
 ///   paused    --start-->      run
 ///   init|ready|run|paused --stop_request--> stopping   (reason stop_requested)
 ///   run|paused --finish_reached--> stopping             (reason finished)
+///   run|paused --peer_stopped-->   stopping             (reason peer_stopped)
 ///   run       --qos_abort-->  error                     (reason qos_abort)
 ///   init|ready|run|paused|stopping --io_fault|model_fault--> error
 ///   stopping  --drained-->    stopped     error --drained--> safe_stop
 ///   stopped|safe_stop --reset--> init
-///   ignored: stop_request, finish_reached, qos_abort in stopping/stopped/error/safe_stop;
+///   ignored: stop_request, finish_reached, peer_stopped, qos_abort in
+///            stopping/stopped/error/safe_stop;
 ///            io_fault, model_fault in error/stopped/safe_stop.
 ///
 /// The stop reason is the cause of the first transition out of init/ready/run/paused; a fault
@@ -76,6 +78,7 @@ enum class Event : std::uint8_t {
   kModelFault,     ///< the model produced a non-finite state
   kDrained,        ///< safe outputs written and the log flushed
   kReset,          ///< back to init for another run
+  kPeerStopped,    ///< the process on the other end of the link stopped cleanly (wire)
 };
 
 /// Why the run stopped; the strings are the run report's `stop_reason`.
@@ -86,6 +89,7 @@ enum class StopReason : std::uint8_t {
   kQosAbort,       ///< "qos_abort"
   kIoFault,        ///< "io_fault"
   kModelFault,     ///< "model_fault"
+  kPeerStopped,    ///< "peer_stopped": the other process ended its run (finish, stop, abort)
 };
 
 enum class Outcome : std::uint8_t {

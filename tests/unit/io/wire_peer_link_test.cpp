@@ -1,0 +1,87 @@
+// The wire's peer link, both sides in one process (they are different sides, so both may attach):
+// a side that waits keeps its heartbeat fresh with Poll, and a side that stops tells the other
+// why, so the other sees kPeerStopped (a clean end) instead of a lost heartbeat (a fault).
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "hiltwin/io/backend.h"
+#include "hiltwin/io/icoboard.h"
+#include "hiltwin/io/wire_bus.h"
+
+namespace hiltwin::io {
+namespace {
+
+std::string FreshName(const char* tag) {
+  const std::string name = std::string("utest-peer-") + tag + "-" + std::to_string(::getpid());
+  WireBus::Unlink(name);
+  return name;
+}
+
+TEST(WirePeerLink, PollSaysWhetherThePeerIsThereAndKeepsThisSideAlive) {
+  const std::string name = FreshName("poll");
+  WireBus twin(name, Image::kIcoboardInverse);
+  EXPECT_EQ(twin.Poll().result, BusResult::kPeerAbsent);
+  WireBus ecs(name, Image::kIcoboard);
+  EXPECT_EQ(twin.Poll().result, BusResult::kOk);
+  EXPECT_EQ(ecs.Poll().result, BusResult::kOk);
+}
+
+TEST(WirePeerLink, AnAnnouncedStopReachesThePeerWithItsCause) {
+  const std::string name = FreshName("stop");
+  WireBus twin_bus(name, Image::kIcoboardInverse);
+  WireBus ecs_bus(name, Image::kIcoboard);
+  IcoBoard ecs(ecs_bus);
+  IcoBoardInverse twin(twin_bus);
+  ASSERT_TRUE(twin.Init(250'000).ok);
+  ASSERT_TRUE(ecs.Init(1'000'000).ok);
+  EcsInputs in{};
+  const std::array<std::int32_t, kChannels> pwm{};
+  ExchangeStatus status = ecs.Exchange(pwm, in);
+  EXPECT_TRUE(status.ok());
+  EXPECT_EQ(status.peer_stopped, nullptr);
+
+  twin_bus.AnnounceStop(StopCause::kQosAbort);
+  status = ecs.Exchange(pwm, in);
+  EXPECT_TRUE(status.ok()) << status.reason;  // the ECS's own board still answered
+  ASSERT_NE(status.peer_stopped, nullptr);
+  EXPECT_STREQ(status.peer_stopped, "wire: the twin aborted its run on its QoS policy");
+  EXPECT_EQ(ecs_bus.Poll().result, BusResult::kPeerStopped);
+
+  ecs_bus.AnnounceStop(StopCause::kPeerStopped);
+  EXPECT_STREQ(twin_bus.PeerStatus().reason,
+               "wire: the ECS stopped because its peer had stopped");
+}
+
+TEST(WirePeerLink, AStoppedPeerThatDetachedStaysStoppedNotLost) {
+  const std::string name = FreshName("detach");
+  WireBus twin(name, Image::kIcoboardInverse);
+  {
+    WireBus ecs(name, Image::kIcoboard);
+    ecs.AnnounceStop(StopCause::kFinished);
+  }
+  const BusStatus status = twin.PeerStatus();
+  EXPECT_EQ(status.result, BusResult::kPeerStopped);
+  EXPECT_STREQ(status.reason, "wire: the ECS finished its run");
+  // A new ECS on the same wire starts afresh: its stop cause is cleared when it attaches.
+  WireBus next(name, Image::kIcoboard);
+  EXPECT_EQ(twin.Poll().result, BusResult::kOk);
+}
+
+TEST(WirePeerLink, OnlyTheWireBackendHasAPeer) {
+  EXPECT_EQ(OpenBackend("mock", {})->peer_link(), nullptr);
+  const std::string name = FreshName("backend");
+  EXPECT_NE(OpenBackend("wire:" + name, {})->peer_link(), nullptr);
+}
+
+TEST(StopCause, NamesMatchTheRunReportsStopReasons) {
+  EXPECT_STREQ(ToString(StopCause::kFinished), "finished");
+  EXPECT_STREQ(ToString(StopCause::kStopRequested), "stop_requested");
+  EXPECT_STREQ(ToString(StopCause::kQosAbort), "qos_abort");
+  EXPECT_STREQ(ToString(StopCause::kPeerStopped), "peer_stopped");
+}
+
+}  // namespace
+}  // namespace hiltwin::io
