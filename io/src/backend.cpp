@@ -32,7 +32,8 @@ class MockBackend final : public IoBackend {
 
 class WireBackend final : public IoBackend {
  public:
-  WireBackend(const std::string& name, Image side) : bus_(name, side) {}
+  WireBackend(const std::string& name, Image side, std::optional<Image> board_image)
+      : bus_(name, side, board_image) {}
   SpiBus& bus() noexcept override { return bus_; }
   EmulatedFpga* emulated_board() noexcept override { return &bus_.board(); }
   BackendSpec::Kind kind() const noexcept override { return BackendSpec::Kind::kWire; }
@@ -88,15 +89,16 @@ BackendSpec ParseBackendSpec(std::string_view text) {
 
 std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptions& options) {
   const BackendSpec parsed = ParseBackendSpec(spec);
-  if (options.mock_board_image && parsed.kind != BackendSpec::Kind::kMock) {
-    throw ConfigError("a board image can only be chosen for the mock backend, not for '" +
-                      std::string(spec) + "': the real or wired board carries its own image");
+  if (options.mock_board_image && parsed.kind == BackendSpec::Kind::kSpidev) {
+    throw ConfigError("a board image can only be chosen for an emulated board (mock, wire), "
+                      "not for '" + std::string(spec) + "': the real board carries its own image");
   }
   switch (parsed.kind) {
     case BackendSpec::Kind::kMock:
       return std::make_unique<MockBackend>(options.mock_board_image.value_or(options.side));
     case BackendSpec::Kind::kWire:
-      return std::make_unique<WireBackend>(parsed.argument, options.side);
+      return std::make_unique<WireBackend>(parsed.argument, options.side,
+                                           options.mock_board_image);
     case BackendSpec::Kind::kSpidev:
       return std::make_unique<SpidevBackend>(parsed.argument, options.spidev);
   }

@@ -257,8 +257,11 @@ bool LayOutOrCheck(WireSegment& segment) {
 
 }  // namespace
 
-WireBus::WireBus(const std::string& name, Image side)
-    : label_("wire:" + name), segment_name_(SegmentName(name)), side_(side), board_(side, &clock_) {
+WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board_image)
+    : label_("wire:" + name),
+      segment_name_(SegmentName(name)),
+      side_(side),
+      board_(board_image.value_or(side), &clock_) {
   segment_ = MapSegment(segment_name_, label_);
   if (!LayOutOrCheck(*segment_)) {
     ::munmap(segment_, sizeof(WireSegment));

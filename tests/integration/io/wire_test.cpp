@@ -310,8 +310,9 @@ TEST(WireBackend, ATwinStartingWhileTheEcsIsStaleInitialisesAndThenReportsTheEcs
   ASSERT_TRUE(ecs.Init(kEcsPeriodNs).ok);
   EcsInputs ecs_in;
   ASSERT_TRUE(ecs.Exchange({0, 0, 0, 0}, ecs_in).ok());
-  // The ECS's timeout is the 100 ms floor (20 × 200 µs is less): after 150 ms it counts as hung.
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  // The ECS's timeout is the floor (20 × 200 µs is less): 50 ms past it, it counts as hung.
+  std::this_thread::sleep_for(std::chrono::nanoseconds(kWireMinHeartbeatTimeoutNs) +
+                              std::chrono::milliseconds(50));
 
   WireBus twin_bus(name, Image::kIcoboardInverse);
   IcoBoardInverse twin(twin_bus);

@@ -105,8 +105,9 @@ TEST_F(RunCli, VirtualClockWithoutInjectionPassesWithExactCycleCounts) {
 
 TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
   const std::string wire = "wire:hiltwin_run_solo_" + std::to_string(getpid());
-  const auto r = Hiltwin(
-      Args({"--clock", "virtual", "--duration", "0.1", "--io", wire, "--report", Path("r.json")}));
+  // --wait-peer 0: start at once, without waiting for the controller.
+  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "0.1", "--io", wire,
+                               "--wait-peer", "0", "--report", Path("r.json")}));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["peer_absent_cycles"], 400);
@@ -114,6 +115,27 @@ TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
   EXPECT_NE(r.err.find("no controller was attached to " + wire + " in 400 of 400 cycles"),
             std::string::npos)
       << r.err;
+}
+
+TEST_F(RunCli, AWireNobodyServesCountsDownThenExitsFiveNamingTheOtherSidesCommand) {
+  const std::string wire = "wire:hiltwin_run_alone_" + std::to_string(getpid());
+  const auto r = Hiltwin(Args({"--duration", "1", "--io", wire, "--wait-peer", "1.2", "--report",
+                               Path("r.json")}));
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_NE(r.err.find("waiting for the controller on " + wire + ": 2 s left; start it with: "
+                       "hiltwin ecs --io " + wire),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("no controller came up on " + wire + " within 1.2 s"), std::string::npos)
+      << r.err;
+  const auto report = ReadJson(Path("r.json"));  // the report is written all the same
+  EXPECT_EQ(report["stop_reason"], "io_fault");
+  EXPECT_EQ(report["cycles_run"], 0);
+  EXPECT_EQ(report["outputs_safe"], true);
+  EXPECT_NE(report["fault"]["reason"].get<std::string>().find("hiltwin ecs --io " + wire),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/hiltwin-wire-hiltwin_run_alone_" +
+                                       std::to_string(getpid())));
 }
 
 TEST_F(RunCli, VirtualRunIsDeterministic) {

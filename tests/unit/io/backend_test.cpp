@@ -1,6 +1,10 @@
 #include "hiltwin/io/backend.h"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
+
+#include <string>
 
 #include "hiltwin/io/icoboard.h"
 
@@ -48,8 +52,14 @@ TEST(OpenBackend, MockCarriesTheRequestedBoardImage) {
   EXPECT_FALSE(init.ok);
   EXPECT_EQ(init.found, Image::kIcoboard);
 
-  // A board image is a mock-only choice.
-  EXPECT_THROW((void)OpenBackend("wire:x", options), ConfigError);
+  // An emulated board may carry the wrong image (mock and wire); a real one carries its own.
+  EXPECT_THROW((void)OpenBackend("spidev:/dev/spidev0.0", options), ConfigError);
+  const std::string name = "utest-backend-image-" + std::to_string(::getpid());
+  auto wired = OpenBackend("wire:" + name, options);
+  IcoBoardInverse twin3(wired->bus());
+  const InitResult wired_init = twin3.Init(1'000'000);
+  EXPECT_FALSE(wired_init.ok);
+  EXPECT_EQ(wired_init.found, Image::kIcoboard);
 }
 
 TEST(OpenBackend, MissingSpidevIsAnOsErrorNotAConfigError) {

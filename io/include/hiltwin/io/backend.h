@@ -39,7 +39,8 @@ struct BackendSpec {
 /// How to open a backend.
 struct BackendOptions {
   Image side = Image::kIcoboardInverse;     ///< the image this side's driver needs
-  std::optional<Image> mock_board_image;    ///< mock: image the emulated board carries (default: side)
+  /// mock, wire: the image the emulated board carries (default: side); fault injection
+  std::optional<Image> mock_board_image;
   SpidevConfig spidev{};
 };
 

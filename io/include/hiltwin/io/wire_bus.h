@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "hiltwin/io/emulated_fpga.h"
@@ -39,8 +40,9 @@ class WireBus final : public SpiBus, public PeerLink {
   /// Attaches to (or creates) the segment of `name` as the side that owns a board of `side`
   /// (icoboard = ECS, icoboard_inverse = twin). Throws std::invalid_argument for a bad name
   /// and std::runtime_error when the segment cannot be used or that side is already attached
-  /// by a live process.
-  WireBus(const std::string& name, Image side);
+  /// by a live process. `board_image` (fault injection) is the image this side's emulated
+  /// board carries, the side's own image when empty: the wrong one fails INIT's identity check.
+  WireBus(const std::string& name, Image side, std::optional<Image> board_image = {});
   ~WireBus() override;
   WireBus(const WireBus&) = delete;
   WireBus& operator=(const WireBus&) = delete;
