@@ -1,0 +1,143 @@
+#include "hiltwin/app_relbot/hil_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace hiltwin::app {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+/// Position of an exit code from best (0) to worst.
+int Severity(int code) noexcept {
+  switch (code) {
+    case 0: return 0;  // pass
+    case 3: return 1;  // flagged
+    case 4: return 2;  // aborted
+    case 5: return 3;  // I/O
+    case 2: return 4;  // usage
+    default: return 5;  // 1 internal, and anything unknown
+  }
+}
+
+std::uint64_t U64At(const std::optional<Json>& report, const Json::json_pointer& where) {
+  if (!report || !report->contains(where) || !report->at(where).is_number()) return 0;
+  return report->at(where).get<std::uint64_t>();
+}
+
+double DoubleAt(const Json& json, const Json::json_pointer& where) {
+  return json.contains(where) && json.at(where).is_number() ? json.at(where).get<double>()
+                                                            : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::optional<HilTracking> TrackingOf(const std::optional<Json>& ecs) {
+  if (!ecs || !ecs->contains("tracking") || !(*ecs)["tracking"].is_object()) return std::nullopt;
+  const Json& t = (*ecs)["tracking"];
+  HilTracking tracking;
+  tracking.max_left_m = DoubleAt(t, Json::json_pointer("/max_abs_error_m/left"));
+  tracking.max_right_m = DoubleAt(t, Json::json_pointer("/max_abs_error_m/right"));
+  tracking.rms_m = DoubleAt(t, Json::json_pointer("/rms_error_m"));
+  tracking.final_m = std::max(std::abs(DoubleAt(t, Json::json_pointer("/final_error_m/left"))),
+                              std::abs(DoubleAt(t, Json::json_pointer("/final_error_m/right"))));
+  return tracking;
+}
+
+Json SideExit(const HilSide& side) {
+  return {{"exit_code", ExitCodeOf(side.status)}, {"ended", side.status.Describe()}};
+}
+
+std::string SideLine(const HilSide& side) {
+  char text[400];
+  if (!side.report) {
+    std::snprintf(text, sizeof text, "%-5s no report (%s)\n", side.name.c_str(),
+                  side.status.Describe().c_str());
+    return text;
+  }
+  const Json& r = *side.report;
+  std::snprintf(text, sizeof text,
+                "%-5s %-8s stop %-15s %llu cycles at %.0f Hz, %llu misses (%.4f %%), %s\n",
+                side.name.c_str(), r.value("verdict", "?").c_str(),
+                r.value("stop_reason", "?").c_str(),
+                static_cast<unsigned long long>(r.value("cycles_run", 0ULL)),
+                r.value("rate_hz", 0.0),
+                static_cast<unsigned long long>(r.value("deadline_misses", 0ULL)),
+                r.value("miss_pct", 0.0), side.status.Describe().c_str());
+  return text;
+}
+
+}  // namespace
+
+int ExitCodeOf(const kernel_glue::ExitStatus& status) noexcept {
+  return status.exited ? status.code : 1;
+}
+
+int WorseExitCode(int a, int b) noexcept { return Severity(a) >= Severity(b) ? a : b; }
+
+HilResult CombineHil(std::string wire, std::string mode, HilSide twin, HilSide ecs) {
+  HilResult result;
+  result.wire = std::move(wire);
+  result.mode = std::move(mode);
+  result.tracking = TrackingOf(ecs.report);
+  result.link.twin_frames = U64At(twin.report, Json::json_pointer("/io_errors"));
+  result.link.ecs_frames = U64At(ecs.report, Json::json_pointer("/io_errors"));
+  result.link.encoder_line_errors =
+      U64At(ecs.report, Json::json_pointer("/encoder_lines/illegal_transitions")) +
+      U64At(ecs.report, Json::json_pointer("/encoder_lines/too_fast_edges")) +
+      U64At(ecs.report, Json::json_pointer("/encoder_lines/resyncs"));
+  result.exit_code = WorseExitCode(ExitCodeOf(twin.status), ExitCodeOf(ecs.status));
+  result.twin = std::move(twin);
+  result.ecs = std::move(ecs);
+  return result;
+}
+
+Json ToJson(const HilResult& r) {
+  Json json;
+  json["exit_code"] = r.exit_code;
+  json["wire"] = r.wire;
+  json["mode"] = r.mode;
+  if (r.tracking) {
+    json["tracking_error_max_m"] = {{"left", r.tracking->max_left_m},
+                                    {"right", r.tracking->max_right_m}};
+    json["tracking_error_rms_m"] = r.tracking->rms_m;
+    json["final_error_m"] = r.tracking->final_m;
+  } else {
+    json["tracking_error_max_m"] = nullptr;
+    json["tracking_error_rms_m"] = nullptr;
+    json["final_error_m"] = nullptr;
+  }
+  json["link_errors"] = r.link.total();
+  json["link_error_parts"] = {{"twin_frames_corrupted_or_missed", r.link.twin_frames},
+                              {"ecs_frames_corrupted_or_missed", r.link.ecs_frames},
+                              {"encoder_line_errors", r.link.encoder_line_errors}};
+  json["twin_exit"] = SideExit(r.twin);
+  json["ecs_exit"] = SideExit(r.ecs);
+  json["twin"] = r.twin.report ? *r.twin.report : Json(nullptr);
+  json["ecs"] = r.ecs.report ? *r.ecs.report : Json(nullptr);
+  return json;
+}
+
+std::string FormatHilSummary(const HilResult& r) {
+  std::string out = SideLine(r.twin) + SideLine(r.ecs);
+  char text[400];
+  if (r.tracking) {
+    std::snprintf(text, sizeof text,
+                  "tracking  max |error| left %.3f mm, right %.3f mm; rms %.3f mm; final %.3f mm\n",
+                  r.tracking->max_left_m * 1e3, r.tracking->max_right_m * 1e3,
+                  r.tracking->rms_m * 1e3, r.tracking->final_m * 1e3);
+    out += text;
+  }
+  std::snprintf(text, sizeof text,
+                "link      %llu errors (twin frames %llu, ECS frames %llu, encoder lines %llu)\n",
+                static_cast<unsigned long long>(r.link.total()),
+                static_cast<unsigned long long>(r.link.twin_frames),
+                static_cast<unsigned long long>(r.link.ecs_frames),
+                static_cast<unsigned long long>(r.link.encoder_line_errors));
+  out += text;
+  std::snprintf(text, sizeof text, "hil       exit %d (the worse of twin %d and ECS %d)\n",
+                r.exit_code, ExitCodeOf(r.twin.status), ExitCodeOf(r.ecs.status));
+  return out + text;
+}
+
+}  // namespace hiltwin::app

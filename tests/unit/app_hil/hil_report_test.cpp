@@ -1,0 +1,83 @@
+// The combined HiL result: figures are read from the ECS's and the twin's reports, a missing
+// report is "no figures" rather than an error, and the exit code is the worse of the two.
+#include "hiltwin/app_relbot/hil_report.h"
+
+#include <gtest/gtest.h>
+
+namespace hiltwin::app {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+kernel_glue::ExitStatus Exited(int code) {
+  kernel_glue::ExitStatus status;
+  status.exited = true;
+  status.code = code;
+  return status;
+}
+
+Json TwinReport() {
+  return Json{{"verdict", "PASS"}, {"stop_reason", "peer_stopped"}, {"io_errors", 2}};
+}
+
+Json EcsReport() {
+  return Json{{"verdict", "FLAGGED"},
+              {"stop_reason", "finished"},
+              {"io_errors", 1},
+              {"tracking",
+               {{"max_abs_error_m", {{"left", 0.0021}, {"right", 0.0019}}},
+                {"rms_error_m", 0.0008},
+                {"final_error_m", {{"left", -0.00004}, {"right", 0.00002}}}}},
+              {"encoder_lines",
+               {{"illegal_transitions", 3}, {"too_fast_edges", 0}, {"resyncs", 4}}}};
+}
+
+TEST(HilReport, FiguresComeFromBothReports) {
+  const HilResult r = CombineHil("wire:x", "closedloop", {"twin", Exited(0), TwinReport()},
+                                 {"ecs", Exited(3), EcsReport()});
+  ASSERT_TRUE(r.tracking.has_value());
+  EXPECT_DOUBLE_EQ(r.tracking->max_left_m, 0.0021);
+  EXPECT_DOUBLE_EQ(r.tracking->max_right_m, 0.0019);
+  EXPECT_DOUBLE_EQ(r.tracking->rms_m, 0.0008);
+  EXPECT_DOUBLE_EQ(r.tracking->final_m, 0.00004);  // the larger magnitude of the two wheels
+  EXPECT_EQ(r.link.twin_frames, 2U);
+  EXPECT_EQ(r.link.ecs_frames, 1U);
+  EXPECT_EQ(r.link.encoder_line_errors, 7U);
+  EXPECT_EQ(r.exit_code, 3);
+  const Json json = ToJson(r);
+  EXPECT_EQ(json["link_errors"], 10);
+  EXPECT_DOUBLE_EQ(json["tracking_error_max_m"]["left"].get<double>(), 0.0021);
+  EXPECT_DOUBLE_EQ(json["final_error_m"].get<double>(), 0.00004);
+  EXPECT_EQ(json["twin"]["stop_reason"], "peer_stopped");
+  EXPECT_EQ(json["ecs"]["verdict"], "FLAGGED");
+  EXPECT_EQ(json["ecs_exit"]["exit_code"], 3);
+  const std::string summary = FormatHilSummary(r);
+  EXPECT_NE(summary.find("max |error| left 2.100 mm, right 1.900 mm"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("exit 3 (the worse of twin 0 and ECS 3)"), std::string::npos) << summary;
+}
+
+TEST(HilReport, AMissingReportLeavesTheFiguresOutAndACrashIsInternal) {
+  kernel_glue::ExitStatus killed;
+  killed.signal = 9;
+  const HilResult r = CombineHil("wire:x", "closedloop", {"twin", Exited(5), TwinReport()},
+                                 {"ecs", killed, std::nullopt});
+  EXPECT_FALSE(r.tracking.has_value());
+  EXPECT_EQ(r.exit_code, 1);
+  const Json json = ToJson(r);
+  EXPECT_TRUE(json["ecs"].is_null());
+  EXPECT_TRUE(json["tracking_error_rms_m"].is_null());
+  EXPECT_NE(FormatHilSummary(r).find("ecs   no report"), std::string::npos);
+}
+
+TEST(HilReport, WorseExitCodeOrdersPassFlaggedAbortedIoUsageInternal) {
+  const int order[] = {0, 3, 4, 5, 2, 1};
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      EXPECT_EQ(WorseExitCode(order[i], order[j]), order[std::max(i, j)]) << i << "," << j;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hiltwin::app
