@@ -121,10 +121,10 @@ std::span<const EcsGainSpec> EcsGainSpecs() noexcept { return kSpecs; }
 
 PidGains DefaultEcsGains() noexcept {
   PidGains gains;
-  gains.kp_duty_per_m = 60.0;
-  gains.ki_duty_per_m_s = 300.0;
-  gains.kd_duty_s_per_m = 1.0;
-  gains.derivative_filter_s = 0.004;
+  gains.kp_duty_per_m = 100.0;
+  gains.ki_duty_per_m_s = 1000.0;
+  gains.kd_duty_s_per_m = 3.0;
+  gains.derivative_filter_s = 0.005;
   gains.duty_limit = 1.0;
   return gains;
 }

@@ -37,6 +37,7 @@ InProcessHil::InProcessHil(const HilConfig& config)
       rest_from_s_(LengthS(config) - config.rest_window_s),
       params_(DefaultRelbotParams()),
       geometry_(WheelGeometryOf(params_)),
+      count_m_(1.0 / io::CountsPerMetre(geometry_)),
       model_(params_, Integrator::kRk4, 1.0 / config.twin_rate_hz),
       twin_(twin_driver_, model_, geometry_),
       ecs_(config.setpoints != nullptr
@@ -89,6 +90,11 @@ void InProcessHil::Observe(std::uint64_t ecs_cycle) noexcept {
         std::max(seen_.max_abs_true_error_left_m, std::abs(seen_.final_true_error_left_m));
     seen_.max_abs_true_error_right_m =
         std::max(seen_.max_abs_true_error_right_m, std::abs(seen_.final_true_error_right_m));
+    const double error_left_m = r.setpoint.left_m - r.measured.left_m;
+    const double error_right_m = r.setpoint.right_m - r.measured.right_m;
+    if (std::max(std::abs(error_left_m), std::abs(error_right_m)) > count_m_) {
+      seen_.last_error_above_one_count_s = r.time_s;
+    }
   }
   if (r.time_s < rest_from_s_) return;
   const double left = r.duty_next.left;

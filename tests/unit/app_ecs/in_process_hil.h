@@ -55,6 +55,9 @@ struct HilObservations {
   std::uint64_t rest_duty_sign_changes = 0;  ///< per wheel, summed: hunting shows up here
   double final_true_error_left_m = 0.0;
   double final_true_error_right_m = 0.0;
+  /// The last ECS sampling time at which either wheel's error exceeded one encoder count
+  /// (closed loop): from then on the loop has settled to within one count.
+  double last_error_above_one_count_s = 0.0;
 };
 
 class InProcessHil final : public runtime::RunTask {
@@ -86,6 +89,7 @@ class InProcessHil final : public runtime::RunTask {
   double rest_from_s_;
   RelbotParams params_;
   io::WheelGeometry geometry_;
+  double count_m_;  ///< one encoder count in metres
   RelbotModel model_;
   io::EmulatedFpga twin_board_{io::Image::kIcoboardInverse};
   io::EmulatedFpga ecs_board_{io::Image::kIcoboard};
