@@ -5,11 +5,11 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 
 namespace hiltwin::app {
 namespace {
@@ -156,8 +156,9 @@ PidGains ParseEcsGains(std::string_view toml_text, std::string_view source_name)
 PidGains LoadEcsGains(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
+    // generic_category().message, not strerror: the command may already run other threads.
     throw ConfigError(path.string() + ": cannot read the ECS gains file (" +
-                      std::string(std::strerror(errno)) +
+                      std::generic_category().message(errno) +
                       "); check the path, or run without a gains file to use the built-in "
                       "gains");
   }
