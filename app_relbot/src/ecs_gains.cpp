@@ -5,11 +5,11 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 
 namespace hiltwin::app {
 namespace {
@@ -121,10 +121,10 @@ std::span<const EcsGainSpec> EcsGainSpecs() noexcept { return kSpecs; }
 
 PidGains DefaultEcsGains() noexcept {
   PidGains gains;
-  gains.kp_duty_per_m = 60.0;
-  gains.ki_duty_per_m_s = 300.0;
-  gains.kd_duty_s_per_m = 1.0;
-  gains.derivative_filter_s = 0.004;
+  gains.kp_duty_per_m = 100.0;
+  gains.ki_duty_per_m_s = 1000.0;
+  gains.kd_duty_s_per_m = 3.0;
+  gains.derivative_filter_s = 0.005;
   gains.duty_limit = 1.0;
   return gains;
 }
@@ -156,8 +156,9 @@ PidGains ParseEcsGains(std::string_view toml_text, std::string_view source_name)
 PidGains LoadEcsGains(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
+    // generic_category().message, not strerror: the command may already run other threads.
     throw ConfigError(path.string() + ": cannot read the ECS gains file (" +
-                      std::string(std::strerror(errno)) +
+                      std::generic_category().message(errno) +
                       "); check the path, or run without a gains file to use the built-in "
                       "gains");
   }

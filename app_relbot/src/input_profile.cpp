@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "hiltwin/analysis/csv.h"
@@ -27,19 +28,47 @@ bool EqualsIgnoreCase(std::string_view a, std::string_view b) {
          });
 }
 
+// Where the duties are: columns 2 and 3 of a profile 'time,left,right', or the duty_left and
+// duty_right columns of a hiltwin log (`hiltwin ecs --mode openloop` logs the duty on the wire
+// there, `hiltwin run` the duty it read), whose other columns are ignored. So an ECS log
+// replays as the input of a reference run without editing (thesis §5.2).
+struct DutyColumns {
+  std::size_t left = 1;
+  std::size_t right = 2;
+};
+
+std::optional<DutyColumns> FindLogDutyColumns(const analysis::CsvTable& table) {
+  std::optional<std::size_t> left;
+  std::optional<std::size_t> right;
+  for (std::size_t i = 1; i < table.names.size(); ++i) {
+    if (EqualsIgnoreCase(table.names[i], "duty_left")) left = i;
+    if (EqualsIgnoreCase(table.names[i], "duty_right")) right = i;
+  }
+  if (!left || !right) return std::nullopt;
+  return DutyColumns{*left, *right};
+}
+
+DutyColumns DutyColumnsOf(const analysis::CsvTable& table) {
+  return FindLogDutyColumns(table).value_or(DutyColumns{});
+}
+
 // The header names the columns, so a file with left and right swapped or a log of another
-// kind is refused instead of played: time (or time_s), left, right, in any letter case.
+// kind is refused instead of played: time (or time_s), left, right, in any letter case; or
+// time and a log's duty_left and duty_right.
 void CheckProfileHeader(const analysis::CsvTable& table, std::size_t line) {
   constexpr std::string_view kAdvice =
       "; add that header as the first line (time in seconds, duties in [-1, 1])";
-  const std::string_view expected = "expected the header 'time,left,right'";
+  const std::string_view expected =
+      "expected the header 'time,left,right' (or a hiltwin log with the columns duty_left and "
+      "duty_right)";
   if (!table.has_header) {
     throw analysis::InputError(analysis::CsvLocation(table.path, line, 1) + ": " +
                                std::string(expected) + ", found a row of numbers" +
                                std::string(kAdvice));
   }
+  const bool is_log = FindLogDutyColumns(table).has_value();
   constexpr std::array<std::string_view, 3> kNames{"time", "left", "right"};
-  for (std::size_t i = 0; i < kNames.size(); ++i) {
+  for (std::size_t i = 0; i < (is_log ? 1 : kNames.size()); ++i) {
     const bool ok = i < table.names.size() &&
                     (EqualsIgnoreCase(table.names[i], kNames[i]) ||
                      (i == 0 && EqualsIgnoreCase(table.names[i], "time_s")));
@@ -51,10 +80,11 @@ void CheckProfileHeader(const analysis::CsvTable& table, std::size_t line) {
                                  std::string(kAdvice));
     }
   }
-  if (table.names.size() > kNames.size()) {
+  if (!is_log && table.names.size() > kNames.size()) {
     throw analysis::InputError(analysis::CsvLocation(table.path, line, kNames.size() + 1) +
                                ": the header has more than the three columns time,left,right; "
-                               "remove the extra columns");
+                               "remove the extra columns (a hiltwin log is read by its "
+                               "duty_left and duty_right columns)");
   }
 }
 
@@ -70,7 +100,9 @@ analysis::CsvRules ProfileRules() {
 // What the reader cannot know about a profile: it starts at 0 s or later, duties are
 // fractions of the supply voltage, and the period is > 0.
 std::vector<ProfileKnot> KnotsOf(const analysis::CsvTable& table) {
-  constexpr std::array<std::string_view, 3> kWhat{"time", "left duty", "right duty"};
+  const DutyColumns duty = DutyColumnsOf(table);
+  const std::array<std::size_t, 2> columns{duty.left, duty.right};
+  constexpr std::array<std::string_view, 2> kWhat{"left duty", "right duty"};
   std::vector<ProfileKnot> knots;
   for (std::size_t row = 0; row < table.rows(); ++row) {
     const double time_s = table.columns[0][row];
@@ -78,16 +110,18 @@ std::vector<ProfileKnot> KnotsOf(const analysis::CsvTable& table) {
       throw analysis::InputError(table.Where(row, 0) + ": time " + analysis::NumberText(time_s) +
                                  " s is negative; profiles start at time 0 or later");
     }
-    for (std::size_t c = 1; c < kWhat.size(); ++c) {
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      const std::size_t c = columns[i];
       if (!DutyOk(table.columns[c][row])) {
         throw analysis::InputError(
-            table.Where(row, c) + ": " + std::string(kWhat[c]) + " " +
+            table.Where(row, c) + ": " + std::string(kWhat[i]) + " " +
             analysis::NumberText(table.columns[c][row]) +
             " is outside [-1, 1]; duty is a fraction of the supply voltage: scale the column "
             "into [-1, 1]");
       }
     }
-    knots.push_back(ProfileKnot{time_s, Duty{table.columns[1][row], table.columns[2][row]}});
+    knots.push_back(
+        ProfileKnot{time_s, Duty{table.columns[duty.left][row], table.columns[duty.right][row]}});
   }
   if (!(knots.back().time_s > 0.0)) {
     throw analysis::InputError(table.Where(table.rows() - 1, 0) +

@@ -35,8 +35,7 @@ double PositionPid::Step(double setpoint_m, double measured_m) noexcept {
                      derivative_gain_duty_per_m_ * (measured_m - previous_measured_m_);
   previous_measured_m_ = measured_m;
 
-  const double candidate_i =
-      std::clamp(integral_duty_ + integral_per_step_duty_per_m_ * error_m, -limit, limit);
+  const double candidate_i = integral_duty_ + integral_per_step_duty_per_m_ * error_m;
   const double candidate_u = p_duty + candidate_i + derivative_duty_;
   // Conditional integration: while the output is beyond the limit, an error that pushes it
   // further out must not grow the integral (it would have to unwind before the output moves).

@@ -93,9 +93,9 @@ std::vector<SetpointKnot> KnotsOf(const analysis::CsvTable& table) {
 }
 
 template <typename ReadTable>
-SetpointProfile ProfileFromCsv(std::string name, ReadTable read_table) {
+SetpointProfile ProfileFromCsv(const std::string& name, const ReadTable& read_table) {
   try {
-    return SetpointProfile::FromKnots(std::move(name), KnotsOf(read_table()));
+    return SetpointProfile::FromKnots(name, KnotsOf(read_table()));
   } catch (const analysis::InputError& error) {
     throw ProfileError(error.what());
   }

@@ -139,25 +139,40 @@ TEST(PositionPid, ConditionalIntegrationHoldsTheIntegralWhileSaturated) {
   EXPECT_LT(u, -0.5);
 }
 
-TEST(PositionPid, IntegralNeverExceedsTheDutyLimit) {
-  // P and D pull the other way (the wheel is racing towards the setpoint), so the output is
-  // not saturated while the integral keeps integrating: the clamp bounds it.
-  PidGains g = P(1.0);
+TEST(PositionPid, RampIsTrackedWithoutErrorAndTheIntegralCancelsTheDerivative) {
+  // With the plant's integrator the loop is type 2: a constant-speed setpoint is tracked
+  // without error. At speed v the derivative on the measurement is a steady -kd·v, which the
+  // integral cancels even beyond the duty limit (here it must reach v/K + kd·v = 1.5).
+  PidGains g = P(100.0);
   g.ki_duty_per_m_s = 1000.0;
-  g.kd_duty_s_per_m = 10.0;
+  g.kd_duty_s_per_m = 2.0;
+  g.derivative_filter_s = 0.004;
+  g.duty_limit = 1.0;
+  PositionPid pid(g, kPeriodS);
+  IntegratorPlant plant;
+  const double v_m_per_s = 0.5;
+  for (int k = 0; k < 10'000; ++k) plant.Step(pid.Step(v_m_per_s * k * kPeriodS, plant.position_m));
+  const double error_m = v_m_per_s * 10'000 * kPeriodS - plant.position_m;  // plant is one step on
+  EXPECT_NEAR(error_m, 0.0, 1e-9);
+  EXPECT_NEAR(pid.integral_duty(), 0.5 + 2.0 * 0.5, 1e-6);
+  EXPECT_NEAR(pid.last().d_duty, -2.0 * 0.5, 1e-9);
+  EXPECT_NEAR(pid.last().output_duty, 0.5, 1e-6);
+  EXPECT_FALSE(pid.last().saturated);
+}
+
+TEST(PositionPid, IntegralStopsGrowingOnceTheOutputSaturatesItsWay) {
+  // The integral alone drives a blocked wheel: it grows only until P + I + D reaches the limit.
+  PidGains g = P(0.0);
+  g.ki_duty_per_m_s = 1000.0;
   g.duty_limit = 0.8;
   PositionPid pid(g, kPeriodS);
   pid.Reset(0.0);
-  double max_integral = 0.0;
-  double y = 0.0;
-  for (int k = 0; k < 2000; ++k) {
-    y += 0.05 * kPeriodS;         // 0.05 m/s: D = -0.5 duty
-    (void)pid.Step(y + 0.05, y);  // 5 cm ahead of the wheel: P = 0.05 duty
-    max_integral = std::max(max_integral, pid.integral_duty());
-  }
-  EXPECT_NEAR(pid.last().output_duty, 0.05 + 0.8 - 0.5, 1e-9);
-  EXPECT_EQ(max_integral, 0.8);
-  EXPECT_FALSE(pid.last().saturated);  // it really was the clamp, not the conditional rule
+  for (int k = 0; k < 5000; ++k) (void)pid.Step(0.01, 0.0);  // +0.01 duty per step
+  // It stops within one step's increment below the limit and stays there.
+  EXPECT_LE(pid.integral_duty(), 0.8);
+  EXPECT_GT(pid.integral_duty(), 0.8 - 0.01 - 1e-12);
+  EXPECT_TRUE(pid.last().integration_held);
+  EXPECT_EQ(pid.last().output_duty, pid.integral_duty());
 }
 
 TEST(PositionPid, NonFiniteInputsStopTheMotorAndKeepTheState) {

@@ -197,6 +197,39 @@ TEST(CsvProfile, ReadsWhatTheAssessReaderReads) {
   }
 }
 
+TEST(CsvProfile, ReadsTheDutyColumnsOfAHiltwinLogAndIgnoresTheRest) {
+  // An ECS open-loop log as RunSession writes it: time_s, the task's columns, timing columns.
+  const char* log =
+      "time_s,duty_left,duty_right,wheel_left_m,wheel_right_m,enc_left,enc_right,cycle,"
+      "latency_us,compute_us,io_us,missed\n"
+      "0,0,0,0,0,0,0,0,0,1.5,0.2,0\n"
+      "0.001,0.25,-0.5,0,0,0,0,1,0,1.5,0.2,0\n"
+      "0.002,0.5,-1,0.0001,-0.0001,1,-1,2,3.5,1.5,0.2,1\n";
+  const InputProfile profile = ParseCsvProfile(log, "ecs.csv");
+  ASSERT_EQ(profile.knots().size(), 3U);
+  EXPECT_EQ(profile.knots()[1].duty.left, 0.25);
+  EXPECT_EQ(profile.knots()[2].duty.right, -1.0);
+  EXPECT_EQ(profile.period_s(), 0.002);
+  // Any order of the columns, as long as both are named (the twin's log has them first).
+  const InputProfile swapped =
+      ParseCsvProfile("time,duty_right,x_m,duty_left\n0,0.1,5,0.2\n1,0.3,6,0.4\n", "t.csv");
+  EXPECT_EQ(swapped.knots()[1].duty.left, 0.4);
+  EXPECT_EQ(swapped.knots()[1].duty.right, 0.3);
+}
+
+TEST(CsvProfile, LogColumnsAreCheckedLikeProfileColumns) {
+  const std::string bad_duty =
+      ErrorOf("time_s,wheel_left_m,duty_left,duty_right\n0,0,0,0\n1,0,1.5,0\n");
+  EXPECT_EQ(bad_duty.rfind("p.csv:3:3: left duty 1.5 is outside [-1, 1]", 0), 0U) << bad_duty;
+  // Only one of the two duty columns: not a log, and not a profile either.
+  const std::string half = ErrorOf("time_s,duty_left,wheel_left_m\n0,0,0\n1,0,0\n");
+  EXPECT_EQ(half.rfind("p.csv:1:2: expected the header 'time,left,right' (or a hiltwin log", 0),
+            0U)
+      << half;
+  const std::string no_time = ErrorOf("cycle,duty_left,duty_right\n0,0,0\n1,0,0\n");
+  EXPECT_EQ(no_time.rfind("p.csv:1:1:", 0), 0U) << no_time;
+}
+
 TEST(LoadInputProfile, BuiltInNameFileOrAClearError) {
   EXPECT_EQ(LoadInputProfile("openloop").name(), "openloop");
   ASSERT_EQ(BuiltinProfileNames().size(), 1U);

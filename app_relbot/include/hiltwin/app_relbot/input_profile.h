@@ -65,8 +65,11 @@ class InputProfile {
 [[nodiscard]] InputProfile OpenLoopProfile();
 
 /// Parses CSV text with the reader of `hiltwin assess` (analysis::ParseCsv): header
-/// `time,left,right`, then one row per knot. `source_name` is used in messages
-/// ("file:line:column: ...", column = CSV field). Throws ProfileError.
+/// `time,left,right`, then one row per knot. A hiltwin log (first column time or time_s, with
+/// columns named duty_left and duty_right, e.g. `hiltwin ecs --mode openloop --log`) is read
+/// by those two columns and its other columns are ignored, so a logged run replays as a
+/// profile. `source_name` is used in messages ("file:line:column: ...", column = CSV field).
+/// Throws ProfileError.
 [[nodiscard]] InputProfile ParseCsvProfile(std::string_view text, std::string_view source_name);
 
 /// Reads and parses a CSV profile file. Throws ProfileError (also when it cannot be read).

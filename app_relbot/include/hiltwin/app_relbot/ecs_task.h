@@ -1,0 +1,148 @@
+#pragma once
+/// The RELbot's embedded control system (ECS) as a run task: the same code drives the twin
+/// (mock or wire backend) or the real robot (spidev), through the ECS image of the IcoBoard.
+/// Per cycle (DESIGN.md "One cycle, as data flows"): one full-duplex exchange (the duty the
+/// last step computed goes out, the encoder counts come in), then one step that computes the
+/// duty for the next exchange. Two modes:
+///
+/// - closed loop (default): wheel position setpoints from a SetpointProfile, one PositionPid
+///   per wheel, tracking-error statistics (thesis §7.2, appendix E). The PID gets the setpoint
+///   rounded to a whole encoder count: the encoder reads only whole counts, so a setpoint
+///   between two of them could never be met and the integral would make the wheel hunt across
+///   the count edge at rest. Logs and statistics use the profile's own setpoint;
+/// - open loop (`--mode openloop`): plays a duty InputProfile and logs the duty on the wire
+///   and the measured wheel positions every cycle (thesis §5.2, fig. 5.2), so the log can be
+///   replayed into a reference run (LoadInputProfile reads its duty_left,duty_right columns).
+///
+/// Time is the task's own: cycle × period_ns, exact multiples, never accumulated. The cycle
+/// of the exchange is the sampling moment: the counts read in cycle k are the wheels at
+/// t_k = k·period, and the duty computed in step k is on the wire from t_{k+1}. Everything on
+/// the loop's path is noexcept and allocation-free.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/app_relbot/position_pid.h"
+#include "hiltwin/app_relbot/relbot_channels.h"
+#include "hiltwin/app_relbot/setpoint_profile.h"
+#include "hiltwin/io/conversions.h"
+#include "hiltwin/io/icoboard.h"
+#include "hiltwin/runtime/run_task.h"
+
+namespace hiltwin::app {
+
+enum class EcsMode : std::uint8_t { kClosedLoop, kOpenLoop };
+
+/// Closed-loop tracking error (setpoint - measured, both in metres of wheel travel) over every
+/// step since the start. Constant memory; kept on the loop thread, read after the run.
+struct TrackingStats {
+  std::uint64_t samples = 0;  ///< steps counted
+  double max_abs_error_left_m = 0.0;
+  double max_abs_error_right_m = 0.0;
+  double rms_error_left_m = 0.0;
+  double rms_error_right_m = 0.0;
+  double rms_error_m = 0.0;         ///< over both wheels together
+  double final_error_left_m = 0.0;  ///< at the last step
+  double final_error_right_m = 0.0;
+  std::uint64_t saturated_cycles = 0;  ///< steps in which either wheel's output hit its limit
+  double max_abs_duty = 0.0;           ///< largest |duty| commanded, either wheel
+};
+
+/// What the last step read, computed and sent: the log row's source.
+struct EcsCycleRecord {
+  std::uint64_t cycle = 0;
+  double time_s = 0.0;      ///< cycle · period: when the counts were read
+  Duty duty_sent;           ///< on the wire from time_s (this cycle's exchange), as quantised
+  Duty duty_next;           ///< this step's output, on the wire from the next exchange
+  WheelPositions measured;  ///< wheel travel since the first step, from the encoder counts
+  WheelPositions setpoint;  ///< closed loop; zero in open loop
+  std::array<std::int64_t, 2> counts{};  ///< encoder counts since the first step: left, right
+};
+
+/// The ECS's cyclic work.
+class EcsTask final : public runtime::RunTask {
+ public:
+  /// Closed loop. `geometry` converts counts to metres (WheelGeometryOf(params) of the robot
+  /// or twin being driven); `period_ns` is the ECS cycle and must equal the session's period.
+  /// Throws ConfigError for invalid gains and std::invalid_argument for period_ns <= 0.
+  /// `board` and `setpoints` are not owned and must outlive the task.
+  EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints, const PidGains& gains,
+          const io::WheelGeometry& geometry, std::int64_t period_ns);
+  /// Open loop: plays `duty_profile` (repeating with its period), sampled at the ECS's cycle.
+  EcsTask(io::IcoBoard& board, const InputProfile& duty_profile, const io::WheelGeometry& geometry,
+          std::int64_t period_ns);
+
+  /// Live: sends the duty of the last step. Safe: sends zero duty (motors off).
+  io::ExchangeStatus Exchange(bool live_outputs) noexcept override;
+  /// Never finishes on its own: after the setpoint profile's end the last setpoint holds (the
+  /// robot is kept in place) and a duty profile repeats, so the command's duration decides.
+  /// A session period other than the task's is a fault (the gains were discretised for it).
+  runtime::StepStatus Step(const scheduler::CycleContext& context) noexcept override;
+  /// Closed loop: setpoint_left_m, setpoint_right_m, wheel_left_m, wheel_right_m,
+  /// error_left_m, error_right_m, duty_left, duty_right, enc_left, enc_right.
+  /// Open loop: duty_left, duty_right, wheel_left_m, wheel_right_m, enc_left, enc_right.
+  /// duty_* is the duty on the wire from time_s on, so a log replays as a duty profile.
+  [[nodiscard]] std::vector<std::string> LogColumns() const override;
+  [[nodiscard]] double LogTimeS() const noexcept override { return last_.time_s; }
+  void FillLogRow(std::span<double> values) const noexcept override;
+
+  [[nodiscard]] EcsMode mode() const noexcept { return mode_; }
+  [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
+  /// The profile's length in seconds: the setpoint profile's last time, or one period of the
+  /// duty profile. The command's default duration.
+  [[nodiscard]] double length_s() const noexcept;
+  [[nodiscard]] const EcsCycleRecord& last() const noexcept { return last_; }
+  /// Closed-loop statistics so far (all zero in open loop). Not synchronised: read it when
+  /// the loop is not running (after RunSession::Run returns).
+  [[nodiscard]] TrackingStats tracking() const noexcept;
+  [[nodiscard]] const PositionPid& pid_left() const noexcept { return pid_left_; }
+  [[nodiscard]] const PositionPid& pid_right() const noexcept { return pid_right_; }
+  [[nodiscard]] const io::EcsInputs& inputs() const noexcept { return inputs_; }
+
+ private:
+  /// Running sums behind TrackingStats.
+  struct TrackingSums {
+    std::uint64_t samples = 0;
+    double max_abs_left_m = 0.0;
+    double max_abs_right_m = 0.0;
+    double sum_sq_left_m2 = 0.0;
+    double sum_sq_right_m2 = 0.0;
+    double final_left_m = 0.0;
+    double final_right_m = 0.0;
+    std::uint64_t saturated_cycles = 0;
+    double max_abs_duty = 0.0;
+  };
+
+  EcsTask(io::IcoBoard& board, EcsMode mode, const SetpointProfile* setpoints,
+          const InputProfile* duty_profile, const PidGains& gains,
+          const io::WheelGeometry& geometry, std::int64_t period_ns);
+  void ReadWheels() noexcept;
+  Duty StepClosedLoop() noexcept;
+  /// `metres` rounded to the nearest whole encoder count.
+  [[nodiscard]] double OnEncoderGrid(double metres) const noexcept;
+  void SetNextDuty(const Duty& duty) noexcept;
+
+  io::IcoBoard& board_;
+  EcsMode mode_;
+  const SetpointProfile* setpoints_;  ///< closed loop
+  const InputProfile* duty_profile_;  ///< open loop
+  io::WheelGeometry geometry_;
+  double counts_per_m_;  ///< io::CountsPerMetre(geometry_), once
+  std::int64_t period_ns_;
+  PositionPid pid_left_;
+  PositionPid pid_right_;
+  io::EcsInputs inputs_{};
+  std::array<std::int32_t, io::kChannels> pwm_next_{};  ///< computed by the last step
+  std::array<std::int32_t, io::kChannels> pwm_sent_{};  ///< on the wire since the last exchange
+  std::array<std::int64_t, 2> origin_counts_{};         ///< left, right at the first step
+  bool have_inputs_ = false;  ///< an exchange has succeeded: the counts are a reading
+  bool started_ = false;      ///< the origin is taken
+  EcsCycleRecord last_{};
+  TrackingSums sums_{};
+};
+
+}  // namespace hiltwin::app

@@ -1,0 +1,144 @@
+#include "in_process_hil.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "hiltwin/kernel_glue/clock.h"
+
+namespace hiltwin::app::test {
+namespace {
+
+std::uint64_t TwinPerEcs(const HilConfig& config) {
+  const double ratio = config.twin_rate_hz / config.ecs_rate_hz;
+  if (!(ratio >= 1.0) || ratio != std::floor(ratio)) {
+    throw std::invalid_argument("the twin's rate must be a whole multiple of the ECS's");
+  }
+  return static_cast<std::uint64_t>(ratio);
+}
+
+double LengthS(const HilConfig& config) {
+  if (config.duration_s > 0.0) return config.duration_s;
+  return config.setpoints != nullptr ? config.setpoints->length_s()
+                                     : config.duty_profile->period_s();
+}
+
+}  // namespace
+
+InProcessHil::InProcessHil(const HilConfig& config)
+    : config_(config),
+      ecs_period_ns_(kernel_glue::PeriodNsFromRateHz(config.ecs_rate_hz)),
+      twin_period_ns_(kernel_glue::PeriodNsFromRateHz(config.twin_rate_hz)),
+      twin_per_ecs_(TwinPerEcs(config)),
+      planned_cycles_(
+          static_cast<std::uint64_t>(std::llround(LengthS(config) * config.ecs_rate_hz))),
+      rest_from_s_(LengthS(config) - config.rest_window_s),
+      params_(DefaultRelbotParams()),
+      geometry_(WheelGeometryOf(params_)),
+      count_m_(1.0 / io::CountsPerMetre(geometry_)),
+      model_(params_, Integrator::kRk4, 1.0 / config.twin_rate_hz),
+      twin_(twin_driver_, model_, geometry_),
+      ecs_(config.setpoints != nullptr
+               ? EcsTask(ecs_driver_, *config.setpoints, config.gains, geometry_, ecs_period_ns_)
+               : EcsTask(ecs_driver_, *config.duty_profile, geometry_, ecs_period_ns_)) {
+  ecs_board_.SetEncoderSource(&encoder_lines_);
+  twin_board_.SetPwmSource(&pwm_lines_);
+  if (!twin_driver_.Init(twin_period_ns_).ok || !ecs_driver_.Init(ecs_period_ns_).ok) {
+    throw std::runtime_error("the emulated boards refused INIT");
+  }
+}
+
+io::ExchangeStatus InProcessHil::Exchange(bool live_outputs) noexcept {
+  const io::ExchangeStatus status = ecs_.Exchange(live_outputs);
+  if (!status.ok()) ++seen_.link_errors;
+  return status;
+}
+
+runtime::StepStatus InProcessHil::Step(const scheduler::CycleContext& context) noexcept {
+  const runtime::StepStatus ecs_status = ecs_.Step(context);
+  if (ecs_status.code != runtime::StepStatus::Code::kOk) return ecs_status;
+  Observe(context.cycle);
+  for (std::uint64_t i = 0; i < twin_per_ecs_; ++i, ++twin_cycle_) {
+    if (!twin_.Exchange(true).ok()) ++seen_.link_errors;
+    scheduler::CycleContext twin_context;
+    twin_context.cycle = twin_cycle_;
+    twin_context.period_ns = twin_period_ns_;
+    twin_context.release_ns = static_cast<std::int64_t>(twin_cycle_) * twin_period_ns_;
+    twin_context.model_time_ns = twin_context.release_ns;
+    if (twin_board_.time_ns() != twin_context.release_ns) ++seen_.board_time_mismatches;
+    const runtime::StepStatus twin_status = twin_.Step(twin_context);
+    if (twin_status.code != runtime::StepStatus::Code::kOk) return twin_status;
+  }
+  return runtime::StepStatus::Ok();
+}
+
+void InProcessHil::Observe(std::uint64_t ecs_cycle) noexcept {
+  ++seen_.ecs_cycles;
+  if (ecs_board_.time_ns() != static_cast<std::int64_t>(ecs_cycle) * ecs_period_ns_ ||
+      ecs_board_.data_frames() != ecs_cycle + 1) {
+    ++seen_.board_time_mismatches;
+  }
+  const EcsCycleRecord& r = ecs_.last();
+  // The model has integrated up to t_k exactly when the ECS samples (twin cycles 0 .. r·k - 1).
+  const RelbotOutputs truth = model_.Outputs();
+  if (ecs_.mode() == EcsMode::kClosedLoop) {
+    seen_.final_true_error_left_m = r.setpoint.left_m - truth.wheel_left_m;
+    seen_.final_true_error_right_m = r.setpoint.right_m - truth.wheel_right_m;
+    seen_.max_abs_true_error_left_m =
+        std::max(seen_.max_abs_true_error_left_m, std::abs(seen_.final_true_error_left_m));
+    seen_.max_abs_true_error_right_m =
+        std::max(seen_.max_abs_true_error_right_m, std::abs(seen_.final_true_error_right_m));
+    const double error_left_m = r.setpoint.left_m - r.measured.left_m;
+    const double error_right_m = r.setpoint.right_m - r.measured.right_m;
+    if (std::max(std::abs(error_left_m), std::abs(error_right_m)) > count_m_) {
+      seen_.last_error_above_one_count_s = r.time_s;
+    }
+  }
+  if (r.time_s < rest_from_s_) return;
+  const double left = r.duty_next.left;
+  const double right = r.duty_next.right;
+  if (!rest_seen_) {
+    rest_seen_ = true;
+    seen_.rest_min_duty = std::min(left, right);
+    seen_.rest_max_duty = std::max(left, right);
+    seen_.rest_min_counts = std::min(r.counts[0], r.counts[1]);
+    seen_.rest_max_counts = std::max(r.counts[0], r.counts[1]);
+  } else {
+    seen_.rest_duty_sign_changes += (left * last_rest_duty_left_ < 0.0 ? 1U : 0U) +
+                                    (right * last_rest_duty_right_ < 0.0 ? 1U : 0U);
+  }
+  seen_.rest_min_duty = std::min({seen_.rest_min_duty, left, right});
+  seen_.rest_max_duty = std::max({seen_.rest_max_duty, left, right});
+  seen_.rest_min_counts = std::min({seen_.rest_min_counts, r.counts[0], r.counts[1]});
+  seen_.rest_max_counts = std::max({seen_.rest_max_counts, r.counts[0], r.counts[1]});
+  if (left != 0.0) last_rest_duty_left_ = left;
+  if (right != 0.0) last_rest_duty_right_ = right;
+}
+
+HilObservations InProcessHil::observations() const noexcept {
+  HilObservations seen = seen_;
+  seen.twin_cycles = twin_cycle_;
+  const io::EncoderLineCounters lines = ecs_board_.encoder_lines().counters();
+  seen.line_errors = lines.illegal_transitions + lines.too_fast_edges + lines.resyncs;
+  return seen;
+}
+
+void RunInProcess(InProcessHil& rig) {
+  for (std::uint64_t k = 0; k < rig.planned_cycles(); ++k) {
+    (void)rig.Exchange(true);
+    scheduler::CycleContext context;
+    context.cycle = k;
+    context.period_ns = rig.ecs_period_ns();
+    context.release_ns = static_cast<std::int64_t>(k) * rig.ecs_period_ns();
+    context.model_time_ns = context.release_ns;
+    const runtime::StepStatus status = rig.Step(context);
+    if (status.code != runtime::StepStatus::Code::kOk) {
+      ADD_FAILURE() << "cycle " << k << ": the step failed: " << status.reason;
+      return;
+    }
+  }
+}
+
+}  // namespace hiltwin::app::test
