@@ -15,9 +15,17 @@ namespace {
 
 constexpr std::size_t kMaxThreadNameChars = 15;
 
+/// What a new thread runs: it names itself first, so its body (and anyone who looks at it
+/// from then on) never sees the creator's name.
+struct ThreadStart {
+  std::string name;
+  std::function<void()> body;
+};
+
 void* RunBody(void* argument) {
-  const std::unique_ptr<std::function<void()>> body(static_cast<std::function<void()>*>(argument));
-  (*body)();
+  const std::unique_ptr<ThreadStart> start(static_cast<ThreadStart*>(argument));
+  pthread_setname_np(pthread_self(), start->name.c_str());
+  start->body();
   return nullptr;
 }
 
@@ -72,7 +80,7 @@ NamedThread::NamedThread(const ThreadSpec& spec, std::function<void()> body) {
   Check(pthread_attr_setschedpolicy(attr.get(), SCHED_OTHER), "pthread_attr_setschedpolicy");
   Check(pthread_attr_setschedparam(attr.get(), &param), "pthread_attr_setschedparam");
   Check(pthread_attr_setaffinity_np(attr.get(), sizeof cpus, &cpus), "pthread_attr_setaffinity_np");
-  auto owned = std::make_unique<std::function<void()>>(std::move(body));
+  auto owned = std::make_unique<ThreadStart>(ThreadStart{spec.name, std::move(body)});
   const int error = pthread_create(&handle_, attr.get(), &RunBody, owned.get());
   if (error != 0) {
     throw std::system_error(error, std::generic_category(),
@@ -80,7 +88,6 @@ NamedThread::NamedThread(const ThreadSpec& spec, std::function<void()> body) {
   }
   static_cast<void>(owned.release());  // RunBody owns it now
   started_ = true;
-  pthread_setname_np(handle_, spec.name.c_str());
 }
 
 NamedThread::NamedThread(NamedThread&& other) noexcept
