@@ -50,7 +50,7 @@ struct HilOptions {
   std::string config_path;
   std::vector<std::string> twin_qos, ecs_qos;
   std::optional<double> twin_max_miss_pct, ecs_max_miss_pct;
-  std::string on_violation = "flag";
+  std::optional<std::string> on_violation;  ///< for both sides; each side's default when unset
   std::vector<std::string> twin_args, ecs_args;
   std::string report_path;
   std::string log_dir;
@@ -119,10 +119,11 @@ std::unique_ptr<WorkDir> MakeWorkDir(const HilOptions& o) {
 }
 
 void AddRules(std::vector<std::string>& argv, const std::vector<std::string>& qos,
-              const std::optional<double>& max_miss_pct, const std::string& on_violation) {
+              const std::optional<double>& max_miss_pct,
+              const std::optional<std::string>& on_violation) {
   for (const std::string& rule : qos) argv.insert(argv.end(), {"--qos", rule});
   if (max_miss_pct) argv.insert(argv.end(), {"--max-miss-pct", Num(*max_miss_pct)});
-  argv.insert(argv.end(), {"--on-violation", on_violation});
+  if (on_violation) argv.insert(argv.end(), {"--on-violation", *on_violation});
 }
 
 std::vector<std::string> TwinArgv(const HilOptions& o, const std::string& wire, const fs::path& dir) {
@@ -297,9 +298,9 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--ecs-qos", o->ecs_qos, "controller (m,k) rule M:K (repeatable)");
   app->add_option("--twin-max-miss-pct", o->twin_max_miss_pct, "twin miss ratio limit, %");
   app->add_option("--ecs-max-miss-pct", o->ecs_max_miss_pct, "controller miss ratio limit, %");
-  app->add_option("--on-violation", o->on_violation, "flag or abort, for both sides")
-      ->check(CLI::IsMember({"flag", "abort"}))
-      ->capture_default_str();
+  app->add_option("--on-violation", o->on_violation,
+                  "flag or abort, for both sides (default: flag; one side alone: --twin-arg)")
+      ->check(CLI::IsMember({"flag", "abort"}));
   app->add_option("--twin-arg", o->twin_args,
                   "pass one more argument to `hiltwin run` (repeatable), e.g. --twin-arg=--cpu "
                   "--twin-arg=1");

@@ -1,0 +1,39 @@
+#pragma once
+/// What the ECS adds to its run report: the closed-loop tracking error, the link's frame
+/// counters and, on an emulated board, the quadrature readers' error counters. One typed record
+/// (EcsFigures), from which the JSON section and the summary lines are both derived; `hiltwin
+/// hil` reads the JSON keys back from the ECS's report file.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "hiltwin/app_relbot/ecs_task.h"
+#include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/io/encoder_lines.h"
+#include "hiltwin/io/icoboard.h"
+#include "hiltwin/runtime/run_report.h"
+
+namespace hiltwin::app {
+
+struct EcsFigures {
+  EcsMode mode = EcsMode::kClosedLoop;
+  TrackingStats tracking;
+  io::LinkCounters link;
+  std::optional<io::EncoderLineCounters> encoder_lines;  ///< emulated boards only
+};
+
+/// Collects the figures after the run (the loop has stopped).
+[[nodiscard]] EcsFigures EcsFiguresOf(const EcsTask& task, const io::IcoBoardLink& driver,
+                                      const io::EmulatedFpga* board);
+
+/// The run report's JSON with the ECS's sections: `tracking` (closed loop: `max_abs_error_m`
+/// {left, right}, `rms_error_m`, `final_error_m` {left, right}, `saturated_cycles`,
+/// `max_abs_duty`; null in open loop), `link_counters` and `encoder_lines` (null on spidev).
+[[nodiscard]] nlohmann::ordered_json EcsReportJson(const runtime::RunReport& report,
+                                                   const EcsFigures& figures);
+
+/// Summary lines printed before the run summary ("tracking  ..." in closed loop).
+[[nodiscard]] std::string FormatEcsFigures(const EcsFigures& figures);
+
+}  // namespace hiltwin::app

@@ -1,0 +1,246 @@
+// Closed-loop HiL on one machine with two real processes (issue 10): `hiltwin hil` end to end,
+// and `hiltwin run` + `hiltwin ecs` side by side on a wire, where a stop, an abort or a crash on
+// one side must end the other within a second with a clear message, safe outputs and a report,
+// and no shared memory may be left behind. Wall-clock runs on a shared machine: the verdicts may
+// be FLAGGED (exit 3), so the tests assert the control and orchestration figures, not PASS.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <optional>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fakes/process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+class HilCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    wire_ = "hiltest-" + std::to_string(getpid()) + "-" + test.substr(0, 24);
+    dir_ = fs::temp_directory_path() / ("hiltwin_hil_" + std::to_string(getpid()) + "_" + test);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    EXPECT_FALSE(fs::exists(SegmentPath())) << "shared memory left behind: " << SegmentPath();
+    fs::remove(SegmentPath());
+    fs::remove_all(dir_);
+  }
+
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string Wire() const { return "wire:" + wire_; }
+  std::string SegmentPath() const { return "/dev/shm/hiltwin-wire-" + wire_; }
+
+  static hiltwin::test::RunResult Hiltwin(std::vector<std::string> args) {
+    args.insert(args.begin(), HILTWIN_BINARY);
+    return hiltwin::test::Run(args, 120'000);
+  }
+  static nlohmann::json ReadJson(const std::string& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+  }
+  static std::string ReadFile(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  /// Waits until `path` contains `text`; false after `timeout`.
+  static bool WaitForText(const std::string& path, const std::string& text,
+                          std::chrono::milliseconds timeout) {
+    const auto end = Clock::now() + timeout;
+    while (Clock::now() < end) {
+      if (ReadFile(path).find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+  /// `hiltwin run` (twin) and `hiltwin ecs` on this test's wire, each with a report; returns
+  /// once both have found each other.
+  void StartPair(std::vector<std::string> twin_extra = {}, std::vector<std::string> ecs_extra = {}) {
+    std::vector<std::string> twin = {HILTWIN_BINARY, "run", "--io", Wire(), "--duration", "30",
+                                     "--no-progress", "--report", Path("twin.json")};
+    twin.insert(twin.end(), twin_extra.begin(), twin_extra.end());
+    std::vector<std::string> ecs = {HILTWIN_BINARY, "ecs", "--io", Wire(), "--duration", "30",
+                                    "--no-progress", "--report", Path("ecs.json")};
+    ecs.insert(ecs.end(), ecs_extra.begin(), ecs_extra.end());
+    twin_.emplace(hiltwin::test::Spawn(twin, Path("twin.out")));
+    ecs_.emplace(hiltwin::test::Spawn(ecs, Path("ecs.out")));
+    ASSERT_TRUE(WaitForText(Path("twin.out.err"), "is up; starting", std::chrono::seconds(10)))
+        << ReadFile(Path("twin.out.err"));
+    ASSERT_TRUE(WaitForText(Path("ecs.out.err"), "is up; starting", std::chrono::seconds(10)))
+        << ReadFile(Path("ecs.out.err"));
+  }
+  /// Waits for `process` to end; returns its status and how long after `since` it ended.
+  static std::pair<hiltwin::kernel_glue::ExitStatus, double> EndOf(
+      hiltwin::kernel_glue::Process& process, Clock::time_point since) {
+    const auto status = process.WaitFor(std::chrono::milliseconds(20'000));
+    const double after_s = std::chrono::duration<double>(Clock::now() - since).count();
+    return {status.value_or(hiltwin::kernel_glue::ExitStatus{}), after_s};
+  }
+
+  std::string wire_;
+  fs::path dir_;
+  std::optional<hiltwin::kernel_glue::Process> twin_;
+  std::optional<hiltwin::kernel_glue::Process> ecs_;
+};
+
+// Thesis §7.2 and appendix E: the 2.5 m setpoint; each wheel's error stays below 3 mm and the
+// run ends without steady-state error.
+TEST_F(HilCli, ClosedLoopTracksTheThesisSetpointWithinThreeMillimetres) {
+  const auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--report", Path("hil.json"),
+                          "--log-dir", Path("logs")});
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
+  const auto hil = ReadJson(Path("hil.json"));
+  EXPECT_EQ(hil["exit_code"], r.exit_code);
+  // Below 3 mm, plus what the setpoint travels (at most 0.625 m/s) while a stall of this
+  // machine holds either loop: a KVM guest stalls both processes for milliseconds at times,
+  // which a Raspberry Pi with Xenomai does not (docs/RESULTS.md).
+  const double stall_s =
+      std::max(hil["twin"]["latency_ns"]["max"].get<double>(),
+               hil["ecs"]["latency_ns"]["max"].get<double>()) * 1e-9;
+  const double bound_m = 3e-3 + 0.625 * stall_s;
+  EXPECT_LT(hil["tracking_error_max_m"]["left"].get<double>(), bound_m) << hil.dump(1);
+  EXPECT_LT(hil["tracking_error_max_m"]["right"].get<double>(), bound_m);
+  EXPECT_LT(hil["tracking_error_rms_m"].get<double>(), 1e-3);
+  EXPECT_LT(hil["final_error_m"].get<double>(), 1e-4);  // about one encoder count (0.0785 mm)
+  EXPECT_GT(hil["tracking_error_rms_m"].get<double>(), 0.0);
+  EXPECT_EQ(hil["link_errors"], 0) << hil["link_error_parts"].dump();
+  EXPECT_EQ(hil["ecs"]["stop_reason"], "finished");
+  EXPECT_EQ(hil["twin"]["stop_reason"], "peer_stopped");
+  EXPECT_EQ(hil["twin"]["peer_stopped"], "wire: the ECS finished its run");
+  EXPECT_EQ(hil["twin"]["peer_absent_cycles"], 0);
+  // The twin really drove forward 2.5 m: its last logged wheel positions.
+  std::ifstream twin_log(Path("logs/twin.csv"));
+  std::string header;
+  std::string line;
+  std::string last;
+  std::getline(twin_log, header);
+  while (std::getline(twin_log, line)) last = line;
+  std::stringstream cells(last);
+  std::vector<double> row;
+  for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+  ASSERT_GE(row.size(), 5U) << header;
+  EXPECT_NEAR(row[3], 2.5, 0.005) << header;  // wheel_left_m
+  EXPECT_NEAR(row[4], 2.5, 0.005) << header;  // wheel_right_m
+  EXPECT_NE(r.out.find("tracking  max |error| left"), std::string::npos) << r.out;
+}
+
+TEST_F(HilCli, AKilledControllerEndsTheTwinWithinASecondAsAnIoFault) {
+  StartPair();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto killed_at = Clock::now();
+  ecs_->Kill(SIGKILL);
+  const auto [status, after_s] = EndOf(*twin_, killed_at);
+  EXPECT_EQ(status.code, 5) << ReadFile(Path("twin.out.err"));
+  EXPECT_LT(after_s, 1.0);
+  const auto report = ReadJson(Path("twin.json"));
+  EXPECT_EQ(report["stop_reason"], "io_fault");
+  EXPECT_NE(report["fault"]["reason"].get<std::string>().find("stopped updating its heartbeat"),
+            std::string::npos)
+      << report["fault"];
+  EXPECT_EQ(report["outputs_safe"], true);
+  EXPECT_NE(ReadFile(Path("twin.out.err")).find("I/O fault"), std::string::npos);
+}
+
+TEST_F(HilCli, AStoppedTwinEndsTheControllerCleanlyWithinASecond) {
+  StartPair();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto stopped_at = Clock::now();
+  twin_->Kill(SIGTERM);
+  const auto [status, after_s] = EndOf(*ecs_, stopped_at);
+  EXPECT_TRUE(status.code == 0 || status.code == 3) << status.Describe();
+  EXPECT_LT(after_s, 1.0);
+  const auto report = ReadJson(Path("ecs.json"));
+  EXPECT_EQ(report["stop_reason"], "peer_stopped");
+  EXPECT_EQ(report["peer_stopped"], "wire: the twin was stopped (signal or stop command)");
+  EXPECT_EQ(report["outputs_safe"], true);
+  EXPECT_EQ(ReadJson(Path("twin.json"))["stop_reason"], "stop_requested");
+}
+
+TEST_F(HilCli, EitherSideMayStartFirst) {
+  // The controller first, the twin 1.5 s later: both wait in ready, then run.
+  std::vector<std::string> ecs = {HILTWIN_BINARY, "ecs", "--io", Wire(), "--duration", "1",
+                                  "--no-progress", "--report", Path("ecs.json")};
+  auto ecs_process = hiltwin::test::Spawn(ecs, Path("ecs.out"));
+  ASSERT_TRUE(WaitForText(Path("ecs.out.err"), "waiting for the twin on " + Wire(),
+                          std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  const auto twin = Hiltwin({"run", "--io", Wire(), "--duration", "3", "--no-progress",
+                             "--report", Path("twin.json")});
+  const auto ecs_status = ecs_process.Wait();
+  EXPECT_TRUE(ecs_status.code == 0 || ecs_status.code == 3) << ReadFile(Path("ecs.out.err"));
+  EXPECT_TRUE(twin.exit_code == 0 || twin.exit_code == 3) << twin.err;
+  EXPECT_EQ(ReadJson(Path("ecs.json"))["stop_reason"], "finished");
+  EXPECT_EQ(ReadJson(Path("ecs.json"))["peer_absent_cycles"], 0);
+  EXPECT_EQ(ReadJson(Path("twin.json"))["stop_reason"], "peer_stopped");
+}
+
+TEST_F(HilCli, AQosAbortOnTheTwinEndsThePairWithExitFour) {
+  const auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--duration", "4",
+                          "--twin-arg=--on-violation", "--twin-arg=abort",
+                          "--twin-arg=--inject-overrun",
+                          "--twin-arg=at=4000,count=20,extra-us=600", "--report",
+                          Path("hil.json")});
+  EXPECT_EQ(r.exit_code, 4) << r.out << r.err;
+  const auto hil = ReadJson(Path("hil.json"));
+  EXPECT_EQ(hil["twin"]["verdict"], "ABORTED");
+  EXPECT_EQ(hil["ecs"]["stop_reason"], "peer_stopped");
+  EXPECT_EQ(hil["ecs"]["peer_stopped"], "wire: the twin aborted its run on its QoS policy");
+}
+
+TEST_F(HilCli, MismatchedImagesStopAtInitWithTheThesisMessage) {
+  const auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--duration", "2",
+                          "--ecs-arg=--board-image", "--ecs-arg=icoboard_inverse", "--report",
+                          Path("hil.json")});
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_NE(r.err.find("Failed to initialise FPGA: found icoboard_inverse"), std::string::npos)
+      << r.err;
+  const auto hil = ReadJson(Path("hil.json"));
+  EXPECT_TRUE(hil["ecs"].is_null());
+  EXPECT_EQ(hil["ecs_exit"]["exit_code"], 5);
+}
+
+TEST_F(HilCli, AWireNobodyServesCountsDownThenExitsFiveNamingTheTwinsCommand) {
+  const auto r = Hiltwin({"ecs", "--io", Wire(), "--wait-peer", "1", "--no-progress",
+                          "--report", Path("ecs.json")});
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_NE(r.err.find("waiting for the twin on " + Wire() + ": 1 s left"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("no twin came up on " + Wire() + " within 1 s"), std::string::npos);
+  EXPECT_NE(r.err.find("start it with: hiltwin run --io " + Wire()), std::string::npos);
+  EXPECT_EQ(ReadJson(Path("ecs.json"))["stop_reason"], "io_fault");
+}
+
+TEST_F(HilCli, BadGainsAndProfilesExitTwoNamingFileAndLine) {
+  std::ofstream(Path("gains.toml")) << "[pid]\nkp_duty_per_m = 60.0\nki_duty_per_m_s = -1\n"
+                                       "kd_duty_s_per_m = 1.0\nderivative_filter_s = 0.004\n"
+                                       "[output]\nduty_limit = 1.0\n";
+  auto r = Hiltwin({"ecs", "--gains", Path("gains.toml"), "--no-progress"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(Path("gains.toml") + ":3"), std::string::npos) << r.err;
+  std::ofstream(Path("set.csv")) << "time,left_m,right_m\n0,0,0\n1,abc,0\n";
+  r = Hiltwin({"ecs", "--setpoint", Path("set.csv"), "--no-progress"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(Path("set.csv") + ":3"), std::string::npos) << r.err;
+  r = Hiltwin({"hil", "--setpoint", Path("set.csv"), "--no-progress"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(Path("set.csv") + ":3"), std::string::npos) << r.err;
+  r = Hiltwin({"ecs", "--mode", "openloop", "--input", Path("missing.csv"), "--no-progress"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("missing.csv"), std::string::npos) << r.err;
+}
+
+}  // namespace
