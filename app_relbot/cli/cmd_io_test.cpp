@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "hiltwin/app_relbot/commands.h"
 #include "hiltwin/io/backend.h"
@@ -103,8 +104,8 @@ class PeerCountsCheck {
 struct Summary {
   std::uint64_t count_errors = 0;
   const char* fault = nullptr;
-  std::int64_t frames = 0;               ///< transfers after INIT (data and TEST)
-  std::int64_t frames_peer_absent = 0;   ///< wire: frames during which no peer was attached
+  std::int64_t frames = 0;              ///< transfers after INIT (data and TEST)
+  std::int64_t frames_peer_absent = 0;  ///< wire: frames during which no peer was attached
 };
 
 /// Wire and real links: `options.frames` data frames, each in its own period slot on the
@@ -148,8 +149,9 @@ const char* SideName(io::Image image) { return image == io::Image::kIcoboard ? "
 std::string NoPeerAdvice(const IoTestOptions& options, io::Image image, bool waited) {
   return std::string("start the other side first, e.g. `hiltwin io-test --io ") + options.io +
          " --image " + io::ToString(io::Counterpart(image)) + " --frames 100000` in another " +
-         "terminal, " + (waited ? "or wait longer with a larger --wait-peer" :
-                                  "or add --wait-peer SECONDS to wait for it");
+         "terminal, " +
+         (waited ? "or wait longer with a larger --wait-peer"
+                 : "or add --wait-peer SECONDS to wait for it");
 }
 
 /// Wire only: waits (start-up, not real-time) until the other process has attached.
@@ -157,14 +159,16 @@ void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image
   const auto* wire = dynamic_cast<const io::WireBus*>(&backend.bus());
   if (wire == nullptr) return;
   kernel_glue::MonotonicClock clock;
-  const std::int64_t deadline = clock.NowNs() + static_cast<std::int64_t>(options.wait_peer_s * 1e9);
+  const std::int64_t deadline =
+      clock.NowNs() + static_cast<std::int64_t>(options.wait_peer_s * 1e9);
   while (wire->PeerStatus().result == io::BusResult::kPeerAbsent) {
     if (clock.NowNs() >= deadline) {
       char seconds[32];
       std::snprintf(seconds, sizeof seconds, "%g", options.wait_peer_s);
       throw CommandError(ExitCode::kIo, std::string("no ") + SideName(io::Counterpart(image)) +
                                             " process attached to " + options.io + " within " +
-                                            seconds + " s (--wait-peer); " + NoPeerAdvice(options, image, true));
+                                            seconds + " s (--wait-peer); " +
+                                            NoPeerAdvice(options, image, true));
     }
     clock.SleepUntilNs(clock.NowNs() + 10'000'000);
   }
@@ -181,8 +185,9 @@ io::BackendSpec::Kind CheckBackendFlags(const IoTestOptions& options) {
   const bool mock = spec.kind == io::BackendSpec::Kind::kMock;
   if (!options.board_image.empty() && !mock) {
     throw CommandError(ExitCode::kUsage,
-                       "--board-image " + options.board_image + " only applies to --io mock; a wired "
-                       "or real board carries its own image (drop --board-image)");
+                       "--board-image " + options.board_image +
+                           " only applies to --io mock; a wired "
+                           "or real board carries its own image (drop --board-image)");
   }
   if (options.wait_peer_s > 0.0 && spec.kind != io::BackendSpec::Kind::kWire) {
     throw CommandError(ExitCode::kUsage,
@@ -190,9 +195,10 @@ io::BackendSpec::Kind CheckBackendFlags(const IoTestOptions& options) {
                        "real board's peer cannot be seen from here (drop --wait-peer)");
   }
   if (!options.inject_fault.empty() && !mock) {
-    throw CommandError(ExitCode::kUsage,
-                       "--inject-fault only applies to --io mock, whose boards run in this process; "
-                       "a wired or real board cannot be made to fail from here (drop --inject-fault)");
+    throw CommandError(
+        ExitCode::kUsage,
+        "--inject-fault only applies to --io mock, whose boards run in this process; "
+        "a wired or real board cannot be made to fail from here (drop --inject-fault)");
   }
   return spec.kind;
 }
@@ -215,8 +221,8 @@ constexpr const char* kFaultForms =
     "stuck-emulator,at=1000,count=5";
 
 [[noreturn]] void BadFault(const std::string& spec, const std::string& problem) {
-  throw CommandError(ExitCode::kUsage, "--inject-fault " + spec + ": " + problem +
-                                           "; accepted form: " + kFaultForms);
+  throw CommandError(ExitCode::kUsage,
+                     "--inject-fault " + spec + ": " + problem + "; accepted form: " + kFaultForms);
 }
 
 std::int64_t ParseFaultNumber(const std::string& spec, const std::string& key,
@@ -234,6 +240,19 @@ std::int64_t ParseFaultNumber(const std::string& spec, const std::string& key,
   return number;
 }
 
+io::LinkFault::Kind ParseFaultKind(const std::string& spec, const std::string& kind) {
+  using Kind = io::LinkFault::Kind;
+  static constexpr std::array<std::pair<const char*, Kind>, 3> kKinds = {{
+      {"stuck-emulator", Kind::kStuckEmulator},
+      {"stuck-reader", Kind::kStuckReader},
+      {"corrupt-counts", Kind::kCorruptCounts},
+  }};
+  for (const auto& [name, value] : kKinds) {
+    if (kind == name) return value;
+  }
+  BadFault(spec, "unknown fault '" + kind + "'");
+}
+
 /// `--inject-fault KIND[,at=FRAME][,count=N]` (mock only): what the boards do wrong, when. A
 /// fault that would come after the last of `frames` data frames is refused: it would test nothing.
 io::LinkFault ParseLinkFault(const std::string& spec, std::int64_t frames) {
@@ -244,10 +263,7 @@ io::LinkFault ParseLinkFault(const std::string& spec, std::int64_t frames) {
     const std::string part = spec.substr(start, comma - start);
     start = comma + 1;
     if (item == 0) {
-      if (part == "stuck-emulator") fault.kind = io::LinkFault::Kind::kStuckEmulator;
-      else if (part == "stuck-reader") fault.kind = io::LinkFault::Kind::kStuckReader;
-      else if (part == "corrupt-counts") fault.kind = io::LinkFault::Kind::kCorruptCounts;
-      else BadFault(spec, "unknown fault '" + part + "'");
+      fault.kind = ParseFaultKind(spec, part);
       continue;
     }
     const std::size_t eq = part.find('=');
@@ -271,7 +287,7 @@ io::LinkFault ParseLinkFault(const std::string& spec, std::int64_t frames) {
 /// Two-board mock only: what crossed between the boards, and the other driver's counters.
 struct MockFigures {
   io::PairTally tally;
-  io::LinkCounters counterpart;          ///< the driver of the other image
+  io::LinkCounters counterpart;  ///< the driver of the other image
   std::uint8_t counterpart_identity = 0;
 };
 
@@ -286,8 +302,9 @@ struct IoTestOutcome {
   std::uint64_t count_errors = 0;  ///< values that arrived wrong, plus reader errors
   bool ok = false;
   [[nodiscard]] double mean_transfer_ns() const {
-    return timing.transfers > 0 ? static_cast<double>(timing.total_ns) / static_cast<double>(timing.transfers)
-                                : 0.0;
+    return timing.transfers > 0
+               ? static_cast<double>(timing.total_ns) / static_cast<double>(timing.transfers)
+               : 0.0;
   }
 };
 
@@ -324,8 +341,9 @@ IoTestOutcome RunMock(const IoTestOptions& options, io::Image image, std::int64_
   const io::Image board_image =
       options.board_image.empty() ? image : *io::ParseImage(options.board_image);
   const bool twin_side = image == io::Image::kIcoboardInverse;
-  auto pair = std::make_unique<io::BoardPairCheck>(
-      twin_side ? board_image : io::Image::kIcoboardInverse, twin_side ? io::Image::kIcoboard : board_image);
+  auto pair =
+      std::make_unique<io::BoardPairCheck>(twin_side ? board_image : io::Image::kIcoboardInverse,
+                                           twin_side ? io::Image::kIcoboard : board_image);
   pair->Inject(fault);
   const io::PairInit init = pair->Init(period_ns);
   IoTestOutcome outcome;
@@ -334,14 +352,17 @@ IoTestOutcome RunMock(const IoTestOptions& options, io::Image image, std::int64_
   const io::InitResult& other = twin_side ? init.ecs : init.twin;
   if (!other.ok) throw CommandError(ExitCode::kIo, other.message + " (the mock's other board)");
   outcome.summary.fault = RunPairSteps(*pair, options.frames, outcome.summary);
-  const io::IcoBoardLink& mine = twin_side ? static_cast<const io::IcoBoardLink&>(pair->twin()) : pair->ecs();
-  const io::IcoBoardLink& theirs = twin_side ? static_cast<const io::IcoBoardLink&>(pair->ecs()) : pair->twin();
+  const io::IcoBoardLink& mine =
+      twin_side ? static_cast<const io::IcoBoardLink&>(pair->twin()) : pair->ecs();
+  const io::IcoBoardLink& theirs =
+      twin_side ? static_cast<const io::IcoBoardLink&>(pair->ecs()) : pair->twin();
   outcome.counters = mine.counters();
   outcome.timing = mine.timing();
   outcome.reader = pair->ecs_board().encoder_lines().counters();
   outcome.mock = MockFigures{pair->tally(), theirs.counters(), other.identity};
   const io::PairTally& t = pair->tally();
-  outcome.count_errors = t.encoder.wrong + t.pwm.wrong + t.test_echo_errors + ReaderErrors(outcome.reader);
+  outcome.count_errors =
+      t.encoder.wrong + t.pwm.wrong + t.test_echo_errors + ReaderErrors(outcome.reader);
   outcome.ok = outcome.summary.fault == nullptr && outcome.count_errors == 0 &&
                t.encoder.missed() == 0 && t.pwm.missed() == 0 && CleanCounters(outcome.counters) &&
                CleanCounters(outcome.mock->counterpart);
@@ -387,7 +408,8 @@ IoTestOutcome ExchangeFrames(io::IoBackend& backend, const IoTestOptions& option
   }
   // The local ECS board model's readers (wire): edges a real reader would miscount.
   const io::EmulatedFpga* board = backend.emulated_board();
-  if (board != nullptr && image == io::Image::kIcoboard) outcome.reader = board->encoder_lines().counters();
+  if (board != nullptr && image == io::Image::kIcoboard)
+    outcome.reader = board->encoder_lines().counters();
   outcome.count_errors = outcome.summary.count_errors + ReaderErrors(outcome.reader);
   outcome.ok = outcome.summary.fault == nullptr && outcome.count_errors == 0 &&
                outcome.summary.frames_peer_absent == 0 && CleanCounters(outcome.counters);
@@ -456,17 +478,19 @@ void PrintFrameLine(const char* what, std::uint64_t data, std::uint64_t init, st
 
 void PrintMockText(const IoTestOptions& options, const MockFigures& m, std::uint64_t edges) {
   const io::LinkCounters& c = m.counterpart;
-  std::printf("  other side        %s (identity %u): %llu of %llu data frames received, %llu "
-              "corrupted, %llu missed\n",
-              io::ToString(io::Counterpart(*io::ParseImage(options.image))),
-              static_cast<unsigned>(m.counterpart_identity), static_cast<ull>(c.frames_received),
-              static_cast<ull>(c.frames_sent), static_cast<ull>(c.frames_corrupted),
-              static_cast<ull>(c.frames_missed));
+  std::printf(
+      "  other side        %s (identity %u): %llu of %llu data frames received, %llu "
+      "corrupted, %llu missed\n",
+      io::ToString(io::Counterpart(*io::ParseImage(options.image))),
+      static_cast<unsigned>(m.counterpart_identity), static_cast<ull>(c.frames_received),
+      static_cast<ull>(c.frames_sent), static_cast<ull>(c.frames_corrupted),
+      static_cast<ull>(c.frames_missed));
   const io::PairTally& t = m.tally;
-  std::printf("  encoder messages  %llu sent, %llu received, %llu missed (twin -> ECS, %llu edges "
-              "decoded; thesis Table 5.2)\n",
-              static_cast<ull>(t.encoder.sent), static_cast<ull>(t.encoder.received),
-              static_cast<ull>(t.encoder.missed()), static_cast<ull>(edges));
+  std::printf(
+      "  encoder messages  %llu sent, %llu received, %llu missed (twin -> ECS, %llu edges "
+      "decoded; thesis Table 5.2)\n",
+      static_cast<ull>(t.encoder.sent), static_cast<ull>(t.encoder.received),
+      static_cast<ull>(t.encoder.missed()), static_cast<ull>(edges));
   std::printf("  PWM messages      %llu sent, %llu received, %llu missed (ECS -> twin)\n",
               static_cast<ull>(t.pwm.sent), static_cast<ull>(t.pwm.received),
               static_cast<ull>(t.pwm.missed()));
@@ -476,11 +500,12 @@ void PrintMockText(const IoTestOptions& options, const MockFigures& m, std::uint
 
 void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
   std::printf("io-test over %s%s, image %s (board identity %u), %.0f Hz\n", options.io.c_str(),
-              o.mock ? " (twin and ECS boards in this process, unpaced)" : "", options.image.c_str(),
-              static_cast<unsigned>(o.init.identity), options.rate_hz);
+              o.mock ? " (twin and ECS boards in this process, unpaced)" : "",
+              options.image.c_str(), static_cast<unsigned>(o.init.identity), options.rate_hz);
   const io::LinkCounters& c = o.counters;
   PrintFrameLine("frames sent", c.frames_sent, c.init_frames_sent, c.test_frames_sent);
-  PrintFrameLine("frames received", c.frames_received, c.init_frames_received, c.test_frames_received);
+  PrintFrameLine("frames received", c.frames_received, c.init_frames_received,
+                 c.test_frames_received);
   std::printf("  frames corrupted  %llu\n", static_cast<ull>(c.frames_corrupted));
   std::printf("  frames missed     %llu\n", static_cast<ull>(c.frames_missed));
   std::printf("  count errors      %llu (reader: %llu illegal, %llu too fast, %llu resyncs)\n",
@@ -499,16 +524,16 @@ void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
 }
 
 /// What the first lost message of one direction was, for the error message.
-std::string DescribeMiss(const char* what, const io::MessageTally& tally, const io::FirstMiss& first,
-                         const char* reader) {
+std::string DescribeMiss(const char* what, const io::MessageTally& tally,
+                         const io::FirstMiss& first, const char* reader) {
   std::string text = std::string(what) + " messages: " + std::to_string(tally.received) + " of " +
-                     std::to_string(tally.sent) + " arrived as sent, " + std::to_string(tally.missed()) +
-                     " missed";
+                     std::to_string(tally.sent) + " arrived as sent, " +
+                     std::to_string(tally.missed()) + " missed";
   if (first.frame < 0) return text;
   text += "; the first at data frame " + std::to_string(first.frame);
   if (*first.reason != '\0') return text + ", whose frame failed (" + first.reason + ")";
-  return text + ", channel " + std::to_string(first.channel) + ": sent " + std::to_string(first.sent) +
-         ", " + reader + " " + std::to_string(first.read);
+  return text + ", channel " + std::to_string(first.channel) + ": sent " +
+         std::to_string(first.sent) + ", " + reader + " " + std::to_string(first.read);
 }
 
 /// Mock: the end-to-end figures that failed, and the way out.
@@ -531,32 +556,36 @@ std::string MockFailure(const IoTestOptions& options, const MockFigures& m) {
 void ThrowUnlessPassed(const IoTestOptions& options, io::Image image, const IoTestOutcome& o) {
   const Summary& summary = o.summary;
   if (summary.fault != nullptr) {
-    throw CommandError(ExitCode::kIo, std::string("link fault on ") + options.io + ": " + summary.fault);
+    throw CommandError(ExitCode::kIo,
+                       std::string("link fault on ") + options.io + ": " + summary.fault);
   }
   if (summary.frames_peer_absent > 0) {
     const std::string other = SideName(io::Counterpart(image));
-    const std::string what =
-        summary.frames_peer_absent == summary.frames
-            ? "no " + other + " process was attached to " + options.io + " during the whole run, so " +
-                  "nothing crossed the wire"
-            : "no " + other + " process was attached to " + options.io + " for " +
-                  std::to_string(summary.frames_peer_absent) + " of " + std::to_string(summary.frames) +
-                  " frames, which tested nothing";
-    throw CommandError(ExitCode::kIo, what + "; " + NoPeerAdvice(options, image, options.wait_peer_s > 0.0));
+    const std::string what = summary.frames_peer_absent == summary.frames
+                                 ? "no " + other + " process was attached to " + options.io +
+                                       " during the whole run, so " + "nothing crossed the wire"
+                                 : "no " + other + " process was attached to " + options.io +
+                                       " for " + std::to_string(summary.frames_peer_absent) +
+                                       " of " + std::to_string(summary.frames) +
+                                       " frames, which tested nothing";
+    throw CommandError(ExitCode::kIo,
+                       what + "; " + NoPeerAdvice(options, image, options.wait_peer_s > 0.0));
   }
   if (o.ok) return;
   if (o.mock) throw CommandError(ExitCode::kIo, MockFailure(options, *o.mock));
-  throw CommandError(ExitCode::kIo, "the link had errors (see the summary above); check wiring, "
-                                    "cable length and SPI speed, then rerun; over a wire or real "
-                                    "link the other side must run io-test too (its pattern is "
-                                    "checked)");
+  throw CommandError(ExitCode::kIo,
+                     "the link had errors (see the summary above); check wiring, "
+                     "cable length and SPI speed, then rerun; over a wire or real "
+                     "link the other side must run io-test too (its pattern is "
+                     "checked)");
 }
 
 int RunIoTest(const IoTestOptions& options) {
   const io::Image image = *io::ParseImage(options.image);
   const bool mock = CheckBackendFlags(options) == io::BackendSpec::Kind::kMock;
-  const io::LinkFault fault =
-      options.inject_fault.empty() ? io::LinkFault{} : ParseLinkFault(options.inject_fault, options.frames);
+  const io::LinkFault fault = options.inject_fault.empty()
+                                  ? io::LinkFault{}
+                                  : ParseLinkFault(options.inject_fault, options.frames);
   const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(options.rate_hz);
   IoTestOutcome outcome;
   if (mock) {
@@ -592,8 +621,10 @@ void AddIoTestOptions(CLI::App* app, IoTestOptions& options) {
                   "TEST loop-back follows every 3rd, so every 4th transfer is a TEST")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{100'000'000}))
       ->capture_default_str();
-  app->add_option("--rate", options.rate_hz, "frame rate in Hz and the step size sent in INIT (over mock only the step: the boards' "
-                  "time is frames x step, and the run is as fast as the machine)")
+  app->add_option(
+         "--rate", options.rate_hz,
+         "frame rate in Hz and the step size sent in INIT (over mock only the step: the boards' "
+         "time is frames x step, and the run is as fast as the machine)")
       ->check(CLI::Range(1.0, 100'000.0))
       ->capture_default_str();
   app->add_option("--wait-peer", options.wait_peer_s,
@@ -601,8 +632,8 @@ void AddIoTestOptions(CLI::App* app, IoTestOptions& options) {
                   "(a run with no peer fails with exit 5)")
       ->check(CLI::Range(0.0, 3600.0));
   app->add_option("--inject-fault", options.inject_fault,
-                  std::string("mock only: make the boards fail to see io-test catch it: ") + kFaultForms +
-                      " (data frame FRAME on, N frames)");
+                  std::string("mock only: make the boards fail to see io-test catch it: ") +
+                      kFaultForms + " (data frame FRAME on, N frames)");
   app->add_flag("--json", options.json,
                 "print the summary as JSON (frames_sent, frames_received, frames_corrupted, "
                 "frames_missed, init_frames_*, test_frames_*, count_errors, counts_over_limit, "
@@ -621,8 +652,10 @@ Command AddIoTestCommand(CLI::App& parent) {
       "here, joined by their wires, unpaced: the ECS must decode the twin's encoder pattern edge\n"
       "by edge and the twin read the ECS's PWM, counted as messages sent/received/missed (thesis\n"
       "Table 5.2: --frames 720000). Over wire:NAME or spidev the other side must run io-test too:\n"
-      "its pattern is checked on arrival. Exit 0 only without errors; 5 on an I/O error, the wrong\n"
-      "image, a lost message or a wire with no peer; 2 on bad usage. Frames: docs/spi-protocol.md.");
+      "its pattern is checked on arrival. Exit 0 only without errors; 5 on an I/O error, the "
+      "wrong\n"
+      "image, a lost message or a wire with no peer; 2 on bad usage. Frames: "
+      "docs/spi-protocol.md.");
   AddIoTestOptions(app, *options);
   return Command{app, [options] { return RunIoTest(*options); }};
 }

@@ -42,15 +42,23 @@ std::int32_t EncoderTestPattern::Advance(Channel& ch, std::int32_t position) con
       if (next == ch.top) ch.phase = Phase::kStopTop;
       return next;
     }
-    case Phase::kStopTop: ch.phase = Phase::kJumpDown; return position;
-    case Phase::kJumpDown: ch.phase = Phase::kJumpUp; return ch.bottom;  // −limit
-    case Phase::kJumpUp: ch.phase = Phase::kWalkDown; return ch.top;     // +limit
+    case Phase::kStopTop:
+      ch.phase = Phase::kJumpDown;
+      return position;
+    case Phase::kJumpDown:
+      ch.phase = Phase::kJumpUp;
+      return ch.bottom;  // −limit
+    case Phase::kJumpUp:
+      ch.phase = Phase::kWalkDown;
+      return ch.top;  // +limit
     case Phase::kWalkDown: {
       const std::int32_t next = std::max(ch.bottom, position - ch.walk);
       if (next == ch.bottom) ch.phase = Phase::kStopBottom;
       return next;
     }
-    case Phase::kStopBottom: ch.phase = Phase::kWalkUp; return position;
+    case Phase::kStopBottom:
+      ch.phase = Phase::kWalkUp;
+      return position;
   }
   return position;
 }
@@ -88,7 +96,9 @@ void BoardPairCheck::ApplyFault() noexcept {
   const bool active = step_ >= fault_.at_frame && step_ < fault_.at_frame + fault_.frames;
   twin_board_.faults().stick_encoder = active && fault_.kind == LinkFault::Kind::kStuckEmulator;
   ecs_board_.faults().stick_encoder = active && fault_.kind == LinkFault::Kind::kStuckReader;
-  if (active && fault_.kind == LinkFault::Kind::kCorruptCounts) ecs_board_.faults().corrupt_answers = 1;
+  if (active && fault_.kind == LinkFault::Kind::kCorruptCounts) {
+    ecs_board_.faults().corrupt_answers = 1;
+  }
 }
 
 PairStatus BoardPairCheck::DataStep() noexcept {
@@ -132,7 +142,9 @@ void BoardPairCheck::CheckEncoder(const ExchangeStatus& status, std::int64_t fra
                                   const std::array<std::int32_t, kChannels>& sent) noexcept {
   FirstMiss& first = tally_.first_encoder_miss;
   if (!status.ok()) {
-    if (first.frame < 0) first = FirstMiss{frame, 0, sent[0], ecs_in_.absolute_counts[0], status.reason};
+    if (first.frame < 0) {
+      first = FirstMiss{frame, 0, sent[0], ecs_in_.absolute_counts[0], status.reason};
+    }
     return;
   }
   for (std::size_t c = 0; c < kChannels; ++c) {

@@ -36,13 +36,14 @@ TEST(IoTestCli, JsonSummaryOfACleanMockRun) {
     const auto r = IoTest({"--io", "mock", "--image", image, "--frames", "400", "--rate", "20000", "--json"});
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     const auto j = nlohmann::json::parse(r.out);
-    for (const char* key : {"frames_sent", "frames_received", "frames_corrupted", "frames_missed",
-                            "init_frames_sent", "init_frames_received", "test_frames_sent",
-                            "test_frames_received", "count_errors", "counts_over_limit",
-                            "frames_peer_absent", "reader_illegal_transitions", "reader_too_fast_edges",
-                            "reader_resyncs", "reader_edges", "encoder_messages_sent",
-                            "encoder_messages_received", "encoder_messages_missed", "pwm_messages_sent",
-                            "pwm_messages_received", "pwm_messages_missed", "counterpart"}) {
+    constexpr const char* kKeys[] = {
+        "frames_sent", "frames_received", "frames_corrupted", "frames_missed", "init_frames_sent",
+        "init_frames_received", "test_frames_sent", "test_frames_received", "count_errors",
+        "counts_over_limit", "frames_peer_absent", "reader_illegal_transitions",
+        "reader_too_fast_edges", "reader_resyncs", "reader_edges", "encoder_messages_sent",
+        "encoder_messages_received", "encoder_messages_missed", "pwm_messages_sent",
+        "pwm_messages_received", "pwm_messages_missed", "counterpart"};
+    for (const char* key : kKeys) {
       EXPECT_TRUE(j.contains(key)) << key;
     }
     // Both boards ran: the twin sent 400 data frames, the ECS one more to decode the last
@@ -109,20 +110,25 @@ TEST(IoTestCli, TableFiveTwoThroughBothMockBoards) {
 TEST(IoTestCli, TheTextSummaryCountsFramesByKindAndMessagesEndToEnd) {
   const auto r = IoTest({"--io", "mock", "--frames", "3000"});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("frames sent       3000 data, 1 INIT, 999 TEST"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("frames received   3000 data, 1 INIT, 999 TEST"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("other side        icoboard (identity 11): 3001 of 3001 data frames received"),
-            std::string::npos)
+  EXPECT_NE(r.out.find("frames sent       3000 data, 1 INIT, 999 TEST"), std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("encoder messages  3000 sent, 3000 received, 0 missed"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("PWM messages      3000 sent, 3000 received, 0 missed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frames received   3000 data, 1 INIT, 999 TEST"), std::string::npos)
+      << r.out;
+  EXPECT_NE(
+      r.out.find("other side        icoboard (identity 11): 3001 of 3001 data frames received"),
+      std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("encoder messages  3000 sent, 3000 received, 0 missed"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("PWM messages      3000 sent, 3000 received, 0 missed"), std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("\nPASS\n"), std::string::npos) << r.out;
 }
 
 struct InjectedFault {
   const char* spec;
-  int missed;             ///< encoder messages lost out of 3000
-  const char* first;      ///< how the error message names the first one
+  int missed;         ///< encoder messages lost out of 3000
+  const char* first;  ///< how the error message names the first one
 };
 
 TEST(IoTestCli, AFaultOnTheEncoderPathFailsTheRun) {
@@ -131,10 +137,12 @@ TEST(IoTestCli, AFaultOnTheEncoderPathFailsTheRun) {
   const InjectedFault faults[] = {
       {"stuck-emulator,at=1000,count=5", 5, "the first at data frame 1000, channel 0: sent "},
       {"stuck-reader,at=1000,count=5", 2001, "the first at data frame 999, channel 0: sent "},
-      {"corrupt-counts,at=1000", 1, "the first at data frame 999, whose frame failed (answer failed its CRC-8 check)"},
+      {"corrupt-counts,at=1000", 1,
+       "the first at data frame 999, whose frame failed (answer failed its CRC-8 check)"},
   };
   for (const InjectedFault& fault : faults) {
-    const auto r = IoTest({"--io", "mock", "--frames", "3000", "--inject-fault", fault.spec, "--json"});
+    const auto r =
+        IoTest({"--io", "mock", "--frames", "3000", "--inject-fault", fault.spec, "--json"});
     EXPECT_EQ(r.exit_code, 5) << fault.spec << r.out << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["encoder_messages_sent"], 3000) << fault.spec;
@@ -143,11 +151,12 @@ TEST(IoTestCli, AFaultOnTheEncoderPathFailsTheRun) {
     EXPECT_EQ(j["pwm_messages_missed"], 0) << fault.spec;
     EXPECT_EQ(j["ok"], false);
     const std::string expected = "encoder messages: " + std::to_string(3000 - fault.missed) +
-                                 " of 3000 arrived as sent, " + std::to_string(fault.missed) + " missed; " +
-                                 fault.first;
+                                 " of 3000 arrived as sent, " + std::to_string(fault.missed) +
+                                 " missed; " + fault.first;
     EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(std::string("this is what --inject-fault ") + fault.spec + " should cause"),
-              std::string::npos)
+    EXPECT_NE(
+        r.err.find(std::string("this is what --inject-fault ") + fault.spec + " should cause"),
+        std::string::npos)
         << r.err;
   }
 }
@@ -169,9 +178,10 @@ TEST(IoTestCli, UsageErrorsExitTwoAndSayWhatIsAccepted) {
   EXPECT_NE(r.err.find("--inject-fault only applies to --io mock"), std::string::npos) << r.err;
   r = IoTest({"--io", "mock", "--inject-fault", "stuck-wheel,at=3"});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--inject-fault stuck-wheel,at=3: unknown fault 'stuck-wheel'; accepted form: "
-                       "KIND[,at=FRAME][,count=N]"),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find("--inject-fault stuck-wheel,at=3: unknown fault 'stuck-wheel'; accepted form: "
+                 "KIND[,at=FRAME][,count=N]"),
+      std::string::npos)
       << r.err;
   r = IoTest({"--io", "mock", "--inject-fault", "stuck-reader,count=0"});
   EXPECT_EQ(r.exit_code, 2);

@@ -65,10 +65,10 @@ struct HilRig {
 
 /// What one asymmetric run ended with.
 struct DriveResult {
-  Duty duty_read;         ///< what the twin's model was given, last cycle
-  RelbotOutputs halfway;  ///< outputs after kCycles / 2
-  RelbotOutputs end;      ///< outputs after kCycles
-  std::array<std::int32_t, io::kChannels> sent{};      ///< counts the twin sent last, by index
+  Duty duty_read;                                  ///< what the twin's model was given, last cycle
+  RelbotOutputs halfway;                           ///< outputs after kCycles / 2
+  RelbotOutputs end;                               ///< outputs after kCycles
+  std::array<std::int32_t, io::kChannels> sent{};  ///< counts the twin sent last, by index
   std::array<std::int64_t, io::kChannels> ecs_read{};  ///< what the ECS decoded from them
 };
 

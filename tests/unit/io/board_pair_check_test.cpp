@@ -2,13 +2,14 @@
 // what it claims (both directions, all four cases of thesis Table 4.1, zero changes, changes of
 // exactly the pulse limit and never more), a clean run delivers every message in both
 // directions, and each injected fault on the encoder path loses messages where it was injected.
+#include "hiltwin/io/board_pair_check.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstdlib>
 
 #include "fakes/alloc_counter.h"
-#include "hiltwin/io/board_pair_check.h"
 #include "hiltwin/io/encoder_emulator.h"
 
 namespace hiltwin::io {
@@ -54,7 +55,7 @@ TEST_P(EncoderTestPatternAtLimit, CoversTableFourOneWithinTheLimit) {
   const std::uint32_t limit = GetParam();
   const PatternStats s = Walk(limit, 4000);
   EXPECT_EQ(s.over_limit, 0U);
-  EXPECT_GT(s.at_limit_up, 4U);    // one jump up per channel and cycle
+  EXPECT_GT(s.at_limit_up, 4U);  // one jump up per channel and cycle
   EXPECT_GT(s.at_limit_down, 4U);
   for (std::size_t kase = 0; kase < s.cases.size(); ++kase) {
     EXPECT_GT(s.cases[kase], 0U) << "Table 4.1 case " << kase << " (0 = no change) never occurs";
@@ -97,7 +98,8 @@ const PairTally& RunPair(BoardPairCheck& pair, int steps) {
   for (int k = 0; k < steps; ++k) {
     EXPECT_EQ(pair.DataStep().fault(), nullptr);
     if (k % 3 == 2) {
-      EXPECT_EQ(pair.TestStep({1, 2, 3, 4, 5, 6, 7, static_cast<std::uint8_t>(k)}).fault(), nullptr);
+      EXPECT_EQ(pair.TestStep({1, 2, 3, 4, 5, 6, 7, static_cast<std::uint8_t>(k)}).fault(),
+                nullptr);
     }
   }
   EXPECT_EQ(pair.Finish().fault(), nullptr);
@@ -191,7 +193,8 @@ TEST(BoardPairCheck, TheWrongImageFailsInit) {
   EXPECT_FALSE(init.ok());
   EXPECT_FALSE(init.twin.ok);
   EXPECT_TRUE(init.ecs.ok);
-  EXPECT_EQ(init.twin.message.rfind("Failed to initialise FPGA: found icoboard, the twin needs", 0), 0U)
+  EXPECT_EQ(init.twin.message.rfind("Failed to initialise FPGA: found icoboard, the twin needs", 0),
+            0U)
       << init.twin.message;
 }
 

@@ -42,7 +42,15 @@ class EncoderTestPattern {
   }
 
  private:
-  enum class Phase : std::uint8_t { kApproach, kWalkUp, kStopTop, kJumpDown, kJumpUp, kWalkDown, kStopBottom };
+  enum class Phase : std::uint8_t {
+    kApproach,
+    kWalkUp,
+    kStopTop,
+    kJumpDown,
+    kJumpUp,
+    kWalkDown,
+    kStopBottom
+  };
   struct Channel {
     std::int32_t bottom = 0;  ///< just below the wrap
     std::int32_t top = 0;     ///< bottom + limit: just above it
@@ -70,11 +78,11 @@ struct MessageTally {
 
 /// The first value that did not arrive as sent, for the error message.
 struct FirstMiss {
-  std::int64_t frame = -1;   ///< data frame of the message; -1 = none
+  std::int64_t frame = -1;  ///< data frame of the message; -1 = none
   std::size_t channel = 0;
   std::int64_t sent = 0;
-  std::int64_t read = 0;     ///< what arrived (ECS: unwrapped absolute counts)
-  const char* reason = "";   ///< the frame's error when the message did not arrive at all
+  std::int64_t read = 0;    ///< what arrived (ECS: unwrapped absolute counts)
+  const char* reason = "";  ///< the frame's error when the message did not arrive at all
 };
 
 /// Faults a link test can inject, to show that it catches them.
@@ -112,7 +120,7 @@ struct PairTally {
   FirstMiss first_encoder_miss;
   FirstMiss first_pwm_miss;
   std::uint64_t test_echo_errors = 0;  ///< TEST answers whose payload was not the one sent
-  std::uint64_t wraps_up = 0;    ///< emulator periods that crossed the wrap counting up (Table 4.1 D)
+  std::uint64_t wraps_up = 0;  ///< emulator periods that crossed the wrap counting up (Table 4.1 D)
   std::uint64_t wraps_down = 0;  ///< ... counting down (Table 4.1 C)
 };
 
@@ -165,7 +173,7 @@ class BoardPairCheck {
 
   EncoderTestPattern pattern_{kMaxRepresentablePulses - 1};
   LinkFault fault_{};
-  std::int64_t step_ = 0;                            ///< data steps done
+  std::int64_t step_ = 0;  ///< data steps done
   std::array<std::int32_t, kChannels> pwm_out_{};
   std::array<std::int32_t, kChannels> encoder_sent_{};  ///< the twin's last encoder message
   TwinInputs twin_in_{};
