@@ -1,15 +1,28 @@
-// `hiltwin io-test`: bring-up test of the FPGA link. INIT, identity check, N frames with a known
-// pattern, then a summary; exit 0 only without errors, 5 on an I/O error, the wrong image or (wire)
-// no peer. Over a wire or a real link the inputs come from the other side, which is expected to run
-// io-test too: its pattern is checked by relations that hold whatever its frame index is.
+// `hiltwin io-test`: bring-up test of the FPGA link. INIT, identity check, N data frames with a
+// known pattern (and a TEST loop-back after every third), then a summary; exit 0 only without
+// errors, 5 on an I/O error, the wrong image, an end-to-end message lost or (wire) no peer.
+//
+// Over mock, both boards run in this process (io::BoardPairCheck): the twin's driver and board,
+// the ECS's driver and board, joined by the encoder lines and the PWM wire. The ECS decodes the
+// twin's encoder pattern edge by edge and the twin reads the ECS's PWM pattern; messages are
+// counted sent/received/missed end to end as thesis Table 5.2 counts them, so
+// `--io mock --frames 720000` repeats that test. Mock boards have no clock (board time is data
+// frames × step), so a mock run is not paced by the wall clock.
+//
+// Over a wire or a real link the other side is expected to run io-test too: its pattern is
+// checked by relations that hold whatever its frame index is.
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "hiltwin/app_relbot/commands.h"
 #include "hiltwin/io/backend.h"
+#include "hiltwin/io/board_pair_check.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
@@ -25,18 +38,18 @@ struct IoTestOptions {
   std::int64_t frames = 1000;
   double rate_hz = 1000.0;
   double wait_peer_s = 0.0;
+  std::string inject_fault;
   bool json = false;
 };
 
-/// The known pattern: PWM values and encoder positions as functions of the data-frame index.
-std::int32_t PatternPwm(std::int64_t k, std::size_t c) {
-  return static_cast<std::int32_t>((k * 37 + static_cast<std::int64_t>(c) * 511) % 4095) - 2047;
-}
-std::int32_t PatternCounts(std::int64_t k, std::size_t c) {
-  return io::WrapToRelative(k * 13 * static_cast<std::int64_t>(c + 1) - 5000);
-}
+/// A TEST loop-back follows every third data frame but the last: one transfer in four.
+constexpr std::int64_t kDataFramesPerTest = 3;
+
+/// Wire and real links: the twin's encoder positions as a function of the data-frame index
+/// (channel c moves (c+1)·13 counts per frame, within any pulse limit), which the other side's
+/// io-test checks by relation (PeerCountsCheck).
 std::int32_t PatternPosition(std::int64_t k, std::size_t c) {
-  return static_cast<std::int32_t>(k * 13 * static_cast<std::int64_t>(c + 1));  // within any pulse limit
+  return static_cast<std::int32_t>(k * 13 * static_cast<std::int64_t>(c + 1));
 }
 std::array<std::uint8_t, 8> PatternBytes(std::int64_t i) {
   std::array<std::uint8_t, 8> bytes{};
@@ -46,50 +59,16 @@ std::array<std::uint8_t, 8> PatternBytes(std::int64_t i) {
   return bytes;
 }
 
-/// Mock only: drives the emulated board's inputs with the pattern, indexed by board time. The
-/// encoder lines are an emulator whose period p (index p + 1) starts at p·step and moves from
-/// PatternCounts(p) to PatternCounts(p + 1); the ECS board's readers decode its edges.
-class PatternSource final : public io::PwmSignalSource, public io::EncoderLineSource {
- public:
-  explicit PatternSource(std::int64_t step_ns)
-      : step_ns_(step_ns),
-        divider_(io::ClockDividerForStep(step_ns)),
-        subticks_(io::SubticksPerStep(step_ns, divider_)) {}
-  void DutyAt(std::int64_t t_ns, std::array<double, io::kChannels>& duty_out) noexcept override {
-    for (std::size_t c = 0; c < io::kChannels; ++c) duty_out[c] = io::PwmToDuty(PatternPwm(t_ns / step_ns_, c));
-  }
-  io::LineView Lines(std::int64_t t_ns) noexcept override {
-    io::LineView view;
-    view.newest = static_cast<std::uint64_t>(t_ns / step_ns_) + 1;
-    return view;
-  }
-  bool Period(std::uint64_t index, io::EncoderPeriod& out) noexcept override {
-    if (index == 0) return false;
-    const auto p = static_cast<std::int64_t>(index - 1);
-    out.index = index;
-    for (std::size_t c = 0; c < io::kChannels; ++c) {
-      const io::PulsePlan plan = io::PlanPulses(PatternCounts(p, c), PatternCounts(p + 1, c));
-      out.channels[c] = io::PulseSegment{PatternCounts(p, c), plan.pulses, plan.direction, p * step_ns_,
-                                         subticks_, divider_};
-    }
-    return true;
-  }
-
- private:
-  std::int64_t step_ns_;
-  std::uint32_t divider_;
-  std::uint32_t subticks_;
-};
-
 /// Residue of `value` modulo `modulus` in [0, modulus).
 std::int64_t Mod(std::int64_t value, std::int64_t modulus) {
   return ((value % modulus) + modulus) % modulus;
 }
 
-/// Twin side over a wire or real link: PWM from the other side's io-test. Every channel must
-/// come from the same pattern frame (channel c is 511·c ahead of channel 0, modulo 4095), or an
-/// adjacent one: a real PWM reader measures each channel in its own PWM period, so one channel
-/// may still show the previous frame. All zero is the idle line before the first ALL frame.
+/// Twin side over a wire or real link: PWM from the other side's io-test (io::PwmTestValue).
+/// Every channel must come from the same pattern frame (channel c is 511·c ahead of channel 0,
+/// modulo 4095), or an adjacent one: a real PWM reader measures each channel in its own PWM
+/// period, so one channel may still show the previous frame. All zero is the idle line before
+/// the first ALL frame.
 bool IsPeerPwmPattern(const std::array<std::int32_t, io::kChannels>& pwm) {
   if (pwm == std::array<std::int32_t, io::kChannels>{}) return true;
   for (std::size_t c = 1; c < io::kChannels; ++c) {
@@ -125,10 +104,12 @@ class PeerCountsCheck {
 struct Summary {
   std::uint64_t count_errors = 0;
   const char* fault = nullptr;
-  std::int64_t frames = 0;               ///< frames sent after INIT
-  std::int64_t frames_peer_absent = 0;   ///< wire: frames during which no peer was attached
+  std::int64_t frames = 0;              ///< transfers after INIT (data and TEST)
+  std::int64_t frames_peer_absent = 0;  ///< wire: frames during which no peer was attached
 };
 
+/// Wire and real links: `options.frames` data frames, each in its own period slot on the
+/// monotonic clock (the board reads that clock), a TEST loop-back after every third but the last.
 template <typename Driver, typename Inputs, typename Send, typename Check>
 Summary RunFrames(Driver& driver, const IoTestOptions& options, std::int64_t period_ns, Send send,
                   Check check) {
@@ -137,12 +118,12 @@ Summary RunFrames(Driver& driver, const IoTestOptions& options, std::int64_t per
   const std::int64_t t0_ns = clock.NowNs() + period_ns;
   Inputs in{};
   std::int64_t data_frames = 0;
-  for (std::int64_t i = 0; i < options.frames; ++i) {
+  for (std::int64_t i = 0; data_frames < options.frames; ++i) {
     clock.SleepUntilNs(t0_ns + i * period_ns);
     io::ExchangeStatus status;
     ++summary.frames;
-    if (i % 4 == 3) {
-      // Every fourth frame is a TEST loop-back: a known pattern on every backend.
+    const bool test = i % (kDataFramesPerTest + 1) == kDataFramesPerTest;
+    if (test) {
       const auto pattern = PatternBytes(i);
       std::array<std::uint8_t, 8> echo{};
       status = driver.Test(pattern, echo);
@@ -168,8 +149,9 @@ const char* SideName(io::Image image) { return image == io::Image::kIcoboard ? "
 std::string NoPeerAdvice(const IoTestOptions& options, io::Image image, bool waited) {
   return std::string("start the other side first, e.g. `hiltwin io-test --io ") + options.io +
          " --image " + io::ToString(io::Counterpart(image)) + " --frames 100000` in another " +
-         "terminal, " + (waited ? "or wait longer with a larger --wait-peer" :
-                                  "or add --wait-peer SECONDS to wait for it");
+         "terminal, " +
+         (waited ? "or wait longer with a larger --wait-peer"
+                 : "or add --wait-peer SECONDS to wait for it");
 }
 
 /// Wire only: waits (start-up, not real-time) until the other process has attached.
@@ -177,40 +159,54 @@ void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image
   const auto* wire = dynamic_cast<const io::WireBus*>(&backend.bus());
   if (wire == nullptr) return;
   kernel_glue::MonotonicClock clock;
-  const std::int64_t deadline = clock.NowNs() + static_cast<std::int64_t>(options.wait_peer_s * 1e9);
+  const std::int64_t deadline =
+      clock.NowNs() + static_cast<std::int64_t>(options.wait_peer_s * 1e9);
   while (wire->PeerStatus().result == io::BusResult::kPeerAbsent) {
     if (clock.NowNs() >= deadline) {
       char seconds[32];
       std::snprintf(seconds, sizeof seconds, "%g", options.wait_peer_s);
       throw CommandError(ExitCode::kIo, std::string("no ") + SideName(io::Counterpart(image)) +
                                             " process attached to " + options.io + " within " +
-                                            seconds + " s (--wait-peer); " + NoPeerAdvice(options, image, true));
+                                            seconds + " s (--wait-peer); " +
+                                            NoPeerAdvice(options, image, true));
     }
     clock.SleepUntilNs(clock.NowNs() + 10'000'000);
   }
 }
 
-/// Checks the flags against the backend kind and opens it (exit 2 for usage, 5 for I/O).
-std::unique_ptr<io::IoBackend> OpenIoTestBackend(const IoTestOptions& options, io::Image image) {
-  io::BackendOptions backend_options;
-  backend_options.side = image;
-  if (!options.board_image.empty()) backend_options.mock_board_image = io::ParseImage(options.board_image);
+/// Checks the flags against the backend kind (exit 2 for usage); returns the kind.
+io::BackendSpec::Kind CheckBackendFlags(const IoTestOptions& options) {
   io::BackendSpec spec;
   try {
     spec = io::ParseBackendSpec(options.io);
   } catch (const io::ConfigError& e) {
     throw CommandError(ExitCode::kUsage, std::string("--io: ") + e.what());
   }
-  if (!options.board_image.empty() && spec.kind != io::BackendSpec::Kind::kMock) {
+  const bool mock = spec.kind == io::BackendSpec::Kind::kMock;
+  if (!options.board_image.empty() && !mock) {
     throw CommandError(ExitCode::kUsage,
-                       "--board-image " + options.board_image + " only applies to --io mock; a wired "
-                       "or real board carries its own image (drop --board-image)");
+                       "--board-image " + options.board_image +
+                           " only applies to --io mock; a wired "
+                           "or real board carries its own image (drop --board-image)");
   }
   if (options.wait_peer_s > 0.0 && spec.kind != io::BackendSpec::Kind::kWire) {
     throw CommandError(ExitCode::kUsage,
                        "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a "
                        "real board's peer cannot be seen from here (drop --wait-peer)");
   }
+  if (!options.inject_fault.empty() && !mock) {
+    throw CommandError(
+        ExitCode::kUsage,
+        "--inject-fault only applies to --io mock, whose boards run in this process; "
+        "a wired or real board cannot be made to fail from here (drop --inject-fault)");
+  }
+  return spec.kind;
+}
+
+/// Opens a wire or spidev backend (exit 2 for usage, 5 for I/O).
+std::unique_ptr<io::IoBackend> OpenIoTestBackend(const IoTestOptions& options, io::Image image) {
+  io::BackendOptions backend_options;
+  backend_options.side = image;
   try {
     return io::OpenBackend(options.io, backend_options);
   } catch (const io::ConfigError& e) {
@@ -220,20 +216,158 @@ std::unique_ptr<io::IoBackend> OpenIoTestBackend(const IoTestOptions& options, i
   }
 }
 
+constexpr const char* kFaultForms =
+    "KIND[,at=FRAME][,count=N] with KIND stuck-emulator, stuck-reader or corrupt-counts, e.g. "
+    "stuck-emulator,at=1000,count=5";
+
+[[noreturn]] void BadFault(const std::string& spec, const std::string& problem) {
+  throw CommandError(ExitCode::kUsage,
+                     "--inject-fault " + spec + ": " + problem + "; accepted form: " + kFaultForms);
+}
+
+std::int64_t ParseFaultNumber(const std::string& spec, const std::string& key,
+                              const std::string& value, std::int64_t min) {
+  std::size_t used = 0;
+  std::int64_t number = -1;
+  try {
+    number = std::stoll(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != value.size() || value.empty() || number < min) {
+    BadFault(spec, key + "=" + value + " is not a whole number >= " + std::to_string(min));
+  }
+  return number;
+}
+
+io::LinkFault::Kind ParseFaultKind(const std::string& spec, const std::string& kind) {
+  using Kind = io::LinkFault::Kind;
+  static constexpr std::array<std::pair<const char*, Kind>, 3> kKinds = {{
+      {"stuck-emulator", Kind::kStuckEmulator},
+      {"stuck-reader", Kind::kStuckReader},
+      {"corrupt-counts", Kind::kCorruptCounts},
+  }};
+  for (const auto& [name, value] : kKinds) {
+    if (kind == name) return value;
+  }
+  BadFault(spec, "unknown fault '" + kind + "'");
+}
+
+/// `--inject-fault KIND[,at=FRAME][,count=N]` (mock only): what the boards do wrong, when. A
+/// fault that would come after the last of `frames` data frames is refused: it would test nothing.
+io::LinkFault ParseLinkFault(const std::string& spec, std::int64_t frames) {
+  io::LinkFault fault;
+  std::size_t start = 0;
+  for (int item = 0; start <= spec.size(); ++item) {
+    const std::size_t comma = std::min(spec.find(',', start), spec.size());
+    const std::string part = spec.substr(start, comma - start);
+    start = comma + 1;
+    if (item == 0) {
+      fault.kind = ParseFaultKind(spec, part);
+      continue;
+    }
+    const std::size_t eq = part.find('=');
+    const std::string key = part.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : part.substr(eq + 1);
+    if (key == "at") {
+      fault.at_frame = ParseFaultNumber(spec, key, value, 0);
+    } else if (key == "count") {
+      fault.frames = ParseFaultNumber(spec, key, value, 1);
+    } else {
+      BadFault(spec, "'" + part + "' is not at=FRAME or count=N");
+    }
+  }
+  if (fault.at_frame >= frames) {
+    BadFault(spec, "at=" + std::to_string(fault.at_frame) + " comes after the last of the run's " +
+                       std::to_string(frames) + " data frames (--frames); choose a smaller at");
+  }
+  return fault;
+}
+
+/// Two-board mock only: what crossed between the boards, and the other driver's counters.
+struct MockFigures {
+  io::PairTally tally;
+  io::LinkCounters counterpart;  ///< the driver of the other image
+  std::uint8_t counterpart_identity = 0;
+};
+
 /// Everything one io-test found; the JSON, the text and the exit code derive from it.
 struct IoTestOutcome {
   Summary summary;
   io::InitResult init;
-  io::LinkCounters counters;
+  io::LinkCounters counters;  ///< this side's (--image) driver
   io::TransferTiming timing;
-  io::EncoderLineCounters reader;  ///< ECS board model's line readers (mock only)
-  std::uint64_t count_errors = 0;  ///< pattern mismatches plus reader errors
+  io::EncoderLineCounters reader;  ///< ECS board model's line readers (mock, and wire as ECS)
+  std::optional<MockFigures> mock;
+  std::uint64_t count_errors = 0;  ///< values that arrived wrong, plus reader errors
   bool ok = false;
   [[nodiscard]] double mean_transfer_ns() const {
-    return timing.transfers > 0 ? static_cast<double>(timing.total_ns) / static_cast<double>(timing.transfers)
-                                : 0.0;
+    return timing.transfers > 0
+               ? static_cast<double>(timing.total_ns) / static_cast<double>(timing.transfers)
+               : 0.0;
   }
 };
+
+/// Every frame of every kind a driver sent was answered and used.
+bool CleanCounters(const io::LinkCounters& c) {
+  return c.frames_corrupted == 0 && c.frames_missed == 0 && c.faults == 0 &&
+         c.frames_received == c.frames_sent && c.init_frames_received == c.init_frames_sent &&
+         c.test_frames_received == c.test_frames_sent;
+}
+
+/// Reader errors: edges a real reader would miscount, and lines that jumped.
+std::uint64_t ReaderErrors(const io::EncoderLineCounters& r) {
+  return r.illegal_transitions + r.too_fast_edges + r.resyncs;
+}
+
+/// The data steps of a two-board mock run, with the transfers in the order RunFrames sends them
+/// (a TEST loop-back after every third data frame but the last), then the ECS's last frame.
+/// Stops at a link fault, as RunFrames does.
+const char* RunPairSteps(io::BoardPairCheck& pair, std::int64_t frames, Summary& summary) {
+  for (std::int64_t k = 0; k < frames; ++k) {
+    ++summary.frames;
+    if (const char* fault = pair.DataStep().fault()) return fault;
+    if ((k + 1) % kDataFramesPerTest == 0 && k + 1 < frames) {
+      ++summary.frames;
+      if (const char* fault = pair.TestStep(PatternBytes(summary.frames)).fault()) return fault;
+    }
+  }
+  return pair.Finish().fault();
+}
+
+/// Over mock: both boards and drivers in this process; `image` says whose counters lead.
+IoTestOutcome RunMock(const IoTestOptions& options, io::Image image, std::int64_t period_ns,
+                      const io::LinkFault& fault) {
+  const io::Image board_image =
+      options.board_image.empty() ? image : *io::ParseImage(options.board_image);
+  const bool twin_side = image == io::Image::kIcoboardInverse;
+  auto pair =
+      std::make_unique<io::BoardPairCheck>(twin_side ? board_image : io::Image::kIcoboardInverse,
+                                           twin_side ? io::Image::kIcoboard : board_image);
+  pair->Inject(fault);
+  const io::PairInit init = pair->Init(period_ns);
+  IoTestOutcome outcome;
+  outcome.init = twin_side ? init.twin : init.ecs;
+  if (!outcome.init.ok) throw CommandError(ExitCode::kIo, outcome.init.message);
+  const io::InitResult& other = twin_side ? init.ecs : init.twin;
+  if (!other.ok) throw CommandError(ExitCode::kIo, other.message + " (the mock's other board)");
+  outcome.summary.fault = RunPairSteps(*pair, options.frames, outcome.summary);
+  const io::IcoBoardLink& mine =
+      twin_side ? static_cast<const io::IcoBoardLink&>(pair->twin()) : pair->ecs();
+  const io::IcoBoardLink& theirs =
+      twin_side ? static_cast<const io::IcoBoardLink&>(pair->ecs()) : pair->twin();
+  outcome.counters = mine.counters();
+  outcome.timing = mine.timing();
+  outcome.reader = pair->ecs_board().encoder_lines().counters();
+  outcome.mock = MockFigures{pair->tally(), theirs.counters(), other.identity};
+  const io::PairTally& t = pair->tally();
+  outcome.count_errors =
+      t.encoder.wrong + t.pwm.wrong + t.test_echo_errors + ReaderErrors(outcome.reader);
+  outcome.ok = outcome.summary.fault == nullptr && outcome.count_errors == 0 &&
+               t.encoder.missed() == 0 && t.pwm.missed() == 0 && CleanCounters(outcome.counters) &&
+               CleanCounters(outcome.mock->counterpart);
+  return outcome;
+}
 
 template <typename Driver, typename Inputs, typename Send, typename Check>
 void ExchangeWith(Driver& driver, const IoTestOptions& options, std::int64_t period_ns, Send send,
@@ -245,11 +379,10 @@ void ExchangeWith(Driver& driver, const IoTestOptions& options, std::int64_t per
   outcome.timing = driver.timing();
 }
 
-/// INIT, then the pattern frames from this side's driver; a mock board plays the other side.
+/// Over a wire or a real link: INIT, then the pattern frames from this side's driver; the other
+/// side's io-test sends its pattern, checked here by relation.
 IoTestOutcome ExchangeFrames(io::IoBackend& backend, const IoTestOptions& options, io::Image image,
                              std::int64_t period_ns) {
-  const bool mock = backend.kind() == io::BackendSpec::Kind::kMock;
-  io::EmulatedFpga* board = backend.emulated_board();
   IoTestOutcome outcome;
   if (image == io::Image::kIcoboardInverse) {
     io::IcoBoardInverse driver(backend.bus());
@@ -260,15 +393,7 @@ IoTestOutcome ExchangeFrames(io::IoBackend& backend, const IoTestOptions& option
           for (std::size_t c = 0; c < io::kChannels; ++c) out[c] = PatternPosition(k, c);
           return out;
         },
-        [&](const io::TwinInputs& in) {
-          if (!mock) return IsPeerPwmPattern(in.pwm);
-          const std::int64_t k = board->time_ns() / period_ns;
-          for (std::size_t c = 0; c < io::kChannels; ++c) {
-            if (in.pwm[c] != PatternPwm(k, c)) return false;
-          }
-          return true;
-        },
-        outcome);
+        [](const io::TwinInputs& in) { return IsPeerPwmPattern(in.pwm); }, outcome);
   } else {
     io::IcoBoard driver(backend.bus());
     PeerCountsCheck peer_counts;
@@ -276,28 +401,49 @@ IoTestOutcome ExchangeFrames(io::IoBackend& backend, const IoTestOptions& option
         driver, options, period_ns,
         [](std::int64_t k) {
           std::array<std::int32_t, io::kChannels> out{};
-          for (std::size_t c = 0; c < io::kChannels; ++c) out[c] = PatternPwm(k, c);
+          for (std::size_t c = 0; c < io::kChannels; ++c) out[c] = io::PwmTestValue(k, c);
           return out;
         },
-        [&](const io::EcsInputs& in) {
-          if (!mock) return peer_counts(in);
-          const std::int64_t k = board->time_ns() / period_ns;
-          for (std::size_t c = 0; c < io::kChannels; ++c) {
-            if (in.counts[c] != PatternCounts(k, c)) return false;
-          }
-          return true;
-        },
-        outcome);
+        [&](const io::EcsInputs& in) { return peer_counts(in); }, outcome);
   }
-  // The ECS board model's readers: edges a real reader would miscount, and lines that jumped.
-  if (board != nullptr && image == io::Image::kIcoboard) outcome.reader = board->encoder_lines().counters();
-  const io::EncoderLineCounters& r = outcome.reader;
-  outcome.count_errors = outcome.summary.count_errors + r.illegal_transitions + r.too_fast_edges + r.resyncs;
-  const io::LinkCounters& c = outcome.counters;
+  // The local ECS board model's readers (wire): edges a real reader would miscount.
+  const io::EmulatedFpga* board = backend.emulated_board();
+  if (board != nullptr && image == io::Image::kIcoboard)
+    outcome.reader = board->encoder_lines().counters();
+  outcome.count_errors = outcome.summary.count_errors + ReaderErrors(outcome.reader);
   outcome.ok = outcome.summary.fault == nullptr && outcome.count_errors == 0 &&
-               outcome.summary.frames_peer_absent == 0 && c.frames_corrupted == 0 &&
-               c.frames_missed == 0 && c.frames_received == c.frames_sent;
+               outcome.summary.frames_peer_absent == 0 && CleanCounters(outcome.counters);
   return outcome;
+}
+
+void AddCounters(nlohmann::json& j, const io::LinkCounters& c) {
+  j["frames_sent"] = c.frames_sent;
+  j["frames_received"] = c.frames_received;
+  j["frames_corrupted"] = c.frames_corrupted;
+  j["frames_missed"] = c.frames_missed;
+  j["init_frames_sent"] = c.init_frames_sent;
+  j["init_frames_received"] = c.init_frames_received;
+  j["test_frames_sent"] = c.test_frames_sent;
+  j["test_frames_received"] = c.test_frames_received;
+  j["faults"] = c.faults;
+}
+
+void AddMockJson(nlohmann::json& j, const IoTestOptions& options, const MockFigures& m) {
+  const io::PairTally& t = m.tally;
+  j["encoder_messages_sent"] = t.encoder.sent;
+  j["encoder_messages_received"] = t.encoder.received;
+  j["encoder_messages_missed"] = t.encoder.missed();
+  j["pwm_messages_sent"] = t.pwm.sent;
+  j["pwm_messages_received"] = t.pwm.received;
+  j["pwm_messages_missed"] = t.pwm.missed();
+  j["test_echo_errors"] = t.test_echo_errors;
+  j["encoder_wraps_up"] = t.wraps_up;
+  j["encoder_wraps_down"] = t.wraps_down;
+  nlohmann::json other;
+  other["image"] = io::ToString(io::Counterpart(*io::ParseImage(options.image)));
+  other["board_identity"] = m.counterpart_identity;
+  AddCounters(other, m.counterpart);
+  j["counterpart"] = other;
 }
 
 void PrintJson(const IoTestOptions& options, const IoTestOutcome& o) {
@@ -306,39 +452,69 @@ void PrintJson(const IoTestOptions& options, const IoTestOutcome& o) {
   j["image"] = options.image;
   j["board_identity"] = o.init.identity;
   j["rate_hz"] = options.rate_hz;
-  j["frames_sent"] = o.counters.frames_sent;
-  j["frames_received"] = o.counters.frames_received;
-  j["frames_corrupted"] = o.counters.frames_corrupted;
-  j["frames_missed"] = o.counters.frames_missed;
+  AddCounters(j, o.counters);
   j["count_errors"] = o.count_errors;
-  j["faults"] = o.counters.faults;
   j["pulse_limit_events"] = o.counters.pulse_limit_events;
   j["counts_over_limit"] = o.counters.counts_over_limit;
   j["reader_illegal_transitions"] = o.reader.illegal_transitions;
   j["reader_too_fast_edges"] = o.reader.too_fast_edges;
   j["reader_resyncs"] = o.reader.resyncs;
+  j["reader_edges"] = o.reader.edges;
   j["transfer_ns_mean"] = o.mean_transfer_ns();
   j["transfer_ns_max"] = o.timing.max_ns;
   j["peer_absent"] = o.summary.frames_peer_absent > 0;
   j["frames_peer_absent"] = o.summary.frames_peer_absent;
+  if (o.mock) AddMockJson(j, options, *o.mock);
   j["ok"] = o.ok;
   std::printf("%s\n", j.dump(2).c_str());
 }
 
+using ull = unsigned long long;
+
+void PrintFrameLine(const char* what, std::uint64_t data, std::uint64_t init, std::uint64_t test) {
+  std::printf("  %-17s %llu data, %llu INIT, %llu TEST\n", what, static_cast<ull>(data),
+              static_cast<ull>(init), static_cast<ull>(test));
+}
+
+void PrintMockText(const IoTestOptions& options, const MockFigures& m, std::uint64_t edges) {
+  const io::LinkCounters& c = m.counterpart;
+  std::printf(
+      "  other side        %s (identity %u): %llu of %llu data frames received, %llu "
+      "corrupted, %llu missed\n",
+      io::ToString(io::Counterpart(*io::ParseImage(options.image))),
+      static_cast<unsigned>(m.counterpart_identity), static_cast<ull>(c.frames_received),
+      static_cast<ull>(c.frames_sent), static_cast<ull>(c.frames_corrupted),
+      static_cast<ull>(c.frames_missed));
+  const io::PairTally& t = m.tally;
+  std::printf(
+      "  encoder messages  %llu sent, %llu received, %llu missed (twin -> ECS, %llu edges "
+      "decoded; thesis Table 5.2)\n",
+      static_cast<ull>(t.encoder.sent), static_cast<ull>(t.encoder.received),
+      static_cast<ull>(t.encoder.missed()), static_cast<ull>(edges));
+  std::printf("  PWM messages      %llu sent, %llu received, %llu missed (ECS -> twin)\n",
+              static_cast<ull>(t.pwm.sent), static_cast<ull>(t.pwm.received),
+              static_cast<ull>(t.pwm.missed()));
+  std::printf("  encoder wraps     %llu counting up, %llu counting down (across +-8192)\n",
+              static_cast<ull>(t.wraps_up), static_cast<ull>(t.wraps_down));
+}
+
 void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
-  using ull = unsigned long long;
-  std::printf("io-test over %s, image %s (board identity %u), %.0f Hz\n", options.io.c_str(),
+  std::printf("io-test over %s%s, image %s (board identity %u), %.0f Hz\n", options.io.c_str(),
+              o.mock ? " (twin and ECS boards in this process, unpaced)" : "",
               options.image.c_str(), static_cast<unsigned>(o.init.identity), options.rate_hz);
-  std::printf("  frames sent       %llu\n", static_cast<ull>(o.counters.frames_sent));
-  std::printf("  frames received   %llu\n", static_cast<ull>(o.counters.frames_received));
-  std::printf("  frames corrupted  %llu\n", static_cast<ull>(o.counters.frames_corrupted));
-  std::printf("  frames missed     %llu\n", static_cast<ull>(o.counters.frames_missed));
+  const io::LinkCounters& c = o.counters;
+  PrintFrameLine("frames sent", c.frames_sent, c.init_frames_sent, c.test_frames_sent);
+  PrintFrameLine("frames received", c.frames_received, c.init_frames_received,
+                 c.test_frames_received);
+  std::printf("  frames corrupted  %llu\n", static_cast<ull>(c.frames_corrupted));
+  std::printf("  frames missed     %llu\n", static_cast<ull>(c.frames_missed));
   std::printf("  count errors      %llu (reader: %llu illegal, %llu too fast, %llu resyncs)\n",
               static_cast<ull>(o.count_errors), static_cast<ull>(o.reader.illegal_transitions),
               static_cast<ull>(o.reader.too_fast_edges), static_cast<ull>(o.reader.resyncs));
-  std::printf("  counts over limit %llu\n", static_cast<ull>(o.counters.counts_over_limit));
+  std::printf("  counts over limit %llu\n", static_cast<ull>(c.counts_over_limit));
   std::printf("  transfer time     mean %.0f ns, max %lld ns\n", o.mean_transfer_ns(),
               static_cast<long long>(o.timing.max_ns));
+  if (o.mock) PrintMockText(options, *o.mock, o.reader.edges);
   if (o.summary.frames_peer_absent > 0) {
     std::printf("  no peer           %lld of %lld frames\n",
                 static_cast<long long>(o.summary.frames_peer_absent),
@@ -347,51 +523,121 @@ void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
   std::printf("%s\n", o.ok ? "PASS" : "FAIL");
 }
 
+/// What the first lost message of one direction was, for the error message.
+std::string DescribeMiss(const char* what, const io::MessageTally& tally,
+                         const io::FirstMiss& first, const char* reader) {
+  std::string text = std::string(what) + " messages: " + std::to_string(tally.received) + " of " +
+                     std::to_string(tally.sent) + " arrived as sent, " +
+                     std::to_string(tally.missed()) + " missed";
+  if (first.frame < 0) return text;
+  text += "; the first at data frame " + std::to_string(first.frame);
+  if (*first.reason != '\0') return text + ", whose frame failed (" + first.reason + ")";
+  return text + ", channel " + std::to_string(first.channel) + ": sent " +
+         std::to_string(first.sent) + ", " + reader + " " + std::to_string(first.read);
+}
+
+/// Mock: the end-to-end figures that failed, and the way out.
+std::string MockFailure(const IoTestOptions& options, const MockFigures& m) {
+  std::string what;
+  if (m.tally.encoder.missed() > 0) {
+    what = DescribeMiss("encoder", m.tally.encoder, m.tally.first_encoder_miss, "the ECS decoded");
+  } else if (m.tally.pwm.missed() > 0) {
+    what = DescribeMiss("PWM", m.tally.pwm, m.tally.first_pwm_miss, "the twin read");
+  } else {
+    what = "the link had errors (see the summary above)";
+  }
+  return what + (options.inject_fault.empty()
+                     ? "; on a mock link no wire can fail, so this is a bug in the board model or "
+                       "the drivers: report it with this output"
+                     : "; this is what --inject-fault " + options.inject_fault + " should cause");
+}
+
 /// Exit 5 with what went wrong and the way out; returns when the test passed.
-void ThrowUnlessPassed(const IoTestOptions& options, io::Image image, const IoTestOutcome& o, bool mock) {
+void ThrowUnlessPassed(const IoTestOptions& options, io::Image image, const IoTestOutcome& o) {
   const Summary& summary = o.summary;
   if (summary.fault != nullptr) {
-    throw CommandError(ExitCode::kIo, std::string("link fault on ") + options.io + ": " + summary.fault);
+    throw CommandError(ExitCode::kIo,
+                       std::string("link fault on ") + options.io + ": " + summary.fault);
   }
   if (summary.frames_peer_absent > 0) {
     const std::string other = SideName(io::Counterpart(image));
-    const std::string what =
-        summary.frames_peer_absent == summary.frames
-            ? "no " + other + " process was attached to " + options.io + " during the whole run, so " +
-                  "nothing crossed the wire"
-            : "no " + other + " process was attached to " + options.io + " for " +
-                  std::to_string(summary.frames_peer_absent) + " of " + std::to_string(summary.frames) +
-                  " frames, which tested nothing";
-    throw CommandError(ExitCode::kIo, what + "; " + NoPeerAdvice(options, image, options.wait_peer_s > 0.0));
+    const std::string what = summary.frames_peer_absent == summary.frames
+                                 ? "no " + other + " process was attached to " + options.io +
+                                       " during the whole run, so " + "nothing crossed the wire"
+                                 : "no " + other + " process was attached to " + options.io +
+                                       " for " + std::to_string(summary.frames_peer_absent) +
+                                       " of " + std::to_string(summary.frames) +
+                                       " frames, which tested nothing";
+    throw CommandError(ExitCode::kIo,
+                       what + "; " + NoPeerAdvice(options, image, options.wait_peer_s > 0.0));
   }
-  if (!o.ok) {
-    throw CommandError(ExitCode::kIo, "the link had errors (see the summary above); check wiring, "
-                                      "cable length and SPI speed, then rerun" +
-                                      std::string(mock ? "" : "; over a wire or real link the other "
-                                                              "side must run io-test too (its pattern "
-                                                              "is checked)"));
-  }
+  if (o.ok) return;
+  if (o.mock) throw CommandError(ExitCode::kIo, MockFailure(options, *o.mock));
+  throw CommandError(ExitCode::kIo,
+                     "the link had errors (see the summary above); check wiring, "
+                     "cable length and SPI speed, then rerun; over a wire or real "
+                     "link the other side must run io-test too (its pattern is "
+                     "checked)");
 }
 
 int RunIoTest(const IoTestOptions& options) {
   const io::Image image = *io::ParseImage(options.image);
-  const std::unique_ptr<io::IoBackend> backend = OpenIoTestBackend(options, image);
-  if (options.wait_peer_s > 0.0) WaitForPeer(*backend, options, image);
+  const bool mock = CheckBackendFlags(options) == io::BackendSpec::Kind::kMock;
+  const io::LinkFault fault = options.inject_fault.empty()
+                                  ? io::LinkFault{}
+                                  : ParseLinkFault(options.inject_fault, options.frames);
   const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(options.rate_hz);
-  const bool mock = backend->kind() == io::BackendSpec::Kind::kMock;
-  PatternSource pattern(period_ns);
+  IoTestOutcome outcome;
   if (mock) {
-    backend->emulated_board()->SetPwmSource(&pattern);
-    backend->emulated_board()->SetEncoderSource(&pattern);
+    outcome = RunMock(options, image, period_ns, fault);
+  } else {
+    const std::unique_ptr<io::IoBackend> backend = OpenIoTestBackend(options, image);
+    if (options.wait_peer_s > 0.0) WaitForPeer(*backend, options, image);
+    outcome = ExchangeFrames(*backend, options, image, period_ns);
   }
-  const IoTestOutcome outcome = ExchangeFrames(*backend, options, image, period_ns);
   if (options.json) {
     PrintJson(options, outcome);
   } else {
     PrintText(options, outcome);
   }
-  ThrowUnlessPassed(options, image, outcome, mock);
+  ThrowUnlessPassed(options, image, outcome);
   return static_cast<int>(ExitCode::kPass);
+}
+
+void AddIoTestOptions(CLI::App* app, IoTestOptions& options) {
+  app->add_option("--io", options.io, std::string("backend: ") + io::kBackendForms)
+      ->capture_default_str();
+  app->add_option("--image", options.image,
+                  "image this side's driver needs: icoboard (ECS) or icoboard_inverse (twin); over "
+                  "mock, whose counters lead the summary")
+      ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}))
+      ->capture_default_str();
+  app->add_option("--board-image", options.board_image,
+                  "mock only: image the emulated board of --image's side carries (default: the one "
+                  "--image needs); a mismatch tests the wrong-image error")
+      ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}));
+  app->add_option("--frames", options.frames,
+                  "data (ALL) frames to send after INIT, each one encoder and one PWM message; a "
+                  "TEST loop-back follows every 3rd, so every 4th transfer is a TEST")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100'000'000}))
+      ->capture_default_str();
+  app->add_option(
+         "--rate", options.rate_hz,
+         "frame rate in Hz and the step size sent in INIT (over mock only the step: the boards' "
+         "time is frames x step, and the run is as fast as the machine)")
+      ->check(CLI::Range(1.0, 100'000.0))
+      ->capture_default_str();
+  app->add_option("--wait-peer", options.wait_peer_s,
+                  "wire only: wait up to SECONDS for the other process to attach before INIT "
+                  "(a run with no peer fails with exit 5)")
+      ->check(CLI::Range(0.0, 3600.0));
+  app->add_option("--inject-fault", options.inject_fault,
+                  std::string("mock only: make the boards fail to see io-test catch it: ") +
+                      kFaultForms + " (data frame FRAME on, N frames)");
+  app->add_flag("--json", options.json,
+                "print the summary as JSON (frames_sent, frames_received, frames_corrupted, "
+                "frames_missed, init_frames_*, test_frames_*, count_errors, counts_over_limit, "
+                "frames_peer_absent; over mock also encoder_messages_*, pwm_messages_*, ...)");
 }
 
 Command AddIoTestCommand(CLI::App& parent) {
@@ -400,36 +646,17 @@ Command AddIoTestCommand(CLI::App& parent) {
       "io-test", "Bring-up test of the FPGA link: INIT, identity check, N frames, errors counted");
   app->description(
       "Bring-up test of the FPGA link: sends INIT (with the step size from --rate), checks the\n"
-      "board's identity (icoboard = ECS image, icoboard_inverse = twin image), then N frames with\n"
-      "a known pattern (every 4th a TEST loop-back) and prints frames sent/received/corrupted/\n"
-      "missed and count errors. Over wire:NAME or spidev the other side must run io-test too:\n"
-      "its pattern is checked on arrival. Exit 0 only without errors; 5 on an I/O error, the\n"
-      "wrong image or a wire with no peer; 2 on bad usage. Frame layout: docs/spi-protocol.md.");
-  app->add_option("--io", options->io, std::string("backend: ") + io::kBackendForms)
-      ->capture_default_str();
-  app->add_option("--image", options->image,
-                  "image this side's driver needs: icoboard (ECS) or icoboard_inverse (twin)")
-      ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}))
-      ->capture_default_str();
-  app->add_option("--board-image", options->board_image,
-                  "mock only: image the emulated board carries (default: the one --image needs); "
-                  "a mismatch tests the wrong-image error")
-      ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}));
-  app->add_option("--frames", options->frames,
-                  "frames to send after INIT: every 4th is a TEST loop-back, the others data (ALL) "
-                  "frames")
-      ->check(CLI::Range(std::int64_t{1}, std::int64_t{100'000'000}))
-      ->capture_default_str();
-  app->add_option("--rate", options->rate_hz, "frame rate in Hz; also the step size sent in INIT")
-      ->check(CLI::Range(1.0, 100'000.0))
-      ->capture_default_str();
-  app->add_option("--wait-peer", options->wait_peer_s,
-                  "wire only: wait up to SECONDS for the other process to attach before INIT "
-                  "(a run with no peer fails with exit 5)")
-      ->check(CLI::Range(0.0, 3600.0));
-  app->add_flag("--json", options->json,
-                "print the summary as JSON (frames_sent, frames_received, frames_corrupted, "
-                "frames_missed, count_errors, counts_over_limit, frames_peer_absent, ...)");
+      "board's identity (icoboard = ECS image, icoboard_inverse = twin image), then N data frames\n"
+      "with a known pattern (a TEST loop-back after every 3rd) and prints frames sent/received/\n"
+      "corrupted/missed (data, INIT and TEST apart) and count errors. Over mock both boards run\n"
+      "here, joined by their wires, unpaced: the ECS must decode the twin's encoder pattern edge\n"
+      "by edge and the twin read the ECS's PWM, counted as messages sent/received/missed (thesis\n"
+      "Table 5.2: --frames 720000). Over wire:NAME or spidev the other side must run io-test too:\n"
+      "its pattern is checked on arrival. Exit 0 only without errors; 5 on an I/O error, the "
+      "wrong\n"
+      "image, a lost message or a wire with no peer; 2 on bad usage. Frames: "
+      "docs/spi-protocol.md.");
+  AddIoTestOptions(app, *options);
   return Command{app, [options] { return RunIoTest(*options); }};
 }
 

@@ -29,6 +29,19 @@ const char* DecodeReason(FrameError error) noexcept {
   return "";
 }
 
+/// The sent and received counters of the kind of frame `opcode` starts.
+struct KindCounters {
+  std::uint64_t* sent;
+  std::uint64_t* received;
+};
+KindCounters CountersOfKind(LinkCounters& counters, Opcode opcode) noexcept {
+  switch (opcode) {
+    case Opcode::kInit: return {&counters.init_frames_sent, &counters.init_frames_received};
+    case Opcode::kTest: return {&counters.test_frames_sent, &counters.test_frames_received};
+    default: return {&counters.frames_sent, &counters.frames_received};
+  }
+}
+
 const char* SideName(Image image) noexcept {
   return image == Image::kIcoboard ? "the ECS" : "the twin";
 }
@@ -57,7 +70,8 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     status.reason = "request field out of range (driver bug)";
     return status;
   }
-  ++counters_.frames_sent;
+  const KindCounters kind = CountersOfKind(counters_, request.opcode);
+  ++*kind.sent;
   const TransferStatus transfer = spi_.Transfer(tx_, rx_);
   status.transfer_ns = transfer.duration_ns;
   // INIT configures this side's own board, which answered; a wire peer whose heartbeat is stale
@@ -115,7 +129,7 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     status.reason = "the board is not initialised (reset or power loss): run INIT again";
     return status;
   }
-  ++counters_.frames_received;
+  ++*kind.received;
   return status;
 }
 

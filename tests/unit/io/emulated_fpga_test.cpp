@@ -49,8 +49,11 @@ TEST(IcoBoardInverse, InitChecksIdentityAndSendsStepAndDivider) {
   EXPECT_TRUE(rig.board.initialised());
   EXPECT_EQ(rig.board.step_ns(), kStepNs);
   EXPECT_EQ(rig.board.clock_divider(), ClockDividerForStep(kStepNs));
-  EXPECT_EQ(rig.driver.counters().frames_sent, 1U);
-  EXPECT_EQ(rig.driver.counters().frames_received, 1U);
+  // INIT is counted apart: frames_sent and frames_received are data frames only.
+  EXPECT_EQ(rig.driver.counters().init_frames_sent, 1U);
+  EXPECT_EQ(rig.driver.counters().init_frames_received, 1U);
+  EXPECT_EQ(rig.driver.counters().frames_sent, 0U);
+  EXPECT_EQ(rig.driver.counters().frames_received, 0U);
   EXPECT_THROW((void)rig.driver.Init(5), std::invalid_argument);
 }
 
@@ -102,7 +105,9 @@ TEST(IcoBoardInverse, ExchangeCarriesValuesAndBoardTimeIsFramesTimesStep) {
     }
   }
   EXPECT_EQ(rig.board.data_frames(), 50U);
-  EXPECT_EQ(rig.driver.counters().frames_received, 51U);
+  EXPECT_EQ(rig.driver.counters().frames_sent, 50U);
+  EXPECT_EQ(rig.driver.counters().frames_received, 50U);
+  EXPECT_EQ(rig.driver.counters().init_frames_received, 1U);
   EXPECT_EQ(rig.driver.counters().frames_corrupted + rig.driver.counters().frames_missed, 0U);
 }
 
@@ -240,6 +245,25 @@ TEST(IcoBoardLink, TestFrameEchoes) {
   const std::array<std::uint8_t, 8> pattern = {1, 2, 3, 4, 0xF0, 0x0F, 0xAA, 0x55};
   ASSERT_TRUE(rig.driver.Test(pattern, echo).ok());  // TEST works before INIT
   EXPECT_EQ(echo, pattern);
+  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  TwinInputs in;
+  ASSERT_TRUE(rig.driver.Exchange({1, 2, 3, 4}, in).ok());
+  ASSERT_TRUE(rig.driver.Test(pattern, echo).ok());
+  ASSERT_TRUE(rig.driver.Test(pattern, echo).ok());
+  // Each kind is counted apart (INIT reset the counters, so the first TEST is gone).
+  const LinkCounters& c = rig.driver.counters();
+  EXPECT_EQ(c.test_frames_sent, 2U);
+  EXPECT_EQ(c.test_frames_received, 2U);
+  EXPECT_EQ(c.init_frames_sent, 1U);
+  EXPECT_EQ(c.frames_sent, 1U);
+  EXPECT_EQ(c.frames_received, 1U);
+  // A damaged TEST answer is a link error like any other, but not a data frame.
+  rig.board.faults().corrupt_answers = 1;
+  EXPECT_EQ(rig.driver.Test(pattern, echo).code, ExchangeStatus::Code::kCorrupted);
+  EXPECT_EQ(c.test_frames_sent, 3U);
+  EXPECT_EQ(c.test_frames_received, 2U);
+  EXPECT_EQ(c.frames_corrupted, 1U);
+  EXPECT_EQ(c.frames_sent, 1U);
 }
 
 TEST(EmulatedFpga, PerChannelOpcodesReadOneChannelBack) {

@@ -35,11 +35,11 @@ constexpr std::int32_t kPwmPeriodClocks = 4096;
 /// the sign from the direction pin.
 [[nodiscard]] std::int32_t PwmReaderValue(double duty) noexcept;
 
-/// Wheel geometry for metres <-> counts. Appendix G computes
-/// `metres / wheel_radius / gear_ratio * encoder_counts_per_rotation`, and its comment reads
-/// "meters to wheel_radians to motor_radians to encoder_counts": a radian count needs counts per
-/// *radian*. hiltwin names every quantity per revolution, so the 2π is explicit here:
-/// counts = metres / (2π · r) · motor turns per wheel turn · counts per motor turn.
+/// Wheel geometry for metres <-> counts: counts = metres · N · CPR / (2π · r). metres / r is
+/// wheel radians; the motor turns N times per wheel turn, so motor radians = wheel radians · N;
+/// the encoder is on the motor shaft, so counts = motor radians / (2π) · CPR. Thesis appendix G's
+/// `metres / wheel_radius / gear_ratio * encoder_counts_per_rotation` differs: it divides by the
+/// ratio and has no 2π (docs/relbot-model.md, "Encoder counts differ from thesis appendix G").
 struct WheelGeometry {
   double wheel_radius_m = 0.05;
   double motor_rev_per_wheel_rev = 1.0;     ///< gearbox reduction N

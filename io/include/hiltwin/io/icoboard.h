@@ -34,12 +34,19 @@ struct ExchangeStatus {
 };
 [[nodiscard]] const char* ToString(ExchangeStatus::Code code) noexcept;
 
-/// Link counters (frames_received = answers that passed every check and were used).
+/// Link counters. "Received" means the answer passed every check and was used. Sent and
+/// received are kept apart per kind, so that frames_sent is the number of data exchanges a user
+/// asked for, not that plus the INIT (and its retries) and the TEST loop-backs; the error
+/// counters cover every kind (a damaged INIT or TEST answer is as much a link error).
 struct LinkCounters {
-  std::uint64_t frames_sent = 0;
-  std::uint64_t frames_received = 0;
-  std::uint64_t frames_corrupted = 0;
-  std::uint64_t frames_missed = 0;
+  std::uint64_t frames_sent = 0;           ///< data frames (ALL, per-channel read-backs)
+  std::uint64_t frames_received = 0;       ///< data frames answered and used
+  std::uint64_t init_frames_sent = 0;      ///< INIT, retries included (INIT resets the counters first)
+  std::uint64_t init_frames_received = 0;
+  std::uint64_t test_frames_sent = 0;      ///< TEST loop-backs
+  std::uint64_t test_frames_received = 0;  ///< answered; whether the echo matched is the caller's
+  std::uint64_t frames_corrupted = 0;      ///< any kind
+  std::uint64_t frames_missed = 0;         ///< any kind
   std::uint64_t faults = 0;
   std::uint64_t pulse_limit_events = 0;  ///< answers whose board flagged kStatusPulseLimit
   std::uint64_t counts_over_limit = 0;   ///< channel changes larger than MaxCountsPerStep
