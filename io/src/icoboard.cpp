@@ -79,8 +79,10 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   // exchange reports the peer as a fault if it is still gone, so nothing is hidden.
   const bool peer_lost_at_init =
       transfer.result == BusResult::kPeerLost && request.opcode == Opcode::kInit;
-  if (transfer.result == BusResult::kIoError ||
-      (transfer.result == BusResult::kPeerLost && !peer_lost_at_init)) {
+  // A lost wire peer is a fault, but this side's own board still took the request: the
+  // answer is checked all the same, so a caller can tell that its safe outputs arrived.
+  const bool peer_lost = transfer.result == BusResult::kPeerLost && !peer_lost_at_init;
+  if (transfer.result == BusResult::kIoError) {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;
     status.reason = transfer.reason;
@@ -127,6 +129,13 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;
     status.reason = "the board is not initialised (reset or power loss): run INIT again";
+    return status;
+  }
+  status.board_answered = true;
+  if (peer_lost) {
+    ++counters_.faults;
+    status.code = ExchangeStatus::Code::kFault;
+    status.reason = transfer.reason;
     return status;
   }
   ++*kind.received;

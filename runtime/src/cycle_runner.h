@@ -57,7 +57,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   /// Thread-safe and lock-free: the loop acts on it after the current cycle.
   void Post(CommandBit command) noexcept;
 
-  /// One exchange with safe outputs, after the loop: true when the board took it.
+  /// One exchange with safe outputs, after the loop: true when the board took and answered it.
   [[nodiscard]] bool WriteSafeOutputs() noexcept;
 
   [[nodiscard]] const LoopCounts& counts() const noexcept { return counts_; }

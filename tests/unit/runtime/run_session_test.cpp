@@ -33,9 +33,12 @@ class ScriptedTask final : public RunTask {
     if (session != nullptr && n == resume_at) session->Post(SessionCommand::kResume);
     if (session != nullptr && n == stop_at) session->Post(SessionCommand::kStop);
     if (n >= io_fault_from)
-      return {.code = io::ExchangeStatus::Code::kFault, .reason = "the link went down"};
-    if (n >= peer_stopped_from) return {.peer_stopped = "wire: the ECS finished its run"};
-    return {};
+      return {.code = io::ExchangeStatus::Code::kFault, .reason = "the link went down",
+              .board_answered = board_answers_faults};
+    if (n >= peer_stopped_from) {
+      return {.board_answered = true, .peer_stopped = "wire: the ECS finished its run"};
+    }
+    return {.board_answered = true};
   }
   StepStatus Step(const scheduler::CycleContext& context) noexcept override {
     ++steps;
@@ -54,6 +57,7 @@ class ScriptedTask final : public RunTask {
   std::uint64_t pause_at = kNever, resume_at = kNever, stop_at = kNever;
   std::uint64_t io_fault_from = kNever, model_fault_at = kNever, finished_at = kNever;
   std::uint64_t peer_stopped_from = kNever;
+  bool board_answers_faults = false;  ///< a wire whose peer is lost: the own board still answers
   std::uint64_t live_exchanges = 0, safe_exchanges = 0, steps = 0, last_cycle = 0;
 
  private:
@@ -232,6 +236,15 @@ TEST(RunSession, AnIoFaultGoesToSafeStopAndExitsFive) {
   EXPECT_EQ(r.fault->reason, "the link went down");
   EXPECT_FALSE(r.outputs_safe);
   EXPECT_EQ(ExitCodeFor(r), ExitCode::kIo);
+}
+
+TEST(RunSession, SafeOutputsTheBoardTookCountAsWrittenAfterAFault) {
+  ScriptedTask task;
+  task.io_fault_from = 50;
+  task.board_answers_faults = true;  // e.g. a lost wire peer: this side's board still answers
+  const RunReport r = RunScripted(task, VirtualConfig(1000));
+  EXPECT_EQ(r.stop_reason, StopReason::kIoFault);
+  EXPECT_TRUE(r.outputs_safe);
 }
 
 TEST(RunSession, AModelFaultGoesToSafeStopWithSafeOutputsAndExitsOne) {

@@ -28,6 +28,9 @@ struct ExchangeStatus {
   std::int64_t transfer_ns = 0;  ///< time the bus took
   bool pulse_limit = false;      ///< an encoder change exceeded what one period can emit
   bool peer_absent = false;      ///< wire: no peer attached yet (values are idle)
+  /// The board took the request and answered it correctly: always with kOk, and also with the
+  /// kFault of a lost wire peer (this side's own board still answered).
+  bool board_answered = false;
   /// wire: the peer announced the end of its run; why (static text). Null while it runs.
   const char* peer_stopped = nullptr;
   [[nodiscard]] bool ok() const noexcept { return code == Code::kOk; }
