@@ -61,6 +61,7 @@ io::ExchangeStatus EcsTask::Exchange(bool live_outputs) noexcept {
     pwm_sent_ = pwm_next_;
   } else {
     pwm_sent_.fill(0);
+    ++held_cycles_;  // paused (or stopping): the profile waits, see Step
   }
   const io::ExchangeStatus status = board_.Exchange(pwm_sent_, inputs_);
   if (status.ok()) have_inputs_ = true;
@@ -133,8 +134,12 @@ runtime::StepStatus EcsTask::Step(const scheduler::CycleContext& context) noexce
         "the session's period differs from the ECS task's period (the PID was discretised "
         "for the task's)");
   }
+  // The profile's clock runs only while the controller runs: after a pause the setpoints go
+  // on from where they stopped instead of jumping ahead by the pause. Skipped releases (skip
+  // policy) still count, so the profile keeps to the wall clock then.
+  const std::uint64_t profile_cycle = context.cycle - held_cycles_;
   last_.cycle = context.cycle;
-  last_.time_s = TimeS(context.cycle, period_ns_);
+  last_.time_s = TimeS(profile_cycle, period_ns_);
   last_.duty_sent =
       Duty{io::PwmToDuty(pwm_sent_[kLeftChannel]), io::PwmToDuty(pwm_sent_[kRightChannel])};
   ReadWheels();
@@ -143,7 +148,7 @@ runtime::StepStatus EcsTask::Step(const scheduler::CycleContext& context) noexce
   } else {
     // Sampled at the moment it goes on the wire (the next exchange), so the duty on the wire
     // over [t_j, t_j+1) is the profile at t_j: the signal ProfilePwmSource plays into a twin.
-    SetNextDuty(duty_profile_->At(TimeS(context.cycle + 1, period_ns_)));
+    SetNextDuty(duty_profile_->At(TimeS(profile_cycle + 1, period_ns_)));
   }
   return runtime::StepStatus::Ok();
 }

@@ -75,6 +75,21 @@ TEST(EcsTask, SafeOutputsSendZeroDuty) {
   EXPECT_EQ(task.last().duty_sent.left, 0.0);  // the log says what was really on the wire
 }
 
+TEST(EcsTask, APauseStopsTheProfilesClockInsteadOfSkippingPartOfIt) {
+  LoneBoard rig;
+  const InputProfile ramp = ParseCsvProfile("time,left,right\n0,0,0\n1,1,-1\n", "ramp.csv");
+  EcsTask task(rig.driver, ramp, rig.geometry, kPeriodNs);
+  for (std::uint64_t k = 0; k < 10; ++k) {
+    ASSERT_TRUE(task.Exchange(true).ok());
+    ASSERT_EQ(task.Step(Cycle(k)).code, runtime::StepStatus::Code::kOk);
+  }
+  for (int paused = 0; paused < 5; ++paused) ASSERT_TRUE(task.Exchange(false).ok());  // 10..14
+  ASSERT_TRUE(task.Exchange(true).ok());
+  ASSERT_EQ(task.Step(Cycle(15)).code, runtime::StepStatus::Code::kOk);
+  EXPECT_EQ(task.LogTimeS(), 10e-3);  // the 11th step of the profile, not the 16th
+  EXPECT_EQ(task.last().duty_next.left, io::PwmToDuty(io::DutyToPwm(11e-3)));
+}
+
 TEST(EcsTask, ClosedLoopDrivesEachWheelOnItsOwnChannel) {
   LoneBoard rig;
   const SetpointProfile setpoints =

@@ -14,7 +14,8 @@
 ///   and the measured wheel positions every cycle (thesis §5.2, fig. 5.2), so the log can be
 ///   replayed into a reference run (LoadInputProfile reads its duty_left,duty_right columns).
 ///
-/// Time is the task's own: cycle × period_ns, exact multiples, never accumulated. The cycle
+/// Time is the task's own: (cycle − paused cycles) × period_ns, exact multiples, never
+/// accumulated, so a pause stops the profile rather than skipping part of it. The cycle
 /// of the exchange is the sampling moment: the counts read in cycle k are the wheels at
 /// t_k = k·period, and the duty computed in step k is on the wire from t_{k+1}. Everything on
 /// the loop's path is noexcept and allocation-free.
@@ -141,6 +142,7 @@ class EcsTask final : public runtime::RunTask {
   std::array<std::int64_t, 2> origin_counts_{};         ///< left, right at the first step
   bool have_inputs_ = false;  ///< an exchange has succeeded: the counts are a reading
   bool started_ = false;      ///< the origin is taken
+  std::uint64_t held_cycles_ = 0;  ///< exchanges with safe outputs (paused): not profile time
   EcsCycleRecord last_{};
   TrackingSums sums_{};
 };
