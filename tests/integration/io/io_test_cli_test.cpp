@@ -211,14 +211,18 @@ std::string WireName(const char* tag) {
   return name;
 }
 
-/// A background process for the other end of a wire; its output goes to a file removed on Stop.
+/// A background process for the other end of wire `name`; its output goes to a file removed
+/// on Stop, and so does the wire's segment (the peer outlives the run under test and is
+/// stopped by a signal, so it cannot be the last one out that removes it).
 class Peer {
  public:
-  explicit Peer(const std::vector<std::string>& argv)
-      : out_("/tmp/hiltwin-io-cli-peer-" + std::to_string(::getpid())),
+  Peer(std::string name, const std::vector<std::string>& argv)
+      : name_(std::move(name)),
+        out_("/tmp/hiltwin-io-cli-peer-" + std::to_string(::getpid())),
         process_(test::Spawn(argv, out_)) {}
   ~Peer() {
     process_.Kill(SIGTERM);
+    io::WireBus::Unlink(name_);
     ::unlink(out_.c_str());
     ::unlink((out_ + ".err").c_str());
   }
@@ -226,6 +230,7 @@ class Peer {
   Peer& operator=(const Peer&) = delete;
 
  private:
+  std::string name_;
   std::string out_;
   kernel_glue::Process process_;
 };
@@ -240,7 +245,7 @@ std::vector<std::string> IoTestPeer(const std::string& name, const char* image) 
 /// io-test as `image` over a fresh wire, against io-test as `peer_image` in another process.
 test::RunResult IoTestAgainstIoTestPeer(const char* tag, const char* image, const char* peer_image) {
   const std::string name = WireName(tag);
-  const Peer peer(IoTestPeer(name, peer_image));
+  const Peer peer(name, IoTestPeer(name, peer_image));
   return IoTest({"--io", "wire:" + name, "--image", image, "--frames", "400", "--rate", "2000",
                  "--wait-peer", "20", "--json"});
 }
@@ -276,7 +281,7 @@ TEST(IoTestCli, APeerThatDoesNotSendThePatternIsCaught) {
   const std::string name = WireName("echo");
   test::RunResult r;
   {
-    const Peer echo({HILTWIN_WIRE_PEER, "twin", name, "1000"});
+    const Peer echo(name, {HILTWIN_WIRE_PEER, "twin", name, "1000"});
     r = IoTest({"--io", "wire:" + name, "--image", "icoboard", "--frames", "400", "--rate", "2000",
                 "--wait-peer", "20", "--json"});
   }
