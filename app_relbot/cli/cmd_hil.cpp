@@ -246,8 +246,8 @@ int RunHil(HilOptions o) {
   } catch (const std::invalid_argument& e) {
     Usage(std::string("--wire: ") + e.what());
   }
+  const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
   std::ofstream report_file = OpenReport(o.report_path);
-  const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);
   kernel_glue::InstallStopSignalHandlers();
   std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s\n",
               Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(),
