@@ -74,11 +74,7 @@ std::unique_ptr<Ecs> BuildEcs(const EcsOptions& o, kernel_glue::TimeNs period_ns
   LoadEcsConfiguration(o, *ecs);
   ecs->backend = OpenBoard(o.session, io::Image::kIcoboard);
   ecs->driver = std::make_unique<io::IcoBoard>(ecs->backend->bus());
-  const io::InitResult init = ecs->driver->Init(period_ns);
-  if (!init.ok) {
-    throw CommandError(ExitCode::kIo,
-                       init.message.empty() ? "Failed to initialise FPGA" : init.message);
-  }
+  InitBoard(*ecs->driver, period_ns);
   const io::WheelGeometry geometry = WheelGeometryOf(ecs->params);
   try {
     if (ecs->setpoints) {
@@ -130,15 +126,7 @@ int RunEcs(EcsOptions o) {
                         const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, profile, rt);
   };
-  std::optional<runtime::RunSession> session;
-  try {
-    session.emplace(std::move(config), *ecs->task);
-  } catch (const std::invalid_argument& e) {
-    Usage(e.what());
-  } catch (const std::runtime_error& e) {
-    Usage(std::string("--log: ") + e.what());
-  }
-  const runtime::RunReport report = session->Run();
+  const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
   const EcsFigures figures =
       EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
   PrintOutcome(o.session, role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),

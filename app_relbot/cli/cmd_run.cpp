@@ -94,11 +94,7 @@ std::unique_ptr<Twin> BuildTwin(const RunOptions& o, kernel_glue::TimeNs period_
   twin->input_name =
       profile_drives ? twin->profile->name() : "the controller on " + o.session.io;
   twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
-  const io::InitResult init = twin->driver->Init(period_ns);
-  if (!init.ok) {
-    throw CommandError(ExitCode::kIo,
-                       init.message.empty() ? "Failed to initialise FPGA" : init.message);
-  }
+  InitBoard(*twin->driver, period_ns);
   twin->geometry = WheelGeometryOf(twin->params);
   twin->task.emplace(*twin->driver, *twin->model, twin->geometry);
   return twin;
@@ -132,15 +128,7 @@ int RunTwin(RunOptions o) {
                      input = twin->input_name](const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(s, planned, input, rt);
   };
-  std::optional<runtime::RunSession> session;
-  try {
-    session.emplace(std::move(config), *twin->task);
-  } catch (const std::invalid_argument& e) {
-    Usage(e.what());
-  } catch (const std::runtime_error& e) {
-    Usage(std::string("--log: ") + e.what());
-  }
-  const runtime::RunReport report = session->Run();
+  const runtime::RunReport report = RunSessionOf(std::move(config), *twin->task);
   PrintOutcome(o.session, role, report, runtime::ToJson(report), "", report_file);
   if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault) {
     std::fprintf(

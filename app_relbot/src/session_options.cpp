@@ -210,6 +210,26 @@ runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionR
   return config;
 }
 
+void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns) {
+  const io::InitResult init = driver.Init(period_ns);
+  if (!init.ok) {
+    throw CommandError(ExitCode::kIo,
+                       init.message.empty() ? "Failed to initialise FPGA" : init.message);
+  }
+}
+
+runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask& task) {
+  std::optional<runtime::RunSession> session;
+  try {
+    session.emplace(std::move(config), task);
+  } catch (const std::invalid_argument& e) {
+    Usage(e.what());
+  } catch (const std::runtime_error& e) {
+    Usage(std::string("--log: ") + e.what());
+  }
+  return session->Run();
+}
+
 std::ofstream OpenReport(const std::string& path) {
   std::ofstream file;
   if (path.empty()) return file;

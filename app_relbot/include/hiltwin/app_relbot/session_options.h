@@ -15,6 +15,7 @@
 
 #include "hiltwin/app_relbot/command.h"
 #include "hiltwin/io/backend.h"
+#include "hiltwin/io/icoboard.h"
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/run_report.h"
 #include "hiltwin/runtime/run_session.h"
@@ -77,6 +78,15 @@ void ValidateSessionOptions(const SessionOptions& o);
 [[nodiscard]] runtime::SessionConfig MakeSessionConfig(const SessionOptions& o,
                                                        const SessionRole& role,
                                                        io::IoBackend& backend);
+
+/// INIT and the identity check of this side's board; exit 5 with the thesis's message
+/// ("Failed to initialise FPGA: ...", fig. 4.2) when the board carries the wrong image.
+void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns);
+
+/// Builds the session (a bad configuration, or a log that cannot be created: exit 2) and runs
+/// it to its end.
+[[nodiscard]] runtime::RunReport RunSessionOf(runtime::SessionConfig config,
+                                              runtime::RunTask& task);
 
 /// Opens --report before the run, so a path that cannot be written fails first, not after.
 [[nodiscard]] std::ofstream OpenReport(const std::string& path);
