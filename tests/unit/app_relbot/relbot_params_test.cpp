@@ -2,69 +2,62 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <fstream>
-#include <limits>
 #include <numbers>
-#include <sstream>
 #include <string>
+
+#include "unit/app_relbot/toml_number_file_tests.h"
 
 namespace hiltwin::app {
 namespace {
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+// app_relbot/relbot.toml through the behaviour every TOML number file shares, with the messages
+// a user of this file sees.
+struct RelbotFile {
+  using Record = RelbotParams;
+  static constexpr const char* kPath = HILTWIN_RELBOT_TOML;
+  static constexpr auto kParse = ParseRelbotParams;
+  static constexpr auto kLoad = LoadRelbotParams;
+  static constexpr auto kValidate = ValidateRelbotParams;
+  static constexpr auto kSpecs = RelbotParamSpecs;
+  static constexpr auto kDefaults = DefaultRelbotParams;
 
-std::string FileText() { return ReadFile(HILTWIN_RELBOT_TOML); }
+  static constexpr std::string_view kWhatToDo =
+      "fix it in the file (app_relbot/relbot.toml lists every key with its unit and a documented "
+      "value), or run without a parameter file to use the built-in set";
+  static constexpr std::string_view kExpectedTables =
+      "supply, motor, gear, encoder, wheel, body, contact, castor";
+  static constexpr std::string_view kUnknownTable = "battery";
+  static constexpr std::string_view kUnknownTopLevelKey = "speed";
+  static constexpr toml_test::MissingKey kMissing{
+      "resistance_ohm",
+      "missing RELbot parameter motor.resistance_ohm (a number > 0 and <= 10000); add it under "
+      "[motor]"};
+  static constexpr toml_test::LineEdit kBelowMin{
+      "resistance_ohm", "resistance_ohm = -4.0",
+      "RELbot parameter motor.resistance_ohm = -4 is out of range: it must be > 0 and <= 10000"};
+  // A 1 km wheel: a unit slip.
+  static constexpr toml_test::LineEdit kAboveMax{
+      "radius_m", "radius_m = 1000.0",
+      "RELbot parameter wheel.radius_m = 1000 is out of range: it must be > 0 and <= 10"};
+  static constexpr toml_test::LineEdit kNotANumber{
+      "radius_m", "radius_m = \"40 mm\"",
+      "RELbot parameter wheel.radius_m must be a number, not a string"};
+  static constexpr toml_test::LineEdit kUnknownKey{
+      "resistance_ohm", "resistance_ohms = 4.0",
+      "unknown key motor.resistance_ohms (check the spelling and the unit suffix)"};
+  static constexpr toml_test::NonFiniteKey kNonFinite{
+      "stiffness_n_per_m", "RELbot parameter contact.stiffness_n_per_m is not a finite number"};
+  static constexpr toml_test::IntegerKey<RelbotParams> kInteger{
+      "ratio_motor_rev_per_wheel_rev", &RelbotParams::gear_ratio_motor_rev_per_wheel_rev, 30};
+  static constexpr double RelbotParams::*kValidateMember = &RelbotParams::wheel_radius_m;
+  static constexpr std::string_view kValidateNaN =
+      "RELbot parameter wheel.radius_m is not a finite number";
+  static constexpr std::string_view kUnreadable =
+      "cannot read the RELbot parameter file (No such file or directory); check the path, or run "
+      "without a parameter file to use the built-in set";
+};
 
-// Replaces the whole line that starts with `key =` (first match) by `replacement`; returns the
-// 1-based line number, so tests can expect "file:line:" in the message.
-int ReplaceLine(std::string& text, const std::string& key, const std::string& replacement) {
-  std::istringstream in(text);
-  std::ostringstream out;
-  std::string line;
-  int number = 0;
-  int found = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (found == 0 && line.rfind(key + " =", 0) == 0) {
-      found = number;
-      line = replacement;
-    }
-    out << line << '\n';
-  }
-  text = out.str();
-  return found;
-}
-
-std::string ErrorOf(const std::string& text) {
-  try {
-    (void)ParseRelbotParams(text, "test.toml");
-  } catch (const ConfigError& error) {
-    return error.what();
-  }
-  return "(no error)";
-}
-
-TEST(RelbotParams, TomlFileEqualsBuiltInDefaults) {
-  const RelbotParams from_file = LoadRelbotParams(HILTWIN_RELBOT_TOML);
-  const RelbotParams defaults = DefaultRelbotParams();
-  int compared = 0;
-  for (const ParamSpec& spec : RelbotParamSpecs()) {
-    EXPECT_EQ(from_file.*spec.member, defaults.*spec.member) << spec.table << "." << spec.key;
-    ++compared;
-  }
-  // Every member of RelbotParams is in the table (no parameter escapes the file).
-  EXPECT_EQ(static_cast<std::size_t>(compared) * sizeof(double), sizeof(RelbotParams));
-}
-
-TEST(RelbotParams, DefaultsAreValid) {
-  EXPECT_NO_THROW(ValidateRelbotParams(DefaultRelbotParams(), "built-in"));
-}
+INSTANTIATE_TYPED_TEST_SUITE_P(RelbotParams, TomlNumberFile, RelbotFile);
 
 TEST(RelbotParams, EveryKeyCarriesAUnitOrCountSuffix) {
   for (const ParamSpec& spec : RelbotParamSpecs()) {
@@ -74,96 +67,19 @@ TEST(RelbotParams, EveryKeyCarriesAUnitOrCountSuffix) {
   }
 }
 
-TEST(RelbotParams, MissingKeyIsNamed) {
-  std::string text = FileText();
-  ASSERT_GT(ReplaceLine(text, "resistance_ohm", "# removed"), 0);
-  const std::string message = ErrorOf(text);
-  EXPECT_NE(message.find("test.toml"), std::string::npos) << message;
-  EXPECT_NE(message.find("missing"), std::string::npos) << message;
-  EXPECT_NE(message.find("motor.resistance_ohm"), std::string::npos) << message;
-  EXPECT_NE(message.find("add it under [motor]"), std::string::npos) << message;
-}
-
-TEST(RelbotParams, OutOfRangeValueIsNamedWithLine) {
-  std::string text = FileText();
-  const int line = ReplaceLine(text, "resistance_ohm", "resistance_ohm = -4.0");
-  ASSERT_GT(line, 0);
-  const std::string message = ErrorOf(text);
-  EXPECT_NE(message.find("test.toml:" + std::to_string(line) + ":"), std::string::npos)
-      << message;
-  EXPECT_NE(message.find("motor.resistance_ohm"), std::string::npos) << message;
-  EXPECT_NE(message.find("out of range"), std::string::npos) << message;
-  EXPECT_NE(message.find("> 0"), std::string::npos) << message;
-}
-
-TEST(RelbotParams, NonFiniteValuesAreRejected) {
-  for (const std::string value : {"nan", "inf", "-inf"}) {
-    std::string text = FileText();
-    ASSERT_GT(ReplaceLine(text, "stiffness_n_per_m", "stiffness_n_per_m = " + value), 0);
-    const std::string message = ErrorOf(text);
-    EXPECT_NE(message.find("contact.stiffness_n_per_m"), std::string::npos) << message;
-    EXPECT_NE(message.find("not a finite number"), std::string::npos) << message;
-  }
-}
-
-TEST(RelbotParams, NonNumberIsRejected) {
-  std::string text = FileText();
-  ASSERT_GT(ReplaceLine(text, "radius_m", "radius_m = \"40 mm\""), 0);
-  const std::string message = ErrorOf(text);
-  EXPECT_NE(message.find("wheel.radius_m must be a number"), std::string::npos) << message;
-}
-
-TEST(RelbotParams, IntegersAreAcceptedAsNumbers) {
-  std::string text = FileText();
-  ASSERT_GT(ReplaceLine(text, "ratio_motor_rev_per_wheel_rev", "ratio_motor_rev_per_wheel_rev = 30"),
-            0);
-  EXPECT_EQ(ParseRelbotParams(text, "test.toml").gear_ratio_motor_rev_per_wheel_rev, 30.0);
-}
-
-TEST(RelbotParams, UnknownKeysAndTablesAreRejected) {
-  std::string text = FileText();
-  const int line = ReplaceLine(text, "resistance_ohm", "resistance_ohm = 4.0\nresistance_ohms = 4.0");
-  std::string message = ErrorOf(text);
-  EXPECT_NE(message.find("unknown key motor.resistance_ohms"), std::string::npos) << message;
-  EXPECT_NE(message.find("test.toml:" + std::to_string(line + 1) + ":"), std::string::npos)
-      << message;
-  message = ErrorOf(FileText() + "\n[battery]\ncapacity_mah = 2200\n");
-  EXPECT_NE(message.find("unknown table [battery]"), std::string::npos) << message;
-  message = ErrorOf("speed = 3\n" + FileText());
-  EXPECT_NE(message.find("unknown top-level key 'speed'"), std::string::npos) << message;
-}
-
-TEST(RelbotParams, SyntaxErrorGivesLineAndColumn) {
-  std::string text = FileText();
-  const int line = ReplaceLine(text, "mass_kg", "mass_kg = = 0.1");
-  const std::string message = ErrorOf(text);
-  EXPECT_NE(message.find("test.toml:" + std::to_string(line) + ":"), std::string::npos)
-      << message;
-  EXPECT_NE(message.find("not valid TOML"), std::string::npos) << message;
-}
-
-TEST(RelbotParams, UnreadableFileSaysSo) {
-  try {
-    (void)LoadRelbotParams("/nonexistent/relbot.toml");
-    FAIL() << "no error";
-  } catch (const ConfigError& error) {
-    const std::string message = error.what();
-    EXPECT_NE(message.find("/nonexistent/relbot.toml: cannot read"), std::string::npos) << message;
-  }
-}
-
-TEST(RelbotParams, ValidateNamesTheBadMember) {
+TEST(RelbotParams, CastorSmoothingSpeedMustBePositive) {
   RelbotParams p;
   p.castor_smoothing_speed_m_per_s = 0.0;  // must be > 0: it divides the Coulomb term
   try {
     ValidateRelbotParams(p, "built-in");
     FAIL() << "no error";
   } catch (const ConfigError& error) {
-    EXPECT_NE(std::string(error.what()).find("castor.smoothing_speed_m_per_s"), std::string::npos);
+    EXPECT_NE(std::string(error.what())
+                  .find("built-in: RELbot parameter castor.smoothing_speed_m_per_s = 0 is out of "
+                        "range: it must be > 0 and <= 100; "),
+              std::string::npos)
+        << error.what();
   }
-  p = RelbotParams{};
-  p.wheel_radius_m = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(ValidateRelbotParams(p, "built-in"), ConfigError);
 }
 
 TEST(RelbotParams, EncoderCountsPerMetreFollowsAppendixG) {

@@ -1,8 +1,8 @@
 #pragma once
 /// The ECS's controller gains and output limit and their TOML file (app_relbot/ecs_gains.toml),
-/// in the style of relbot_params.h: every key carries its unit, every key is required, unknown
-/// keys are rejected, values are range-checked, and every error is a ConfigError that says
-/// "file:line:column: key: what is wrong; what to do". The built-in gains (DefaultEcsGains)
+/// read like relbot.toml by toml_numbers.h: every key carries its unit, every key is required,
+/// unknown keys are rejected, values are range-checked, and every error is a ConfigError that
+/// says "file:line:column: key: what is wrong; what to do". The built-in gains (DefaultEcsGains)
 /// equal the file; a unit test checks it. Gains are continuous-time quantities, so one file
 /// serves every ECS rate (the PID discretises them at its period).
 
@@ -10,20 +10,14 @@
 #include <span>
 #include <string_view>
 
+#include "hiltwin/app_relbot/config_error.h"
 #include "hiltwin/app_relbot/position_pid.h"
-#include "hiltwin/app_relbot/relbot_params.h"  // ConfigError
+#include "hiltwin/app_relbot/toml_numbers.h"
 
 namespace hiltwin::app {
 
 /// How one gain appears in the TOML file and which values it accepts.
-struct EcsGainSpec {
-  std::string_view table;    ///< TOML table, "pid" or "output"
-  std::string_view key;      ///< key in the table, e.g. "kp_duty_per_m"
-  double PidGains::*member;  ///< where the value goes
-  double min;                ///< smallest accepted value
-  bool min_exclusive;        ///< true: value must be > min; false: >= min
-  double max;                ///< largest accepted value (inclusive)
-};
+using EcsGainSpec = TomlNumberSpec<PidGains>;
 
 /// Every key, in file order. The loader, the validator and the tests iterate this.
 [[nodiscard]] std::span<const EcsGainSpec> EcsGainSpecs() noexcept;

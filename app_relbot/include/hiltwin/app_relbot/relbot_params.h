@@ -7,19 +7,13 @@
 
 #include <filesystem>
 #include <span>
-#include <stdexcept>
 #include <string_view>
 
+#include "hiltwin/app_relbot/config_error.h"
+#include "hiltwin/app_relbot/toml_numbers.h"
 #include "hiltwin/io/conversions.h"
 
 namespace hiltwin::app {
-
-/// A bad or missing configuration value; the message names the file, the key (and line), and
-/// says what to do. The command line maps it to exit code 2.
-class ConfigError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// RELbot parameters in SI units; the member name carries the unit.
 struct RelbotParams {
@@ -47,14 +41,7 @@ struct RelbotParams {
 };
 
 /// How one parameter appears in the TOML file and which values it accepts.
-struct ParamSpec {
-  std::string_view table;       ///< TOML table, e.g. "motor"
-  std::string_view key;         ///< key in the table, e.g. "resistance_ohm"
-  double RelbotParams::*member; ///< where the value goes
-  double min;                   ///< smallest accepted value
-  bool min_exclusive;           ///< true: value must be > min; false: >= min
-  double max;                   ///< largest accepted value (inclusive)
-};
+using ParamSpec = TomlNumberSpec<RelbotParams>;
 
 /// Every parameter, in file order. The loader, the validator and the tests iterate this.
 [[nodiscard]] std::span<const ParamSpec> RelbotParamSpecs() noexcept;
