@@ -74,10 +74,8 @@ struct EcsRig {
   bool driver_ok = false;
 };
 
-Figure ClosedLoopCycleNs(long calls) {
-  EcsRig rig;
-  const app::SetpointProfile profile = app::ClosedLoopProfile();
-  app::EcsTask task(rig.driver, profile, app::DefaultEcsGains(), rig.geometry, kPeriodNs);
+/// One EcsTask cycle as the loop runs it: Exchange, then Step. `label` names it in errors.
+Figure TaskCycleNs(app::EcsTask& task, const EcsRig& rig, long calls, const char* label) {
   std::uint64_t errors = rig.driver_ok ? 0 : 1;
   const Figure f = NsPerCall(
       [&](long i) {
@@ -87,25 +85,22 @@ Figure ClosedLoopCycleNs(long calls) {
       calls);
   g_sink = g_sink + task.last().duty_next.left;
   if (errors != 0)
-    std::printf("(closed loop: %llu errors)\n", static_cast<unsigned long long>(errors));
+    std::printf("(%s: %llu errors)\n", label, static_cast<unsigned long long>(errors));
   return f;
+}
+
+Figure ClosedLoopCycleNs(long calls) {
+  EcsRig rig;
+  const app::SetpointProfile profile = app::ClosedLoopProfile();
+  app::EcsTask task(rig.driver, profile, app::DefaultEcsGains(), rig.geometry, kPeriodNs);
+  return TaskCycleNs(task, rig, calls, "closed loop");
 }
 
 Figure OpenLoopCycleNs(long calls) {
   EcsRig rig;
   const app::InputProfile profile = app::OpenLoopProfile();
   app::EcsTask task(rig.driver, profile, rig.geometry, kPeriodNs);
-  std::uint64_t errors = rig.driver_ok ? 0 : 1;
-  const Figure f = NsPerCall(
-      [&](long i) {
-        if (!task.Exchange(true).ok()) ++errors;
-        if (task.Step(Cycle(i)).code != runtime::StepStatus::Code::kOk) ++errors;
-      },
-      calls);
-  g_sink = g_sink + task.last().duty_next.left;
-  if (errors != 0)
-    std::printf("(open loop: %llu errors)\n", static_cast<unsigned long long>(errors));
-  return f;
+  return TaskCycleNs(task, rig, calls, "open loop");
 }
 
 /// The board exchange alone (what EcsTask::Exchange adds to the driver is one copy).
