@@ -11,6 +11,8 @@ packages=(
   libspdlog-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libfftw3-dev                                  # Welch spectra in `hiltwin assess`
   liblttng-ust-dev lttng-tools babeltrace2      # tracepoints and trace tests
+  liblttng-ctl-dev libbabeltrace2-dev           # `hiltwin trace`: sessions, reading CTF
+  libtracefs-dev libtraceevent-dev              # `hiltwin trace --kernel`: scheduler events
   libgtest-dev libgmock-dev                     # tests
   rt-tests valgrind bc                          # cyclictest peer, callgrind counts, bench arithmetic
   clang-tidy                                    # scripts/tidy.sh: the function-size rule

@@ -50,14 +50,13 @@ class QosRecorder final : public sched::CycleObserver {
   explicit QosRecorder(hiltwin::qos::QosMonitor& monitor) : monitor_(monitor) {}
   sched::CycleAction OnCycle(const sched::TimingSample& sample) noexcept override {
     HILTWIN_TRACE(cycle, sample.cycle, sample.release_ns, sample.wake_ns, sample.start_ns,
-                  sample.end_ns, sample.releases_skipped, static_cast<std::uint8_t>(sample.missed));
+                  sample.end_ns, sample.io_ns, sample.releases_skipped,
+                  static_cast<std::uint8_t>(sample.missed), std::uint8_t{1});
     bool stop = monitor_.Record(sample.cycle, sample.missed);
     for (std::uint32_t i = 1; i <= sample.releases_skipped; ++i) {
       stop = monitor_.Record(sample.cycle + i, true) || stop;
     }
-    const hiltwin::qos::LiveQos live = monitor_.Live();
-    HILTWIN_TRACE(qos, sample.cycle, static_cast<std::int64_t>(live.distance_to_failure),
-                  static_cast<std::uint8_t>(live.verdict));
+    // (It also fired a per-cycle `qos` tracepoint, an event that no longer exists.)
     return stop ? sched::CycleAction::kStop : sched::CycleAction::kContinue;
   }
 

@@ -125,7 +125,8 @@ double MeasureIdleTraceNs() {
   for (int k = 0; k < kCalls; ++k) {
     const auto k64 = static_cast<std::uint64_t>(k);
     const auto t = static_cast<std::int64_t>(k);
-    HILTWIN_TRACE(cycle, k64, t, t + 1, t + 2, t + 3, std::uint32_t{0}, std::uint8_t{0});
+    HILTWIN_TRACE(cycle, k64, t, t + 1, t + 2, t + 3, std::int64_t{0}, std::uint32_t{0},
+                  std::uint8_t{0}, std::uint8_t{1});
     asm volatile("" ::: "memory");
   }
   return NsPerCall(start, Clock::now(), kCalls);

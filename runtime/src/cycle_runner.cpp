@@ -2,6 +2,8 @@
 
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/tracing/trace.h"
+#include "hiltwin/tracing/trace_codes.h"
+#include "traced_lifecycle.h"
 
 namespace hiltwin::runtime {
 
@@ -10,16 +12,19 @@ using statemachine::StopReason;
 
 CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
                          statemachine::Lifecycle& lifecycle, qos::QosMonitor& monitor,
-                         const OverrunInjector& injector, tracing::CsvLogger* logger,
-                         std::uint64_t planned_releases, std::size_t task_log_columns) noexcept
+                         const OverrunInjector& injector, const CycleRunnerConfig& config)
     : task_(task),
       clock_(clock),
       lifecycle_(lifecycle),
       monitor_(monitor),
       injector_(injector),
-      logger_(logger),
-      planned_releases_(planned_releases),
-      task_log_columns_(task_log_columns) {}
+      logger_(config.logger),
+      timing_log_(config.timing_log),
+      planned_releases_(config.planned_releases),
+      task_log_columns_(config.task_log_columns),
+      period_ns_(config.period_ns),
+      deadline_ns_(config.deadline_ns),
+      violations_seen_(monitor.rules().size(), 0) {}
 
 scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
   rules_ = lifecycle_.rules();
@@ -31,12 +36,22 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   io_ns_ = clock_.NowNs() - io_start_ns;
   io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
   if (io_fault_) {
+    TraceIoError(context.cycle, tracing::IoErrorKind::kFault);
     NoteFault(StopReason::kIoFault, context.cycle, io.reason);
     return scheduler::CycleAction::kContinue;  // OnCycle still records the cycle, then stops
   }
-  if (!io.ok()) ++counts_.io_errors;  // the task held its inputs
-  if (io.peer_absent) ++counts_.peer_absent_cycles;
-  if (io.pulse_limit) ++counts_.pulse_limit_cycles;
+  if (!io.ok()) {
+    ++counts_.io_errors;  // the task held its inputs
+    TraceIoError(context.cycle, tracing::IoErrorKind::kHeldInputs);
+  }
+  if (io.peer_absent) {
+    ++counts_.peer_absent_cycles;
+    TraceIoError(context.cycle, tracing::IoErrorKind::kPeerAbsent);
+  }
+  if (io.pulse_limit) {
+    ++counts_.pulse_limit_cycles;
+    TraceIoError(context.cycle, tracing::IoErrorKind::kPulseLimit);
+  }
   peer_stop_seen_ = io.peer_stopped != nullptr;
   if (peer_stop_seen_ && peer_stopped_ == nullptr) peer_stopped_ = io.peer_stopped;
   if (!rules_.steps_model) {
@@ -45,7 +60,10 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   }
   step_status_ = task_.Step(context);
   const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(context.cycle);
-  if (extra_ns > 0) clock_.SpendNs(extra_ns);
+  if (extra_ns > 0) {
+    HILTWIN_TRACE(overrun_injected, context.cycle, extra_ns);
+    clock_.SpendNs(extra_ns);
+  }
   if (step_status_.code == StepStatus::Code::kModelFault) {
     NoteFault(StopReason::kModelFault, context.cycle, step_status_.reason);
   } else {
@@ -56,7 +74,14 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
 
 scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sample) noexcept {
   HILTWIN_TRACE(cycle, sample.cycle, sample.release_ns, sample.wake_ns, sample.start_ns,
-                sample.end_ns, sample.releases_skipped, static_cast<std::uint8_t>(sample.missed));
+                sample.end_ns, sample.io_ns, sample.releases_skipped,
+                static_cast<std::uint8_t>(sample.missed),
+                static_cast<std::uint8_t>(rules_.records_qos));
+  if (sample.missed) {
+    HILTWIN_TRACE(deadline_miss, sample.cycle,
+                  sample.end_ns - sample.release_ns - deadline_ns_);
+  }
+  if (timing_log_ != nullptr) LogTiming(sample);
   qos_abort_ = false;
   if (rules_.records_qos) RecordQos(sample);
   if (stepped_ && logger_ != nullptr) Log(sample);
@@ -73,9 +98,38 @@ scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sampl
   for (std::uint32_t i = 1; i <= sample.releases_skipped && !qos_abort_; ++i) {
     qos_abort_ = monitor_.Record(sample.cycle + i, true);
   }
-  // Arguments are evaluated only while a trace session records.
-  HILTWIN_TRACE(qos, sample.cycle, static_cast<std::int64_t>(monitor_.DistanceToFailure()),
-                static_cast<std::uint8_t>(monitor_.Live().verdict));
+  // A rule's violation count can only rise on a miss: the common cycle skips the loop.
+  if (sample.missed || sample.releases_skipped > 0) TraceViolations(sample.cycle);
+}
+
+void CycleRunner::TraceViolations(std::uint64_t cycle) noexcept {
+  const auto rules = monitor_.rules();
+  for (std::size_t i = 0; i < rules.size() && i < violations_seen_.size(); ++i) {
+    if (rules[i].violations == violations_seen_[i]) continue;
+    violations_seen_[i] = rules[i].violations;
+    HILTWIN_TRACE(qos_violation, static_cast<std::uint32_t>(i), cycle,
+                  rules[i].distance_to_failure, rules[i].violations);
+  }
+}
+
+void CycleRunner::TraceIoError(std::uint64_t cycle, tracing::IoErrorKind kind) noexcept {
+  HILTWIN_TRACE(io_error, cycle, static_cast<std::uint8_t>(kind));
+}
+
+void CycleRunner::LogTiming(const scheduler::TimingSample& sample) noexcept {
+  // Nanoseconds since release 0, so the doubles stay exact (timing_log_format.h).
+  if (!timing_base_set_) {
+    timing_base_ns_ = sample.release_ns -
+                      static_cast<kernel_glue::TimeNs>(sample.cycle) * period_ns_;
+    timing_base_set_ = true;
+  }
+  const auto rel = [this](kernel_glue::TimeNs t) { return static_cast<double>(t - timing_base_ns_); };
+  const std::array<double, tracing::kTimingLogFields.size()> row = {
+      static_cast<double>(sample.cycle), rel(sample.release_ns), rel(sample.wake_ns),
+      rel(sample.start_ns), rel(sample.end_ns), static_cast<double>(sample.io_ns),
+      static_cast<double>(sample.releases_skipped), sample.missed ? 1.0 : 0.0,
+      rules_.records_qos ? 1.0 : 0.0};
+  timing_log_->TryLog(rel(sample.release_ns) * 1e-9, row);
 }
 
 void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
@@ -106,17 +160,19 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
   };
   // Faults first: when several causes meet in one cycle the report names the one that makes
   // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
-  if (io_fault_) lifecycle_.Handle(Event::kIoFault);
-  if (step_status_.code == StepStatus::Code::kModelFault) lifecycle_.Handle(Event::kModelFault);
-  if (qos_abort_) lifecycle_.Handle(Event::kQosAbort);
-  if (kernel_glue::StopRequested() || asked(CommandBit::kStop))
-    lifecycle_.Handle(Event::kStopRequest);
+  const auto handle = [this, &sample](Event event) {
+    HandleTraced(lifecycle_, event, sample.cycle);
+  };
+  if (io_fault_) handle(Event::kIoFault);
+  if (step_status_.code == StepStatus::Code::kModelFault) handle(Event::kModelFault);
+  if (qos_abort_) handle(Event::kQosAbort);
+  if (kernel_glue::StopRequested() || asked(CommandBit::kStop)) handle(Event::kStopRequest);
   if (plan_done || step_status_.code == StepStatus::Code::kFinished) {
-    lifecycle_.Handle(Event::kFinishReached);
+    handle(Event::kFinishReached);
   }
-  if (peer_stop_seen_) lifecycle_.Handle(Event::kPeerStopped);
-  if (asked(CommandBit::kPause)) lifecycle_.Handle(Event::kPause);
-  if (asked(CommandBit::kResume)) lifecycle_.Handle(Event::kStart);
+  if (peer_stop_seen_) handle(Event::kPeerStopped);
+  if (asked(CommandBit::kPause)) handle(Event::kPause);
+  if (asked(CommandBit::kResume)) handle(Event::kStart);
   return true;
 }
 

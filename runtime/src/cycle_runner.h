@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/qos/monitor.h"
@@ -17,6 +18,8 @@
 #include "hiltwin/scheduler/cycle.h"
 #include "hiltwin/statemachine/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
+#include "hiltwin/tracing/timing_log_format.h"
+#include "hiltwin/tracing/trace_codes.h"
 
 namespace hiltwin::runtime {
 
@@ -42,13 +45,22 @@ struct LoopCounts {
 inline constexpr std::array<const char*, 5> kTimingLogColumns = {"cycle", "latency_us",
                                                                  "compute_us", "io_us", "missed"};
 
+/// The runner's fixed figures and sinks (none owned).
+struct CycleRunnerConfig {
+  tracing::CsvLogger* logger = nullptr;      ///< the data log; null: none
+  tracing::CsvLogger* timing_log = nullptr;  ///< the timing log; null: none
+  std::uint64_t planned_releases = 0;        ///< 0: until stopped
+  std::size_t task_log_columns = 0;
+  kernel_glue::TimeNs period_ns = 0;
+  kernel_glue::TimeNs deadline_ns = 0;
+};
+
 class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleObserver {
  public:
-  /// None of the references is owned. `logger` may be null (no log). `planned_releases` 0:
-  /// until stopped.
+  /// None of the references is owned. Allocates its per-rule bookkeeping here, never later.
   CycleRunner(RunTask& task, kernel_glue::Clock& clock, statemachine::Lifecycle& lifecycle,
-              qos::QosMonitor& monitor, const OverrunInjector& injector, tracing::CsvLogger* logger,
-              std::uint64_t planned_releases, std::size_t task_log_columns) noexcept;
+              qos::QosMonitor& monitor, const OverrunInjector& injector,
+              const CycleRunnerConfig& config);
 
   scheduler::CycleAction Step(const scheduler::CycleContext& context) noexcept override;
   [[nodiscard]] kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
@@ -68,6 +80,10 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
  private:
   void RecordQos(const scheduler::TimingSample& sample) noexcept;
   void Log(const scheduler::TimingSample& sample) noexcept;
+  void LogTiming(const scheduler::TimingSample& sample) noexcept;
+  /// Fires hiltwin:qos_violation for every rule whose violation count rose at `cycle`.
+  void TraceViolations(std::uint64_t cycle) noexcept;
+  void TraceIoError(std::uint64_t cycle, tracing::IoErrorKind kind) noexcept;
   /// Offers this cycle's events to the lifecycle; false when there were none (the state is
   /// unchanged, the common case).
   bool PostEvents(const scheduler::TimingSample& sample) noexcept;
@@ -79,9 +95,15 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   qos::QosMonitor& monitor_;
   const OverrunInjector& injector_;
   tracing::CsvLogger* logger_;
+  tracing::CsvLogger* timing_log_;
   std::uint64_t planned_releases_;
   std::size_t task_log_columns_;
+  kernel_glue::TimeNs period_ns_;
+  kernel_glue::TimeNs deadline_ns_;
   std::array<double, tracing::kMaxLogColumns> row_{};
+  std::vector<std::uint64_t> violations_seen_;  ///< per rule, as last traced
+  kernel_glue::TimeNs timing_base_ns_ = 0;       ///< release 0's time, for the timing log
+  bool timing_base_set_ = false;
 
   // This cycle, from Step to OnCycle. Only the loop thread changes the state while the loop
   // runs, so the rules read in Step hold until OnCycle posts events.

@@ -112,6 +112,12 @@ Json ToJson(const RunReport& r) {
   for (const auto& [key, value] : r.details) json[key] = value;
   json["log_path"] = r.log ? Json(r.log->path) : Json(nullptr);
   if (r.log && !r.log->error.empty()) json["log_error"] = r.log->error;
+  json["timing_log_path"] = r.timing_log ? Json(r.timing_log->path) : Json(nullptr);
+  if (r.timing_log) {
+    json["timing_log_rows_written"] = r.timing_log->rows_written;
+    json["timing_log_rows_dropped"] = r.timing_log->rows_dropped;
+    if (!r.timing_log->error.empty()) json["timing_log_error"] = r.timing_log->error;
+  }
   json["final_state"] = statemachine::ToString(r.final_state);
   json["outputs_safe"] = r.outputs_safe;
   if (r.fault) {
@@ -208,6 +214,11 @@ std::string FormatSummary(const RunReport& r) {
     Append(out, "log        %s: %llu rows written, %llu dropped\n", r.log->path.c_str(),
            static_cast<ull>(r.log->rows_written), static_cast<ull>(r.log->rows_dropped));
   }
+  if (r.timing_log) {
+    Append(out, "timing log %s: %llu rows written, %llu dropped\n", r.timing_log->path.c_str(),
+           static_cast<ull>(r.timing_log->rows_written),
+           static_cast<ull>(r.timing_log->rows_dropped));
+  }
   if (!l.peer_stopped.empty()) Append(out, "peer       %s\n", l.peer_stopped.c_str());
   if (r.fault) {
     Append(out, "fault      %s at cycle %llu: %s\n", statemachine::ToString(r.fault->kind),
@@ -233,6 +244,14 @@ std::vector<std::string> Problems(const RunReport& r) {
   if (r.log && !r.log->error.empty()) {
     lines.push_back("the log " + r.log->path + " is incomplete: " + r.log->error);
   }
+  if (r.timing_log && !r.timing_log->error.empty()) {
+    lines.push_back("the timing log " + r.timing_log->path + " is incomplete: " +
+                    r.timing_log->error);
+  } else if (r.timing_log && r.timing_log->rows_dropped > 0) {
+    lines.push_back("warning: the timing log " + r.timing_log->path + " lost " +
+                    std::to_string(r.timing_log->rows_dropped) +
+                    " rows (its writer fell behind); an analysis of it misses those cycles");
+  }
   return lines;
 }
 
@@ -245,6 +264,7 @@ ExitCode ExitCodeFor(const RunReport& r) noexcept {
     return ExitCode::kInternal;
   }
   if (r.log && !r.log->error.empty()) return ExitCode::kIo;
+  if (r.timing_log && !r.timing_log->error.empty()) return ExitCode::kIo;
   switch (r.verdict) {
     case qos::Verdict::kPass:
       return ExitCode::kPass;

@@ -9,7 +9,15 @@
 #include <stdexcept>
 #include <thread>
 
+#include <sched.h>
+
+#include <cmath>
+
 #include "cycle_runner.h"
+#include "hiltwin/tracing/timing_log_format.h"
+#include "hiltwin/tracing/trace.h"
+#include "hiltwin/tracing/trace_codes.h"
+#include "traced_lifecycle.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/kernel_glue/thread.h"
 
@@ -33,6 +41,47 @@ std::unique_ptr<tracing::CsvLogger> MakeLogger(const SessionConfig& config, cons
   log.wait_when_full = config.clock == ClockKind::kVirtual;
   log.writer_cpus = kernel_glue::HelperCpus(allowed_cpus, config.rt.cpus);
   return std::make_unique<tracing::CsvLogger>(std::move(log));
+}
+
+/// The timing log: every cycle, its format in its preamble (tracing/timing_log_format.h).
+std::unique_ptr<tracing::CsvLogger> MakeTimingLog(const SessionConfig& config,
+                                                  kernel_glue::TimeNs period_ns,
+                                                  kernel_glue::TimeNs deadline_ns,
+                                                  const std::vector<int>& allowed_cpus) {
+  if (config.timing_log_path.empty()) return nullptr;
+  tracing::CsvLoggerConfig log;
+  log.path = config.timing_log_path;
+  log.columns.assign(tracing::kTimingLogFields.begin(), tracing::kTimingLogFields.end());
+  log.preamble = {std::string(tracing::kTimingLogMagic),
+                  "period_ns=" + std::to_string(period_ns),
+                  "deadline_ns=" + std::to_string(deadline_ns),
+                  "planned_cycles=" + std::to_string(config.executive.max_cycles)};
+  for (const qos::RuleSpec& rule : config.qos.rules) {
+    log.preamble.push_back(
+        std::string("rule=") + qos::ToString(rule.kind) + " m=" + std::to_string(rule.m) +
+        " k=" + std::to_string(rule.k) + " n=" + std::to_string(rule.n) + " max_miss_ppm=" +
+        std::to_string(std::llround(rule.max_miss_pct * tracing::kPpmPerPercent)));
+  }
+  log.wait_when_full = config.clock == ClockKind::kVirtual;
+  log.writer_cpus = kernel_glue::HelperCpus(allowed_cpus, config.rt.cpus);
+  return std::make_unique<tracing::CsvLogger>(std::move(log));
+}
+
+/// hiltwin:loop_start and one hiltwin:qos_rule per rule, from the loop thread.
+void TraceLoopStart(const SessionConfig& config, const scheduler::Executive& executive,
+                    const std::optional<kernel_glue::RtSession>& rt) noexcept {
+  const int priority = rt ? rt->record().fifo_priority : 0;
+  const int policy = rt && rt->record().sched_fifo ? SCHED_FIFO : SCHED_OTHER;
+  HILTWIN_TRACE(loop_start, static_cast<std::int32_t>(::gettid()),
+                static_cast<std::int32_t>(::sched_getcpu()), policy, priority,
+                executive.config().period_ns, executive.deadline_ns(),
+                config.executive.max_cycles, static_cast<std::uint32_t>(config.qos.rules.size()));
+  for (std::size_t i = 0; i < config.qos.rules.size(); ++i) {
+    const qos::RuleSpec& rule = config.qos.rules[i];
+    HILTWIN_TRACE(qos_rule, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(rule.kind),
+                  rule.m, rule.k, rule.n,
+                  static_cast<std::uint32_t>(std::lround(rule.max_miss_pct * tracing::kPpmPerPercent)));
+  }
 }
 
 io::StopCause StopCauseOf(statemachine::StopReason reason) noexcept {
@@ -108,11 +157,19 @@ RunSession::RunSession(SessionConfig config, RunTask& task)
                                 " fit beside the timing columns");
   }
   logger_ = MakeLogger(config_, task_, allowed_cpus_);
+  timing_log_ = MakeTimingLog(config_, executive_.config().period_ns, executive_.deadline_ns(),
+                              allowed_cpus_);
+  CycleRunnerConfig runner;
+  runner.logger = logger_.get();
+  runner.timing_log = timing_log_.get();
+  runner.planned_releases = config_.executive.max_cycles;
+  runner.task_log_columns = task_.LogColumns().size();
+  runner.period_ns = executive_.config().period_ns;
+  runner.deadline_ns = executive_.deadline_ns();
   runner_ = std::make_unique<CycleRunner>(task_, *clock_, lifecycle_, monitor_, config_.injector,
-                                          logger_.get(), config_.executive.max_cycles,
-                                          task_.LogColumns().size());
+                                          runner);
   executive_.AddObserver(*runner_);
-  lifecycle_.Handle(statemachine::Event::kConfigured);
+  HandleTraced(lifecycle_, statemachine::Event::kConfigured, 0);
 }
 
 RunSession::~RunSession() = default;
@@ -149,9 +206,11 @@ void RunSession::LoopThreadMain(LoopResult& result) noexcept {
     if (result.cancelled) return;
   }
   if (hooks_ != nullptr) hooks_->BeforeLoop();
+  TraceLoopStart(config_, executive_, result.rt);
   // Why the loop ended is the lifecycle's to say (the runner posted the event that ended it);
   // the executive's own stop cause adds nothing.
   static_cast<void>(executive_.Run(*runner_));
+  HILTWIN_TRACE(loop_end, executive_.stats().cycles_run, executive_.stats().releases);
   // Leaving run or paused: the outputs go safe at once, from the loop thread.
   result.outputs_safe = runner_->WriteSafeOutputs();
   // Then the peer learns why: it stops cleanly instead of waiting for a heartbeat timeout.
@@ -176,6 +235,7 @@ RunReport RunSession::Run() {
     if (!result.setup_error.empty())
       throw std::runtime_error("real-time set-up: " + result.setup_error);
     if (logger_) logger_->Start();  // after the RT set-up: see LoopThreadMain
+    if (timing_log_) timing_log_->Start();
     if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
   } catch (...) {
     // Release the waiting loop thread without running a cycle, then report the failure.
@@ -186,8 +246,8 @@ RunReport RunSession::Run() {
     CancelLoop(result, lock, loop);
     result.outputs_safe = true;  // never left the safe outputs
     config_.peer->link->AnnounceStop(StopCauseOf(lifecycle_.stop_reason()));
-    if (logger_) logger_->Stop();
-    lifecycle_.Handle(statemachine::Event::kDrained);
+    StopLoggers();
+    HandleTraced(lifecycle_, statemachine::Event::kDrained, 0);
     return BuildReport(result, 0.0);
   }
   // The control thread is a helper too while the loop runs: off the loop's CPUs. Best effort:
@@ -196,7 +256,7 @@ RunReport RunSession::Run() {
   static_cast<void>(kernel_glue::SetCallingThreadCpus(helper_cpus));
   const kernel_glue::MonotonicClock wall;
   const kernel_glue::TimeNs wall_start_ns = wall.NowNs();
-  lifecycle_.Handle(statemachine::Event::kStart);
+  HandleTraced(lifecycle_, statemachine::Event::kStart, 0);
   result.go = true;
   result.changed.notify_all();
   // The control thread's duty while the loop runs: forward signal commands every 100 ms and
@@ -215,9 +275,14 @@ RunReport RunSession::Run() {
     PrintProgress();
     std::fputc('\n', stderr);
   }
-  if (logger_) logger_->Stop();
-  lifecycle_.Handle(statemachine::Event::kDrained);
+  StopLoggers();
+  HandleTraced(lifecycle_, statemachine::Event::kDrained, executive_.stats().releases);
   return BuildReport(result, wall_time_s);
+}
+
+void RunSession::StopLoggers() {
+  if (logger_) logger_->Stop();
+  if (timing_log_) timing_log_->Stop();
 }
 
 void RunSession::CancelLoop(LoopResult& result, std::unique_lock<std::mutex>& lock,
@@ -245,7 +310,7 @@ bool RunSession::WaitForPeer() {
       return true;
     }
     if (kernel_glue::StopRequested()) {
-      lifecycle_.Handle(statemachine::Event::kStopRequest);
+      HandleTraced(lifecycle_, statemachine::Event::kStopRequest, 0);
       return false;
     }
     const kernel_glue::TimeNs waited_ns = clock.NowNs() - start_ns;
@@ -255,7 +320,7 @@ bool RunSession::WaitForPeer() {
                              "no " + config_.peer_name + " came up on " + config_.io + " within " +
                                  Seconds(wait.timeout_s) + " s (" + status.reason +
                                  "); start it with: " + wait.start_hint};
-      lifecycle_.Handle(statemachine::Event::kIoFault);
+      HandleTraced(lifecycle_, statemachine::Event::kIoFault, 0);
       return false;
     }
     // A countdown: rewritten in place on a terminal, a line every 5 s otherwise.
@@ -364,6 +429,10 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
   if (logger_) {
     r.log = LogFigures{logger_->path(), logger_->rows_written(), logger_->rows_dropped(),
                        logger_->error()};
+  }
+  if (timing_log_) {
+    r.timing_log = LogFigures{timing_log_->path(), timing_log_->rows_written(),
+                              timing_log_->rows_dropped(), timing_log_->error()};
   }
   r.wall_time_s = wall_time_s;
   if (result.rt) r.rt_setup = result.rt->record();

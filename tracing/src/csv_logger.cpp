@@ -69,6 +69,12 @@ CsvLoggerConfig Validate(CsvLoggerConfig config) {
                                   "' is used twice (time_s is reserved); make names unique");
     }
   }
+  for (const std::string& line : config.preamble) {
+    if (line.find_first_of("\r\n") != std::string::npos) {
+      throw std::invalid_argument(where + "preamble line '" + line +
+                                  "' holds a line break; give one line per entry");
+    }
+  }
   const std::size_t capacity = config.queue_capacity_rows;
   if (capacity == 0 || (capacity & (capacity - 1)) != 0 || capacity > kMaxQueueCapacityRows) {
     throw std::invalid_argument(where + "queue_capacity_rows " + std::to_string(capacity) +
@@ -168,7 +174,9 @@ CsvLogger::CsvLogger(CsvLoggerConfig config)
                              ErrnoText(err) + "; check that the directory exists and is writable");
   }
   std::setvbuf(file_, file_buffer_.get(), _IOFBF, kFileBufferBytes);
-  std::string header = "time_s";
+  std::string header;
+  for (const std::string& line : config_.preamble) header.append("# ").append(line).append("\n");
+  header += "time_s";
   for (const std::string& name : config_.columns) header.append(",").append(name);
   header += "\n";
   if (std::fwrite(header.data(), 1, header.size(), file_) != header.size() ||

@@ -41,9 +41,9 @@ TEST(TraceMacro, IsOneStatementUsableWithoutBraces) {
   bool flag = g_evaluations >= 0;
   int branch = 0;
   if (flag)
-    HILTWIN_TRACE(mark, std::uint64_t{1}, std::int32_t{7});
+    HILTWIN_TRACE(io_error, std::uint64_t{1}, std::uint8_t{0});
   else
-    HILTWIN_TRACE(mark, std::uint64_t{2}, std::int32_t{8});
+    HILTWIN_TRACE(io_error, std::uint64_t{2}, std::uint8_t{1});
   branch = flag ? 1 : 2;
   EXPECT_EQ(branch, 1);
 }
@@ -55,8 +55,9 @@ TEST(TraceMacro, EvaluatesArgumentsAtMostOnceAndAllocatesNothing) {
     test::ScopedAllocationCount counter;
     for (std::uint64_t k = 0; k < 100; ++k) {
       HILTWIN_TRACE(cycle, Counted(k), std::int64_t{1}, std::int64_t{2}, std::int64_t{3},
-                    std::int64_t{4}, std::uint32_t{0}, std::uint8_t{0});
-      HILTWIN_TRACE(qos, k, std::int64_t{5}, static_cast<std::uint8_t>(TraceVerdict::kPass));
+                    std::int64_t{4}, std::int64_t{0}, std::uint32_t{0}, std::uint8_t{0},
+                    std::uint8_t{1});
+      HILTWIN_TRACE(deadline_miss, k, std::int64_t{5});
     }
     allocations = counter.count();
   }

@@ -102,6 +102,7 @@ struct RunReport {
   std::optional<RunFault> fault;
   bool outputs_safe = true;  ///< the safe outputs were written when the loop ended
   std::optional<LogFigures> log;
+  std::optional<LogFigures> timing_log;  ///< `--timing-log`: every cycle's time stamps
   double wall_time_s = 0.0;
   std::optional<kernel_glue::RtSetupRecord> rt_setup;  ///< absent on the virtual clock
 };
@@ -115,7 +116,7 @@ struct RunReport {
 /// What went wrong or needs attention, one line each, for stderr (empty when nothing did).
 [[nodiscard]] std::vector<std::string> Problems(const RunReport& report);
 
-/// The process exit code: an I/O fault or an incomplete log 5, a model fault 1, otherwise the
+/// The process exit code: an I/O fault or an incomplete log (data or timing) 5, a model fault 1, otherwise the
 /// verdict (PASS 0, FLAGGED 3, ABORTED 4).
 [[nodiscard]] ExitCode ExitCodeFor(const RunReport& report) noexcept;
 

@@ -63,6 +63,9 @@ struct SessionConfig {
   kernel_glue::RtSetupRequest rt;  ///< applied to the loop thread (realtime clock only)
   OverrunInjector injector;
   std::optional<LogConfig> log;
+  /// Every cycle's time stamps, through a second RT-safe logger (tracing/timing_log_format.h):
+  /// the trace for users who may not use LTTng. Empty: none.
+  std::string timing_log_path;
   bool progress = false;  ///< a throttled progress line on stderr, from the control thread
   /// SIGUSR1 pauses and SIGUSR2 resumes the run (forwarded by the control thread within
   /// 100 ms). Off by default: the handlers are process-wide, the command decides.
@@ -112,6 +115,8 @@ class RunSession {
   /// (io_fault) or a stop signal arrives (stop_requested).
   [[nodiscard]] bool WaitForPeer();
   void ForwardPauseSignal() noexcept;
+  /// Drains and closes the data log and the timing log (after the loop).
+  void StopLoggers();
   /// Releases the parked loop thread without running a cycle and joins it.
   static void CancelLoop(LoopResult& result, std::unique_lock<std::mutex>& lock,
                          kernel_glue::NamedThread& loop);
@@ -124,6 +129,7 @@ class RunSession {
   qos::QosMonitor monitor_;
   scheduler::Executive executive_;
   std::unique_ptr<tracing::CsvLogger> logger_;
+  std::unique_ptr<tracing::CsvLogger> timing_log_;
   std::unique_ptr<CycleRunner> runner_;
   std::vector<int> allowed_cpus_;  ///< the process's CPUs, read before anything is pinned
   LoopThreadHooks* hooks_ = nullptr;

@@ -32,6 +32,9 @@ inline constexpr std::size_t kMaxLogColumns = 32;
 struct CsvLoggerConfig {
   std::string path;                                 ///< output file, truncated at construction
   std::vector<std::string> columns;                 ///< value column names after "time_s"
+  /// Lines written before the header row, each as "# <line>" (CSV readers that take '#'
+  /// comments skip them): a file's format and fixed facts, e.g. the timing log's.
+  std::vector<std::string> preamble;
   std::size_t queue_capacity_rows = 1 << 16;        ///< power of two; 65536 rows = 16 s at 4 kHz
   std::uint32_t decimation = 1;                     ///< log every Nth offered row (1 = all)
   std::int64_t writer_poll_period_ns = 2'000'000;   ///< writer sleeps this long between drains

@@ -16,9 +16,6 @@ inline constexpr bool kTracingCompiledIn = true;
 inline constexpr bool kTracingCompiledIn = false;
 #endif
 
-/// Verdict codes carried by the `qos` event.
-enum class TraceVerdict : unsigned char { kPass = 0, kFlagged = 1, kAborted = 2 };
-
 namespace detail {
 /// Declared only: named inside sizeof by the disabled HILTWIN_TRACE, never called.
 template <typename... Args>

@@ -1,0 +1,128 @@
+#pragma once
+/// The jitter report of one traced run (`hiltwin trace`): distributions of wake-up latency,
+/// period jitter, compute and response time; the misses and how they cluster; the worst cycles;
+/// and, when the kernel was recorded, the cause of every late cycle. One typed record; the text,
+/// JSON, pictures and the Perfetto export all derive from it (jitter_outputs.h).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/qos/rules.h"
+#include "hiltwin/scheduler/timing_stats.h"
+
+namespace hiltwin::analysis {
+
+/// One histogram bin of a distribution, [low_ns, high_ns).
+struct HistogramBin {
+  std::int64_t low_ns = 0;
+  std::int64_t high_ns = 0;
+  std::uint64_t count = 0;
+};
+
+/// One timing quantity over the judged cycles: the same log-linear histogram and percentile
+/// rule as the run report (scheduler::TimingStats), so the two agree to the bin.
+struct Distribution {
+  std::string name;  ///< "latency", "period_jitter", "compute", "response"
+  scheduler::TimingSummary summary;
+  std::vector<HistogramBin> bins;  ///< non-empty bins only, ascending
+};
+
+/// Where the misses fell.
+struct MissClusters {
+  std::uint64_t misses = 0;           ///< judged misses, skipped releases included
+  std::uint64_t bursts = 0;           ///< runs of consecutive missed releases
+  std::uint64_t longest_burst = 0;    ///< releases in the longest run
+  std::uint64_t longest_burst_start_k = 0;
+  /// Per window rule (mk_firm, misses_in_window), in rule order: how many of its windows held
+  /// at least one miss, and the most misses any one held.
+  struct RuleWindows {
+    qos::RuleSpec rule;
+    std::uint64_t windows_touched = 0;
+    std::uint64_t max_misses_in_window = 0;
+  };
+  std::vector<RuleWindows> windows;
+};
+
+/// Why a cycle was late.
+enum class CauseClass : std::uint8_t {
+  kPreempted,     ///< another thread ran on the loop's CPU while the loop was runnable
+  kInterrupt,     ///< a hard interrupt (or the local timer, or softirq) held the CPU
+  kPageFault,     ///< the loop thread faulted
+  kOwnCompute,    ///< the step itself ran long (compute above its p99.9)
+  kInvisible,     ///< nothing in the guest explains it: hypervisor steal or SMI
+  kNotRecorded,   ///< the kernel was not recorded (no --kernel)
+};
+/// "preempted", "interrupt", "page_fault", "own_compute", "invisible", "not_recorded".
+[[nodiscard]] const char* ToString(CauseClass cause) noexcept;
+
+/// The evidence for one cause.
+struct Cause {
+  CauseClass cause = CauseClass::kNotRecorded;
+  std::int64_t duration_ns = 0;  ///< how long the culprit held the CPU inside the window
+  // kPreempted: the thread that ran instead.
+  std::string thread;            ///< comm
+  int pid = 0;
+  std::string policy;            ///< "SCHED_FIFO", ... ("" when unknown)
+  int priority = 0;              ///< rt priority (0 for SCHED_OTHER)
+  // kInterrupt: which one ("local_timer", an irq handler's name, a softirq vector).
+  std::string interrupt;
+  int irq = -1;
+  // kPageFault: how many faults, first address.
+  std::uint64_t faults = 0;
+  std::uint64_t address = 0;
+  /// One line a person reads, e.g. "preempted by rt-hog (pid 4242, SCHED_FIFO 95) for 2.10 ms".
+  std::string evidence;
+};
+
+/// A cycle worth naming: a miss or a wake-up above p99.9.
+struct NotableCycle {
+  std::uint64_t k = 0;
+  std::int64_t release_ns = 0;
+  std::int64_t latency_ns = 0;   ///< wake - release
+  std::int64_t compute_ns = 0;   ///< end - start - io
+  std::int64_t response_ns = 0;  ///< end - release
+  bool missed = false;
+  Cause cause;  ///< the dominant cause (the longest culprit in the window)
+};
+
+/// Ranked causes: how many notable cycles each explains, most first.
+struct CauseCount {
+  CauseClass cause = CauseClass::kNotRecorded;
+  std::uint64_t cycles = 0;   ///< notable cycles this cause is dominant in
+  std::uint64_t misses = 0;   ///< of them, misses
+  /// The top culprits within the class ("rt-hog (pid 4242)", "local_timer"), most first.
+  std::vector<std::pair<std::string, std::uint64_t>> culprits;
+};
+
+struct JitterReport {
+  TraceSource source = TraceSource::kLttng;
+  std::string path;
+  std::int64_t period_ns = 0;
+  std::int64_t deadline_ns = 0;
+  std::uint64_t cycles = 0;          ///< cycles in the trace
+  std::uint64_t cycles_judged = 0;   ///< of them, counted in the QoS ledger
+  std::uint64_t releases_skipped = 0;
+  std::uint64_t misses = 0;          ///< judged misses, skipped releases included (= report)
+  double miss_pct = 0.0;             ///< misses / (judged cycles + skipped)
+  Distribution latency, period_jitter, compute, response;
+  MissClusters clusters;
+  std::vector<NotableCycle> worst;   ///< the 10 worst cycles by response time
+  bool kernel_recorded = false;
+  std::vector<NotableCycle> notable; ///< every miss and wake-up above p99.9, in order of k
+  std::vector<CauseCount> causes;    ///< ranked; empty without the kernel
+  std::uint64_t discarded_events = 0;       ///< LTTng's, from the trace
+  std::uint64_t kernel_lost_events = 0;     ///< tracefs ring overruns
+  bool trace_complete = false;
+  std::optional<LoopThread> loop;
+  std::vector<std::string> warnings;  ///< e.g. discarded events, incomplete trace
+};
+
+/// Analyses a trace; `kernel` may be null (causes: not recorded). Throws TraceReadError when
+/// the trace holds no cycle.
+[[nodiscard]] JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel);
+
+}  // namespace hiltwin::analysis
