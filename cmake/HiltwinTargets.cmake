@@ -49,22 +49,28 @@ endfunction()
 #                   [RT_TESTS <regex>] [TIMEOUT s])
 # A GoogleTest executable whose tests CTest discovers one by one, with labels
 # (unit, integration, rt, soak) so suites can be chosen with `ctest -L`.
+# RESOURCE_LOCK: a name CTest never runs two holders of at once (`lttng`: the one session
+# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer).
 # RT_TESTS: the tests (Suite.Name) that depend on the wall clock also get the label `rt`, so
 # `ctest -L rt` selects exactly the tests a noisy machine can disturb. gtest_discover_tests
 # flattens a list given to PROPERTIES, so the second label is set by a CTest include file that
 # runs after discovery, over the discovered list.
 function(hiltwin_add_gtest name)
-  cmake_parse_arguments(ARG "" "TIMEOUT;RT_TESTS" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;RT_TESTS;RESOURCE_LOCK" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
   hiltwin_target_warnings(${name})
+  set(extra_properties)
+  if(ARG_RESOURCE_LOCK)
+    set(extra_properties RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
   gtest_discover_tests(${name}
     DISCOVERY_TIMEOUT 60
     TEST_LIST ${name}_TESTS
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} ${extra_properties}
     EXTRA_ARGS --gtest_color=no)
   if(ARG_RT_TESTS)
     set(rt_labels ${ARG_LABELS} rt)
