@@ -1,11 +1,13 @@
 // The single `hiltwin` binary: parses the command line, runs the chosen subcommand and maps
 // every failure to the documented exit codes (DESIGN.md "Contracts").
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "hiltwin/app_relbot/commands.h"
@@ -32,8 +34,22 @@ int main(int argc, char** argv) {
       "and tells you whether a run can be trusted.",
       "hiltwin"};
   app.require_subcommand(1);
+  app.fallthrough();  // --log-level may also follow the command
   app.set_version_flag("--version", "hiltwin 0.1.0");
   app.footer("Run 'hiltwin <command> --help' for the flags of one command.");
+
+  // Non-real-time messages (start-up, warnings, progress of long work) go through spdlog, on
+  // stderr so that stdout stays the command's result; nothing logs from inside the loop.
+  auto logger = spdlog::stderr_color_mt("hiltwin");
+  logger->set_pattern("hiltwin: %^%l%$: %v");
+  spdlog::set_default_logger(logger);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level,
+                 "how much the non-real-time messages say: trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
+      ->capture_default_str();
+  app.parse_complete_callback(
+      [&log_level] { spdlog::set_level(spdlog::level::from_str(log_level)); });
 
   auto entries = hiltwin::app::CommandRegistry();
   std::stable_sort(entries.begin(), entries.end(),

@@ -104,6 +104,9 @@ void AddSessionOptions(CLI::App& app, SessionOptions& o) {
   app.add_option("--log", o.log_path, "write a CSV log (20-sim DataFromFile / MATLAB readable)");
   app.add_option("--log-decimation", o.log_decimation, "log every Nth cycle")
       ->capture_default_str();
+  app.add_option("--timing-log", o.timing_log_path,
+                 "write every cycle's time stamps to this file (no LTTng needed); analyse it "
+                 "with 'hiltwin trace --analyze FILE'");
   app.add_option("--report", o.report_path, "write the JSON run report to this file");
   app.add_option("--inject-overrun", o.inject_overrun,
                  "add compute time to chosen cycles, e.g. at=20000,count=5,extra-us=600 or "
@@ -198,6 +201,7 @@ runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionR
   config.rt.cpus = o.cpus;
   config.injector = MakeInjector(o, planned);
   if (!o.log_path.empty()) config.log = runtime::LogConfig{o.log_path, o.log_decimation};
+  config.timing_log_path = o.timing_log_path;
   config.progress = !o.no_progress && isatty(STDERR_FILENO) == 1;
   config.pause_signals = true;  // kill -USR1 pauses, -USR2 resumes (documented in --help)
   if (io::PeerLink* link = backend.peer_link(); link != nullptr) {
@@ -220,12 +224,16 @@ void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns) {
 
 runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask& task) {
   std::optional<runtime::RunSession> session;
+  // Only the two logs can fail to open; the message quotes the path of the one that did.
+  const std::string timing_log_quoted = "'" + config.timing_log_path + "'";
   try {
     session.emplace(std::move(config), task);
   } catch (const std::invalid_argument& e) {
     Usage(e.what());
   } catch (const std::runtime_error& e) {
-    Usage(std::string("--log: ") + e.what());
+    const bool timing = timing_log_quoted != "''" &&
+                        std::string(e.what()).find(timing_log_quoted) != std::string::npos;
+    Usage(std::string(timing ? "--timing-log: " : "--log: ") + e.what());
   }
   return session->Run();
 }

@@ -1,6 +1,6 @@
 // The RELbot twin in the real run assembly (runtime::RunSession, exactly as `hiltwin run` uses
 // it): executive, lifecycle, mock FPGA link, RELbot model, QoS monitor, tracepoints and CSV
-// logger run 20,000 cycles on the loop thread without a single heap allocation after start.
+// logger and timing log run 20,000 cycles on the loop thread without a single heap allocation after start.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -59,6 +59,7 @@ struct TwinRig {
     config.qos.planned_cycles = kCycles;
     config.injector.Add(runtime::ParseOverrunInjection("every=997,extra-us=400"));  // miss path
     config.log = runtime::LogConfig{log_path, 1};
+    config.timing_log_path = log_path + ".timing";
     session.emplace(std::move(config), task);
   }
 
@@ -97,8 +98,11 @@ TEST(TwinLoop, RunsTwentyThousandCyclesWithoutAllocating) {
   EXPECT_EQ(report.link.io_errors, 0U);
   ASSERT_TRUE(report.log.has_value());
   EXPECT_EQ(report.log->rows_written, kCycles);
+  ASSERT_TRUE(report.timing_log.has_value());
+  EXPECT_EQ(report.timing_log->rows_written, kCycles);
   EXPECT_TRUE(report.outputs_safe);
   std::filesystem::remove(log_path);
+  std::filesystem::remove(log_path + ".timing");
 }
 
 TEST(TwinLoop, EncoderPositionsReachTheBoardAndTheSafeOutputsStopThePulses) {
@@ -129,6 +133,7 @@ TEST(TwinLoop, EncoderPositionsReachTheBoardAndTheSafeOutputsStopThePulses) {
   // Pulses already due finish within one period; after that the emulator is still.
   EXPECT_EQ(left.PositionAt(now_ns + 250'000), left.PositionAt(now_ns + 10 * 250'000));
   std::filesystem::remove(log_path);
+  std::filesystem::remove(log_path + ".timing");
 }
 
 }  // namespace

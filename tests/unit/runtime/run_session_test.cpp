@@ -309,6 +309,36 @@ TEST(RunSession, TheLogHasTheTaskColumnsThenTheTimingColumns) {
   std::filesystem::remove(path);
 }
 
+TEST(RunSession, TheTimingLogHasEveryCycleInNanosecondsSinceReleaseZeroAndItsFormat) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("hiltwin_timing_log_" + std::to_string(getpid()) + ".csv"))
+                               .string();
+  ScriptedTask task;
+  SessionConfig config = VirtualConfig(20);
+  config.timing_log_path = path;
+  config.qos.rules = {qos::MakeMkRule(3, 4)};
+  config.injector.Add(ParseOverrunInjection("at=5,extra-us=1500"));
+  const RunReport r = RunScripted(task, std::move(config));
+  ASSERT_TRUE(r.timing_log.has_value());
+  EXPECT_EQ(r.timing_log->rows_written, 20U);
+  EXPECT_EQ(r.timing_log->rows_dropped, 0U);
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 5U + 1U + 20U);
+  EXPECT_EQ(lines[0], "# hiltwin timing log 1");
+  EXPECT_EQ(lines[1], "# period_ns=1000000");
+  EXPECT_EQ(lines[2], "# deadline_ns=1000000");
+  EXPECT_EQ(lines[3], "# planned_cycles=20");
+  EXPECT_EQ(lines[4], "# rule=mk_firm m=3 k=4 n=0 max_miss_ppm=0");
+  EXPECT_EQ(lines[5], "time_s,k,release_ns,wake_ns,start_ns,end_ns,io_ns,skipped,missed,judged");
+  EXPECT_EQ(lines[6], "0,0,0,0,0,0,0,0,0,1");
+  // The injected cycle: 1.5 ms of compute past its release, missed; the next one catches up.
+  EXPECT_EQ(lines[6 + 5], "0.005,5,5000000,5000000,5000000,6500000,0,0,1,1");
+  EXPECT_EQ(lines[6 + 6], "0.006,6,6000000,6500000,6500000,6500000,0,0,0,1");
+  std::filesystem::remove(path);
+}
+
 /// The scheduling policy and CPUs of every thread of this process, read from the loop thread.
 class ThreadCensus final : public LoopThreadHooks {
  public:

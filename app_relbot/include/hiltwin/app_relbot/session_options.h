@@ -37,6 +37,7 @@ struct SessionOptions {
   double deadline_us = 0.0;
   std::string log_path;
   std::uint32_t log_decimation = 1;
+  std::string timing_log_path;  ///< every cycle's time stamps, for `hiltwin trace --analyze`
   std::string report_path;
   std::vector<std::string> inject_overrun;
   int priority = 80;

@@ -1,0 +1,37 @@
+#pragma once
+/// `hiltwin run` as a function: the RELbot twin's flags, built into a task and run through the
+/// shared session assembly, with the run's summary, report and exit code. `hiltwin trace` runs
+/// exactly this inside its recording, so a traced run and a plain one cannot differ.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/runtime/run_report.h"
+
+namespace hiltwin::app {
+
+/// `run`'s own flags beside the shared ones.
+struct TwinRunOptions {
+  SessionOptions session;
+  std::string input = "openloop";
+  double controller_rate_hz = 0.0;  ///< 0: min(1000 Hz, --rate), the thesis ECS rate
+  std::string config_path;
+  std::string integrator = "rk4";
+};
+
+/// Adds every `run` flag (shared and own) to `app`.
+void AddTwinRunOptions(CLI::App& app, TwinRunOptions& o);
+
+/// What a twin run ended with.
+struct TwinRunOutcome {
+  runtime::RunReport report;
+  int exit_code = 0;
+};
+
+/// Checks the flags, builds the twin, runs it and prints its outcome exactly as `hiltwin run`
+/// does (stdout summary, stderr problems, --report file). Throws CommandError for bad flags
+/// (exit 2) and an unusable board (exit 5) before the run. `command` names it in messages.
+TwinRunOutcome RunTwin(TwinRunOptions o, const char* command = "run");
+
+}  // namespace hiltwin::app
