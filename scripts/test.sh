@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds and runs every default test twice: the normal build, then under ASan+UBSan.
+# Builds and runs every default test three times: the normal build, under ASan+UBSan, and
+# with the LTTng tracepoints compiled out (the same suite minus the LTTng-only tests).
 # Opt-in labels (soak) are excluded; run them with: ctest --test-dir build -L soak
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -16,3 +17,4 @@ run_suite() {
 run_suite "$root/build"
 bash "$root/scripts/tidy.sh" "$root/build"
 run_suite "$root/build-asan" -DHILTWIN_SANITIZE=ON -DHILTWIN_BUILD_BENCH=OFF
+run_suite "$root/build-notrace" -DHILTWIN_WITH_LTTNG=OFF -DHILTWIN_BUILD_BENCH=OFF

@@ -102,10 +102,21 @@ void PrintStartLines(const char* command, const SessionOptions& o, std::uint64_t
   std::fflush(stdout);
 }
 
+/// --input-rate, or its documented default.
+double ControllerRateOf(const TwinRunOptions& o) {
+  return o.controller_rate_hz == 0.0 ? std::min(1000.0, o.session.rate_hz) : o.controller_rate_hz;
+}
+
 }  // namespace
 
+void CheckTwinRunOptions(const TwinRunOptions& o) {
+  TwinRunOptions checked = o;
+  checked.controller_rate_hz = ControllerRateOf(o);
+  Validate(checked);
+}
+
 TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
-  if (o.controller_rate_hz == 0.0) o.controller_rate_hz = std::min(1000.0, o.session.rate_hz);
+  o.controller_rate_hz = ControllerRateOf(o);
   Validate(o);
   const std::uint64_t planned = PlannedCycles(o.session);
   std::ofstream report_file = OpenReport(o.session.report_path);

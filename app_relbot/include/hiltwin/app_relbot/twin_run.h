@@ -23,6 +23,9 @@ struct TwinRunOptions {
 /// Adds every `run` flag (shared and own) to `app`.
 void AddTwinRunOptions(CLI::App& app, TwinRunOptions& o);
 
+/// The flag checks RunTwin starts with, for a caller that must know before it starts anything.
+void CheckTwinRunOptions(const TwinRunOptions& o);
+
 /// What a twin run ended with.
 struct TwinRunOutcome {
   runtime::RunReport report;

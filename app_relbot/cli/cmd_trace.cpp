@@ -1,0 +1,64 @@
+// `hiltwin trace`: record the twin's run with LTTng (and the kernel's scheduler events with
+// --kernel) and write a jitter report that names the cause of each late cycle; or analyse a
+// recording or timing log made earlier (--analyze). Flags -> TraceOptions -> trace_run.h.
+#include <memory>
+#include <string>
+
+#include "hiltwin/app_relbot/commands.h"
+#include "hiltwin/app_relbot/trace_run.h"
+
+namespace hiltwin::app {
+namespace {
+
+/// --analyze runs nothing, so a run flag beside it is a mistake worth naming.
+void RefuseRunFlagsWithAnalyze(const CLI::App& app) {
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string name = option->get_name();
+    if (option->count() == 0 || name == "--analyze" || name == "--output" || name == "--help" ||
+        name == "--log-level") {
+      continue;
+    }
+    throw CommandError(ExitCode::kUsage,
+                       name +
+                           " does not go with --analyze: --analyze reads a recording made "
+                           "earlier and runs nothing (drop " +
+                           name + ")");
+  }
+}
+
+Command AddTraceCommand(CLI::App& parent) {
+  auto o = std::make_shared<TraceOptions>();
+  CLI::App* app = parent.add_subcommand(
+      "trace",
+      "Run the RELbot twin exactly as 'hiltwin run' does, inside an LTTng recording, and write a\n"
+      "jitter report into --output DIR: wake-up latency, period jitter, compute and response\n"
+      "time (histograms, percentiles), misses and how they cluster, the 10 worst cycles, pictures\n"
+      "(PNG, one HTML page) and a Perfetto trace (ui.perfetto.dev opens DIR/perfetto_trace.json).\n"
+      "--kernel also records the kernel's scheduler and interrupt events and names the cause of\n"
+      "every late cycle (preempted by whom, interrupt, page fault, own compute, invisible).\n"
+      "--analyze PATH reports on a recording made earlier: a trace folder (also one recorded by\n"
+      "hand with lttng while 'hiltwin run' ran) or a timing log ('hiltwin run --timing-log').\n"
+      "Needs an lttng-sessiond (started when none runs and you are root or in group 'tracing').\n"
+      "Exit: as 'hiltwin run' (0 PASS, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault), 2 bad\n"
+      "input, 5 when tracing is not possible here or the trace could not be read.");
+  AddTwinRunOptions(*app, o->run);
+  app->add_option("--output", o->output_dir,
+                  "folder for the trace and the report (new or empty; with --analyze: where the "
+                  "report goes, default the trace folder or FILE.jitter/)");
+  app->add_flag("--kernel", o->kernel,
+                "also record the kernel's scheduler, interrupt and page-fault events (root, or "
+                "tracefs readable) and name the cause of every late cycle");
+  app->add_option("--analyze", o->analyze_path,
+                  "analyse this trace folder or timing log instead of running");
+  return {app, [o, app] {
+            if (o->analyze_path.empty()) return TraceTwin(*o);
+            RefuseRunFlagsWithAnalyze(*app);
+            return AnalyzeTrace(*o);
+          }};
+}
+
+}  // namespace
+
+HILTWIN_REGISTER_COMMAND(40, AddTraceCommand);
+
+}  // namespace hiltwin::app

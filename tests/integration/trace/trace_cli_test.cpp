@@ -1,0 +1,235 @@
+// End-to-end tests of `hiltwin trace`: the real binary, a real lttng-sessiond (started by the
+// command itself when none runs), the kernel's tracefs for --kernel. What is asserted holds on a
+// noisy machine: the trace's report must agree with the run's own report exactly (cycles,
+// misses) and to the histogram's resolution (percentiles), whatever the timing was; the cause
+// test plants a competitor whose name must come out as the cause.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fakes/process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class TraceCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("hiltwin_trace_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  [[nodiscard]] std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+
+  static hiltwin::test::RunResult Hiltwin(std::vector<std::string> args, int timeout_ms = 120'000) {
+    args.insert(args.begin(), HILTWIN_BINARY);
+    return hiltwin::test::Run(args, timeout_ms);
+  }
+
+  static json ReadJson(const std::string& path) {
+    std::ifstream in(path);
+    return json::parse(in);
+  }
+
+  /// The trace's report agrees with the run's: same cycles and misses, every percentile within
+  /// one bucket of the shared log-linear histogram.
+  static void ExpectAgreement(const json& run, const json& jitter) {
+    EXPECT_EQ(jitter["cycles"].get<std::uint64_t>(), run["cycles_run"].get<std::uint64_t>());
+    EXPECT_EQ(jitter["misses"].get<std::uint64_t>(), run["deadline_misses"].get<std::uint64_t>());
+    for (const auto& [run_key, jitter_key] :
+         {std::pair{"latency_ns", "latency"}, std::pair{"compute_ns", "compute"},
+          std::pair{"response_ns", "response"}}) {
+      for (const char* figure : {"min", "p50", "p99", "p999", "max"}) {
+        const auto a = run[run_key][figure].get<std::int64_t>();
+        const auto b = jitter[jitter_key][std::string(figure) + "_ns"].get<std::int64_t>();
+        EXPECT_LE(std::llabs(a - b), std::max<std::int64_t>(1, std::max(a, b) / 128))
+            << run_key << " " << figure << ": run " << a << ", trace " << b;
+      }
+    }
+  }
+
+  fs::path dir_;
+};
+
+#if defined(HILTWIN_WITH_LTTNG)
+
+TEST_F(TraceCli, ARecordedRunHasTheRunsVerdictAndAReportThatAgreesWithIt) {
+  const std::string out = Path("trace");
+  const auto r = Hiltwin({"trace", "--output", out, "--duration", "1", "--rate", "4000",
+                          "--no-progress", "--report", Path("run.json")});
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
+  const json run = ReadJson(Path("run.json"));
+  EXPECT_EQ(run, ReadJson(out + "/run_report.json"));
+  const json jitter = ReadJson(out + "/jitter_report.json");
+  ExpectAgreement(run, jitter);
+  EXPECT_EQ(r.exit_code, run["verdict"] == "PASS" ? 0 : 3);
+  EXPECT_EQ(jitter["discarded_events"].get<std::uint64_t>(), 0U);
+  for (const char* file : {"jitter_report.txt", "jitter_report.html", "perfetto_trace.json",
+                           "jitter_latency_histogram.png"}) {
+    EXPECT_TRUE(fs::exists(out + "/" + file)) << file;
+  }
+  EXPECT_NE(r.out.find("causes were not recorded"), std::string::npos) << r.out;
+}
+
+TEST_F(TraceCli, AnalyzeReadsTheRecordingAgainAndSaysTheSame) {
+  const std::string out = Path("trace");
+  ASSERT_LE(Hiltwin({"trace", "--output", out, "--duration", "0.5", "--no-progress",
+                     "--clock", "virtual"})
+                .exit_code,
+            3);
+  const json first = ReadJson(out + "/jitter_report.json");
+  const auto again = Hiltwin({"trace", "--analyze", out, "--output", Path("again")});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const json second = ReadJson(Path("again") + "/jitter_report.json");
+  EXPECT_EQ(first["cycles"], second["cycles"]);
+  EXPECT_EQ(first["misses"], second["misses"]);
+  EXPECT_EQ(first["latency"], second["latency"]);
+}
+
+TEST_F(TraceCli, AnalyzeReadsATraceRecordedByHandWithTheLttngCommand) {
+  // What a user does without `hiltwin trace`: their own session around `hiltwin run`.
+  const std::string session = "hiltwin_by_hand_" + std::to_string(getpid());
+  const std::string out = Path("by_hand");
+  const auto lttng = [](std::vector<std::string> args) {
+    args.insert(args.begin(), "lttng");
+    return hiltwin::test::Run(args, 30'000);
+  };
+  if (lttng({"list"}).exit_code != 0 &&
+      hiltwin::test::Run({"lttng-sessiond", "--daemonize", "--no-kernel"}).exit_code != 0) {
+    GTEST_SKIP() << "no lttng-sessiond can run here";
+  }
+  ASSERT_EQ(lttng({"create", session, "--output=" + out}).exit_code, 0);
+  ASSERT_EQ(lttng({"enable-event", "--userspace", "--session=" + session, "hiltwin:*"}).exit_code,
+            0);
+  ASSERT_EQ(lttng({"start", session}).exit_code, 0);
+  const auto run = Hiltwin({"run", "--duration", "0.5", "--clock", "virtual", "--no-progress",
+                            "--report", Path("run.json")});
+  ASSERT_EQ(lttng({"stop", session}).exit_code, 0);
+  ASSERT_EQ(lttng({"destroy", session}).exit_code, 0);
+  ASSERT_LE(run.exit_code, 3) << run.err;
+  const auto analysis = Hiltwin({"trace", "--analyze", out});
+  ASSERT_EQ(analysis.exit_code, 0) << analysis.err;
+  ExpectAgreement(ReadJson(Path("run.json")), ReadJson(out + "/jitter_report.json"));
+}
+
+TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses) {
+  if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
+  // The competitor: SCHED_FIFO 95 on CPU 1, 3 ms of spinning every 100 ms, above the loop's 80.
+  auto hog = hiltwin::test::Spawn(
+      {HILTWIN_HOG, "hiltwin-hog", "1", "95", "3", "97", "20"}, Path("hog.out"));
+  for (int i = 0; i < 100 && !fs::exists(Path("hog.out")); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  std::ifstream ready(Path("hog.out"));
+  std::string word;
+  if (!(ready >> word) || word != "ready") GTEST_SKIP() << "SCHED_FIFO refused: no competitor";
+  const std::string out = Path("trace");
+  const auto r = Hiltwin({"trace", "--kernel", "--output", out, "--duration", "2", "--rate",
+                          "4000", "--cpu", "1", "--priority", "80", "--no-progress"});
+  if (r.exit_code == 5 && r.err.find("--kernel") != std::string::npos) {
+    GTEST_SKIP() << "the kernel cannot be recorded here: " << r.err;
+  }
+  ASSERT_LE(r.exit_code, 4) << r.out << r.err;
+  const json jitter = ReadJson(out + "/jitter_report.json");
+  EXPECT_TRUE(jitter["kernel_recorded"].get<bool>());
+  ASSERT_FALSE(jitter["causes"].empty()) << jitter.dump(2);
+  const json& top = jitter["causes"][0];
+  EXPECT_EQ(top["cause"], "preempted") << jitter["causes"].dump(2);
+  ASSERT_FALSE(top["culprits"].empty());
+  EXPECT_NE(top["culprits"][0]["name"].get<std::string>().find("hiltwin-hog"), std::string::npos)
+      << top.dump(2);
+  // Every miss the competitor caused names it, with its policy and priority.
+  bool named = false;
+  for (const json& cycle : jitter["notable"]) {
+    if (cycle["cause"]["cause"] != "preempted") continue;
+    EXPECT_EQ(cycle["cause"]["thread"], "hiltwin-hog");
+    EXPECT_EQ(cycle["cause"]["policy"], "SCHED_FIFO");
+    EXPECT_EQ(cycle["cause"]["priority"], 95);
+    named = true;
+  }
+  EXPECT_TRUE(named);
+}
+
+TEST_F(TraceCli, KernelWithoutThePermissionExitsFiveWithTheReasonAndTheFix) {
+  // A real unprivileged user, not a mock: setpriv drops to nobody for the one command.
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to drop to another user";
+  fs::permissions(dir_, fs::perms::all);
+  const std::string out = Path("trace");
+  const auto r = hiltwin::test::Run({"setpriv", "--reuid=nobody", "--regid=nogroup",
+                                     "--clear-groups", HILTWIN_BINARY, "trace", "--kernel",
+                                     "--output", out, "--duration", "0.1", "--priority", "0"});
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_NE(r.err.find("--kernel"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("root"), std::string::npos) << r.err;  // what to do
+  EXPECT_FALSE(fs::exists(out + "/jitter_report.json"));
+}
+
+#else
+
+TEST_F(TraceCli, WithoutLttngRecordingSaysSoAndExitsFive) {
+  const auto r = Hiltwin({"trace", "--output", Path("trace"), "--duration", "0.1"});
+  EXPECT_EQ(r.exit_code, 5);
+  EXPECT_NE(r.err.find("--timing-log"), std::string::npos) << r.err;
+}
+
+#endif
+
+TEST_F(TraceCli, ATimingLogGivesTheSameReportWithoutLttng) {
+  const auto run = Hiltwin({"run", "--duration", "1", "--rate", "4000", "--no-progress",
+                            "--timing-log", Path("timing.csv"), "--report", Path("run.json")});
+  ASSERT_LE(run.exit_code, 3) << run.err;
+  const auto analysis = Hiltwin({"trace", "--analyze", Path("timing.csv")});
+  ASSERT_EQ(analysis.exit_code, 0) << analysis.err;
+  ExpectAgreement(ReadJson(Path("run.json")), ReadJson(Path("timing.csv.jitter") +
+                                                       "/jitter_report.json"));
+  EXPECT_NE(analysis.out.find("causes were not recorded"), std::string::npos);
+}
+
+TEST_F(TraceCli, BadInputExitsTwoNamingTheFileAndThePlace) {
+  // A folder with no trace.
+  auto r = Hiltwin({"trace", "--analyze", dir_.string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(dir_.string()), std::string::npos) << r.err;
+  // A path that does not exist.
+  r = Hiltwin({"trace", "--analyze", Path("nothing_here")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("nothing_here"), std::string::npos) << r.err;
+  // A timing log cut in the middle of its last row.
+  ASSERT_LE(Hiltwin({"run", "--duration", "0.05", "--clock", "virtual", "--no-progress",
+                     "--timing-log", Path("timing.csv")})
+                .exit_code,
+            3);
+  const auto size = fs::file_size(Path("timing.csv"));
+  fs::resize_file(Path("timing.csv"), size - 7);
+  r = Hiltwin({"trace", "--analyze", Path("timing.csv")});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("timing.csv:207"), std::string::npos) << r.err;  // 6 + header + 200
+  // Run flags make no sense beside --analyze.
+  r = Hiltwin({"trace", "--analyze", Path("timing.csv"), "--rate", "1000"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--rate"), std::string::npos) << r.err;
+}
+
+TEST_F(TraceCli, ARecordingIntoAFolderThatHoldsFilesIsRefusedBeforeAnythingRuns) {
+  std::ofstream(Path("old.txt")) << "keep me\n";
+  const auto r = Hiltwin({"trace", "--output", dir_.string(), "--duration", "0.1"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("already holds files"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(Path("old.txt")));
+}
+
+}  // namespace
