@@ -325,7 +325,8 @@ struct Tally {
   std::uint64_t first_address = 0;
   std::int64_t fault_ns = 0;
   int fault_cpu = -1;
-  int missing_cpu = -1;  // a CPU the window needs that the recording lacks
+  bool cpu_missing = false;  // the window needs a CPU the recording lacks (or none is known)
+  int missing_cpu = -1;
 };
 
 // The attribution of one window against the index.
@@ -361,6 +362,7 @@ Tally WindowQuery::Collect() {
     const bool waiting_for_release = it->state == LoopState::kSleeping && it->begin_ns < w_.begin_ns;
     if (lo >= hi || (it->state == LoopState::kSleeping && !waiting_for_release)) continue;
     if (!ix_.Recorded(it->cpu)) {
+      t_.cpu_missing = true;
       t_.missing_cpu = it->cpu;
       continue;
     }
@@ -634,9 +636,12 @@ Cause CauseAttributor::Attribute(const CauseWindow& window) const {
   }
   WindowQuery query(ix, window);
   const Tally tally = query.Collect();
-  if (tally.missing_cpu >= 0) {
-    return NotRecorded("CPU " + std::to_string(tally.missing_cpu) +
-                       ", where the loop was, was not recorded");
+  if (tally.cpu_missing) {
+    return NotRecorded(tally.missing_cpu < 0
+                           ? "the loop's CPU is unknown (no scheduler event of the loop thread, "
+                             "no pin)"
+                           : "CPU " + std::to_string(tally.missing_cpu) +
+                                 ", where the loop was, was not recorded");
   }
   return MakeCause(ix, Decide(tally, window), tally, window);
 }

@@ -107,8 +107,10 @@ void TraceWarnings(const TimingTrace& trace, const detail::CycleStats& stats, Ji
                          " events discarded by the tracer: cycles may be missing from the figures");
   }
   if (!trace.complete) {
-    r.warnings.emplace_back("the trace is incomplete (no end of the loop seen): the run was cut "
-                            "short or the trace stopped early");
+    r.warnings.emplace_back(trace.source == TraceSource::kLttng
+                                ? "the trace is incomplete (no end of the loop seen): the run was "
+                                  "cut short or the trace stopped early"
+                                : "the timing log ends in a torn row: the run was cut short");
   }
   if (stats.gaps > 0) {
     r.warnings.push_back(Count(stats.cycles_missing, "cycle") + " missing from the trace in " +

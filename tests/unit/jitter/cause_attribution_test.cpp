@@ -249,6 +249,22 @@ TEST(CauseAttribution, ACycleOutsideTheKernelRecordingIsNotRecorded) {
   EXPECT_EQ(NotableAt(r, 1000).cause.cause, CauseClass::kOwnCompute);
 }
 
+TEST(CauseAttribution, TheLoopsCpuNotRecordedGivesNoCause) {
+  Case c;
+  c.spec.releases = 20'000;
+  c.spec.overrides[1000] = {3'000, 200'000};
+  const TimingTrace trace = testing::MakeTrace(c.spec);
+  KernelTrace kernel = testing::MakeKernel(trace, {});
+  kernel.cpus = {0};  // the recorder listed only CPU 0
+  const JitterReport r = AnalyzeJitter(trace, &kernel);
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_EQ(n.cause.cause, CauseClass::kNotRecorded);
+  EXPECT_EQ(n.cause.evidence, "CPU 1, where the loop was, was not recorded");
+  EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.find("CPU 1 was not among the recorded CPUs") != std::string::npos;
+  }));
+}
+
 TEST(CauseAttribution, ATimingLogCannotBeMatchedToKernelEvents) {
   Case c;
   c.spec.overrides[1000] = {3'000, 200'000};
