@@ -32,15 +32,17 @@ void Header(const JitterReport& r, std::string& out) {
                 static_cast<unsigned long long>(r.releases_skipped));
   out += Printf("deadline misses: %llu (%.3f %% of judged releases, skipped ones included)\n",
                 static_cast<unsigned long long>(r.misses), r.miss_pct);
-  out += Printf("events: %llu discarded by the tracer; kernel: ",
+  out += Printf("%llu events discarded by the tracer; kernel: ",
                 static_cast<unsigned long long>(r.discarded_events));
   out += r.kernel_recorded ? Printf("recorded, %llu events lost\n",
                                     static_cast<unsigned long long>(r.kernel_lost_events))
                            : std::string("not recorded\n");
   out += std::string("trace complete: ") + (r.trace_complete ? "yes" : "no");
   if (r.loop) {
-    out += Printf("; loop thread tid %d on CPU %d (%s %d)", r.loop->tid, r.loop->cpu,
-                  detail::PolicyName(r.loop->policy), r.loop->priority);
+    const bool rt = r.loop->policy == 1 || r.loop->policy == 2;  // SCHED_FIFO, SCHED_RR
+    out += Printf("; loop thread tid %d on CPU %d (%s", r.loop->tid, r.loop->cpu,
+                  detail::PolicyName(r.loop->policy));
+    out += rt ? Printf(" %d)", r.loop->priority) : std::string(")");
   }
   out += "\n\n";
 }

@@ -115,7 +115,8 @@ TEST(JitterOutputs, TextStatesTheKeyFiguresAndNeverHidesDiscardedEvents) {
   const std::string text = FormatJitterText(r);
   for (const char* line :
        {"hiltwin jitter report: synthetic (lttng)", "period 50 us, deadline 50 us",
-        "deadline misses: 4", "0 discarded by the tracer", "latency ", "period jitter |x|",
+        "deadline misses: 4", "0 events discarded by the tracer",
+        "loop thread tid 1000 on CPU 1 (SCHED_FIFO 80)", "latency ", "period jitter |x|",
         "compute ", "response ", "wake-up latency histogram", "misses: 4 in 2 bursts",
         "(3,4)-firm", "10 worst cycles by response time", "interrupt: eth0 (irq 42) for 40 us",
         "causes of the", "warnings: none"}) {
