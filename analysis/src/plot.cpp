@@ -1,54 +1,17 @@
 #include "hiltwin/analysis/plot.h"
 
-#include <unistd.h>
-
-#include <cerrno>
-#include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <vector>
 
-#include "hiltwin/kernel_glue/process.h"
+#include "gnuplot_process.h"
 
 namespace hiltwin::analysis {
 namespace {
-
-// gnuplot single-quoted strings: a quote is written twice.
-std::string GnuplotQuote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    out += c;
-    if (c == '\'') out += '\'';
-  }
-  out += "'";
-  return out;
-}
-
-// Removes the temporary directory whatever happens.
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    const char* base = std::getenv("TMPDIR");
-    std::string pattern = std::string(base != nullptr && *base != '\0' ? base : "/tmp") +
-                          "/hiltwin-assess-XXXXXX";
-    if (mkdtemp(pattern.data()) == nullptr) {
-      throw PlotError("cannot create a temporary directory for gnuplot's data (" +
-                      std::string(std::strerror(errno)) + "); set TMPDIR to a writable directory");
-    }
-    path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-};
 
 // Rows to draw: all of them, or per bucket the rows with the smallest and largest difference
 // (in time order), so spikes in the error survive thinning.
@@ -78,31 +41,12 @@ std::vector<std::size_t> RowsToDraw(const Assessment& a, std::size_t max_points)
   return rows;
 }
 
-// gnuplot renders in a few seconds even at max_points rows; a stuck one must not hang.
-constexpr std::chrono::seconds kGnuplotTimeout{120};
-
-// Runs gnuplot on `script`, its stdout and stderr together (its messages, for the error).
-kernel_glue::ProcessResult RunGnuplot(const std::filesystem::path& script) {
-  kernel_glue::ProcessOptions streams;
-  streams.out = kernel_glue::OutputTarget::Capture();
-  streams.err = kernel_glue::OutputTarget::SameAsStdout();
-  try {
-    return kernel_glue::RunProcess({"gnuplot", script.string()}, streams, kGnuplotTimeout);
-  } catch (const kernel_glue::SpawnError& e) {
-    if (e.NotFound()) {
-      throw InputError("gnuplot is not installed (not found on PATH): install the Debian "
-                       "package gnuplot-nox (apt-get install gnuplot-nox)");
-    }
-    throw PlotError(e.what());
-  }
-}
-
 }  // namespace
 
 void WritePlot(const Assessment& a, const std::string& png_path, std::size_t max_points) {
-  const TempDir dir;
-  const std::filesystem::path data = dir.path / "curves.dat";
-  const std::filesystem::path script = dir.path / "plot.gp";
+  const detail::ScratchDir dir("hiltwin-assess");
+  const std::filesystem::path data = dir.path() / "curves.dat";
+  const std::filesystem::path script = dir.path() / "plot.gp";
   {
     std::ofstream out(data);
     out << "# time y_sim y_exp diff diff_compensated\n";
@@ -129,36 +73,27 @@ void WritePlot(const Assessment& a, const std::string& png_path, std::size_t max
                 a.time.eta, a.time_compensated.eta, a.total, a.pass ? "PASS" : "FAIL");
   {
     std::ofstream gp(script);
-    const std::string d = GnuplotQuote(data.string());
+    const std::string d = detail::GnuplotQuote(data.string());
     gp << "set terminal pngcairo size 1280,860 font 'sans,11' noenhanced\n"
-       << "set output " << GnuplotQuote(png_path) << "\n"
+       << "set output " << detail::GnuplotQuote(png_path) << "\n"
        << "set datafile missing 'NaN'\n"
-       << "set multiplot layout 2,1 title " << GnuplotQuote(title) << "\n"
+       << "set multiplot layout 2,1 title " << detail::GnuplotQuote(title) << "\n"
        << "set grid\nset key outside top center horizontal\nset autoscale xfix\n"
        << "set lmargin 14\nset rmargin 4\n"
        << "set ylabel 'value'\n"
        << "plot " << d << " using 1:3 with lines lw 2 lc rgb '#2ca02c' title "
-       << GnuplotQuote("experiment y_e: " + a.exp_label) << ", \\\n     " << d
+       << detail::GnuplotQuote("experiment y_e: " + a.exp_label) << ", \\\n     " << d
        << " using 1:2 with lines lw 1 dt 2 lc rgb '#d62728' title "
-       << GnuplotQuote("simulation y_s: " + a.sim_label) << "\n"
+       << detail::GnuplotQuote("simulation y_s: " + a.sim_label) << "\n"
        << "set xlabel 'time [s]'\nset ylabel 'y_s - y_e'\n"
        << "plot " << d << " using 1:4 with lines lw 1 lc rgb '#1f77b4' title 'difference', \\\n     "
        << d << " using 1:5 with lines lw 1 lc rgb '#ff7f0e' title "
-       << GnuplotQuote("difference after delay compensation (d = " + std::string(delay) + ")")
+       << detail::GnuplotQuote("difference after delay compensation (d = " + std::string(delay) + ")")
        << "\nunset multiplot\nset output\n";
     if (!gp) throw PlotError("cannot write gnuplot's script " + script.string());
   }
 
-  std::error_code ec;
-  std::filesystem::remove(png_path, ec);  // so an old picture cannot pass for a new one
-  const kernel_glue::ProcessResult gnuplot = RunGnuplot(script);
-  const bool written =
-      std::filesystem::exists(png_path, ec) && std::filesystem::file_size(png_path, ec) > 0;
-  if (!gnuplot.status.Success() || !written) {
-    throw PlotError("cannot write " + png_path + ": gnuplot " +
-                    (gnuplot.status.Success() ? "wrote no picture" : gnuplot.status.Describe()) +
-                    ": " + gnuplot.out + "check that the directory exists and is writable");
-  }
+  detail::RenderWithGnuplot(script, png_path);
 }
 
 }  // namespace hiltwin::analysis

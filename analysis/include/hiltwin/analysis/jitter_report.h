@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hiltwin/analysis/kernel_events.h"
@@ -23,12 +24,18 @@ struct HistogramBin {
   std::uint64_t count = 0;
 };
 
-/// One timing quantity over the judged cycles: the same log-linear histogram and percentile
-/// rule as the run report (scheduler::TimingStats), so the two agree to the bin.
+/// One timing quantity over the cycles the executive accounts it for — every cycle run, paused
+/// and grace cycles included, as the run report's figures (scheduler/src/executive.cpp):
+/// latency only of cycles whose loop was asleep at the release (not of catch-up cycles);
+/// period jitter only between neighbouring cycles (not the first, not after skipped releases).
+/// The same log-linear histogram and percentile rule (scheduler::TimingStats), so the two agree
+/// to the bin.
 struct Distribution {
   std::string name;  ///< "latency", "period_jitter", "compute", "response"
   scheduler::TimingSummary summary;
-  std::vector<HistogramBin> bins;  ///< non-empty bins only, ascending
+  /// Non-empty bins only, ascending; of |value| (period jitter is signed, its percentiles are
+  /// of the magnitude).
+  std::vector<HistogramBin> bins;
 };
 
 /// Where the misses fell.
@@ -63,6 +70,7 @@ enum class CauseClass : std::uint8_t {
 struct Cause {
   CauseClass cause = CauseClass::kNotRecorded;
   std::int64_t duration_ns = 0;  ///< how long the culprit held the CPU inside the window
+  int cpu = -1;                  ///< the loop's CPU where it happened (-1: not recorded)
   // kPreempted: the thread that ran instead.
   std::string thread;            ///< comm
   int pid = 0;
@@ -103,6 +111,8 @@ struct JitterReport {
   std::string path;
   std::int64_t period_ns = 0;
   std::int64_t deadline_ns = 0;
+  /// Release of the trace's first cycle: the outputs count time stamps from it.
+  std::int64_t first_release_ns = 0;
   std::uint64_t cycles = 0;          ///< cycles in the trace
   std::uint64_t cycles_judged = 0;   ///< of them, counted in the QoS ledger
   std::uint64_t releases_skipped = 0;
@@ -110,9 +120,13 @@ struct JitterReport {
   double miss_pct = 0.0;             ///< misses / (judged cycles + skipped)
   Distribution latency, period_jitter, compute, response;
   MissClusters clusters;
-  std::vector<NotableCycle> worst;   ///< the 10 worst cycles by response time
+  /// The 10 worst cycles by response time, judged or not (ties: earlier k first), each with
+  /// its cause like a notable cycle's.
+  std::vector<NotableCycle> worst;
   bool kernel_recorded = false;
-  std::vector<NotableCycle> notable; ///< every miss and wake-up above p99.9, in order of k
+  /// Every judged miss (those `misses` counts) and every wake-up strictly above the latency
+  /// p99.9 (of cycles whose latency was recorded), in order of k.
+  std::vector<NotableCycle> notable;
   std::vector<CauseCount> causes;    ///< ranked; empty without the kernel
   std::uint64_t discarded_events = 0;       ///< LTTng's, from the trace
   std::uint64_t kernel_lost_events = 0;     ///< tracefs ring overruns

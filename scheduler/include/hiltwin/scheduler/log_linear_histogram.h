@@ -32,6 +32,10 @@ class LogLinearHistogram {
   [[nodiscard]] static std::int64_t BucketLow(std::size_t index) noexcept;
   [[nodiscard]] static std::int64_t BucketHigh(std::size_t index) noexcept;
   [[nodiscard]] static std::size_t BucketCount() noexcept;
+  /// Values recorded in bucket `index` (0 past the last bucket): the bins of a plotted histogram.
+  [[nodiscard]] std::uint64_t CountAt(std::size_t index) const noexcept {
+    return index < counts_.size() ? counts_[index] : 0;
+  }
 
  private:
   std::vector<std::uint64_t> counts_;

@@ -1,0 +1,209 @@
+#include <algorithm>
+#include <memory>
+#include <numeric>
+
+#include "cause_attribution.h"
+#include "hiltwin/analysis/jitter_report.h"
+#include "jitter_format.h"
+#include "jitter_stats.h"
+
+namespace hiltwin::analysis {
+
+const char* ToString(CauseClass cause) noexcept {
+  switch (cause) {
+    case CauseClass::kPreempted: return "preempted";
+    case CauseClass::kInterrupt: return "interrupt";
+    case CauseClass::kPageFault: return "page_fault";
+    case CauseClass::kOwnCompute: return "own_compute";
+    case CauseClass::kInvisible: return "invisible";
+    case CauseClass::kNotRecorded: return "not_recorded";
+  }
+  return "unknown";
+}
+
+namespace {
+
+constexpr std::size_t kWorstCycles = 10;
+
+// "1 cycle", "3 cycles".
+std::string Count(std::uint64_t n, const char* noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
+NotableCycle NotableOf(const scheduler::TimingSample& s) {
+  NotableCycle n;
+  n.k = s.cycle;
+  n.release_ns = s.release_ns;
+  n.latency_ns = s.wake_ns - s.release_ns;
+  n.compute_ns = s.end_ns - s.start_ns - s.io_ns;
+  n.response_ns = s.end_ns - s.release_ns;
+  n.missed = s.missed;
+  return n;
+}
+
+void CountReleases(const TimingTrace& trace, JitterReport& r) {
+  std::uint64_t judged_releases = 0;
+  for (const TracedCycle& c : trace.cycles) {
+    r.releases_skipped += c.sample.releases_skipped;
+    if (!c.judged) continue;
+    ++r.cycles_judged;
+    judged_releases += 1 + c.sample.releases_skipped;
+  }
+  r.misses = r.clusters.misses;
+  r.miss_pct = judged_releases == 0 ? 0.0
+                                    : static_cast<double>(r.misses) * 100.0 /
+                                          static_cast<double>(judged_releases);
+}
+
+// Every judged miss and every wake-up above the latency p99.9, in order of k.
+std::vector<std::size_t> NotableIndices(const TimingTrace& trace, const detail::CycleStats& stats,
+                                        std::int64_t latency_p999_ns) {
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < trace.cycles.size(); ++i) {
+    const TracedCycle& c = trace.cycles[i];
+    const bool late_wake = stats.latency_recorded[i] &&
+                           c.sample.wake_ns - c.sample.release_ns > latency_p999_ns;
+    if ((c.judged && c.sample.missed) || late_wake) out.push_back(i);
+  }
+  return out;
+}
+
+// The cycles with the longest response, longest first (earlier k first on a tie).
+std::vector<std::size_t> WorstIndices(const TimingTrace& trace) {
+  std::vector<std::size_t> order(trace.cycles.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const std::size_t n = std::min(kWorstCycles, order.size());
+  auto response = [&](std::size_t i) {
+    return trace.cycles[i].sample.end_ns - trace.cycles[i].sample.release_ns;
+  };
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n), order.end(),
+                    [&](std::size_t a, std::size_t b) {
+                      return response(a) != response(b) ? response(a) > response(b) : a < b;
+                    });
+  order.resize(n);
+  return order;
+}
+
+// What the attribution needs of the run: the window and what is normal.
+detail::CauseWindow WindowOf(const scheduler::TimingSample& s, bool wake_only,
+                             const JitterReport& r) {
+  detail::CauseWindow w;
+  w.begin_ns = s.release_ns;
+  w.end_ns = wake_only ? s.wake_ns : s.end_ns;
+  w.step_begin_ns = s.start_ns;
+  w.step_end_ns = s.end_ns;
+  w.compute_ns = s.end_ns - s.start_ns - s.io_ns;
+  w.excess_ns = wake_only ? (s.wake_ns - s.release_ns) - r.latency.summary.p50_ns
+                          : (s.end_ns - s.release_ns) - r.response.summary.p50_ns;
+  w.wake_only = wake_only;
+  w.compute_p50_ns = r.compute.summary.p50_ns;
+  w.compute_p999_ns = r.compute.summary.p999_ns;
+  return w;
+}
+
+void TraceWarnings(const TimingTrace& trace, const detail::CycleStats& stats, JitterReport& r) {
+  if (trace.discarded_events > 0) {
+    r.warnings.push_back(std::to_string(trace.discarded_events) +
+                         " events discarded by the tracer: cycles may be missing from the figures");
+  }
+  if (!trace.complete) {
+    r.warnings.emplace_back(trace.source == TraceSource::kLttng
+                                ? "the trace is incomplete (no end of the loop seen): the run was "
+                                  "cut short or the trace stopped early"
+                                : "the timing log ends in a torn row: the run was cut short");
+  }
+  if (stats.gaps > 0) {
+    r.warnings.push_back(Count(stats.cycles_missing, "cycle") + " missing from the trace in " +
+                         Count(stats.gaps, "gap") +
+                         " (k jumps): period jitter is left out across them");
+  }
+  if (trace.other_processes > 0) {
+    r.warnings.push_back("the trace holds " + std::to_string(trace.other_processes) +
+                         " other hiltwin processes; only pid " + std::to_string(trace.pid) +
+                         " is analysed");
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// Why kernel events cannot explain this trace's cycles, or "" when they can.
+std::string WhyNoCauses(const TimingTrace& trace) {
+  if (trace.source == TraceSource::kTimingLog) {
+    return "kernel events were not matched to the cycles: a timing log's times count from "
+           "release 0, not on the kernel's clock (trace with LTTng for causes)";
+  }
+  if (!trace.loop || trace.loop->tid <= 0) {
+    return "kernel events were not matched to the cycles: the trace does not name the loop "
+           "thread (no loop_start event)";
+  }
+  return "";
+}
+
+void AttributeCauses(const TimingTrace& trace, const KernelTrace* kernel,
+                     const std::vector<std::size_t>& notable, const std::vector<std::size_t>& worst,
+                     JitterReport& r) {
+  const std::string why_not = kernel != nullptr ? WhyNoCauses(trace) : "";
+  if (!why_not.empty()) r.warnings.push_back(why_not);
+  r.kernel_recorded = kernel != nullptr && why_not.empty();
+  if (!r.kernel_recorded) {
+    for (NotableCycle& n : r.notable) n.cause.cause = CauseClass::kNotRecorded;
+    for (NotableCycle& n : r.worst) n.cause.cause = CauseClass::kNotRecorded;
+    return;
+  }
+  r.kernel_lost_events = kernel->lost_events;
+  if (kernel->lost_events > 0) {
+    r.warnings.push_back(std::to_string(kernel->lost_events) +
+                         " kernel events lost (ring buffer overruns): a cause may be missing");
+  }
+  const detail::CauseAttributor attributor(*kernel, *trace.loop);
+  for (std::string& w : attributor.Warnings()) r.warnings.push_back(std::move(w));
+  auto attribute = [&](std::size_t i, NotableCycle& n) {
+    const TracedCycle& c = trace.cycles[i];
+    // A cycle that is notable only for its wake-up (no miss) is explained up to the wake.
+    const bool wake_only = !(c.judged && c.sample.missed) &&
+                           n.response_ns <= r.response.summary.p999_ns;
+    n.cause = attributor.Attribute(WindowOf(c.sample, wake_only, r));
+  };
+  for (std::size_t j = 0; j < notable.size(); ++j) attribute(notable[j], r.notable[j]);
+  for (std::size_t j = 0; j < worst.size(); ++j) attribute(worst[j], r.worst[j]);
+  r.causes = detail::RankCauses(r.notable);
+}
+
+}  // namespace
+
+JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel) {
+  if (trace.cycles.empty()) {
+    throw TraceReadError(trace.path + ": the trace holds no cycle of the loop (was the run "
+                                      "traced, and did it get past its start?)");
+  }
+  JitterReport r;
+  r.source = trace.source;
+  r.path = trace.path;
+  r.period_ns = trace.period_ns;
+  r.deadline_ns = trace.deadline_ns;
+  r.cycles = trace.cycles.size();
+  r.first_release_ns = trace.cycles.front().sample.release_ns;
+  r.discarded_events = trace.discarded_events;
+  r.trace_complete = trace.complete;
+  r.loop = trace.loop;
+
+  const detail::CycleStats stats = detail::AccumulateCycleStats(trace);
+  r.latency = detail::MakeDistribution("latency", stats.latency);
+  r.period_jitter = detail::MakeDistribution("period_jitter", stats.period_jitter);
+  r.compute = detail::MakeDistribution("compute", stats.compute);
+  r.response = detail::MakeDistribution("response", stats.response);
+  r.clusters = detail::ClusterMisses(trace);
+  CountReleases(trace, r);
+  TraceWarnings(trace, stats, r);
+
+  const std::vector<std::size_t> notable = NotableIndices(trace, stats, r.latency.summary.p999_ns);
+  for (const std::size_t i : notable) r.notable.push_back(NotableOf(trace.cycles[i].sample));
+  const std::vector<std::size_t> worst = WorstIndices(trace);
+  for (const std::size_t i : worst) r.worst.push_back(NotableOf(trace.cycles[i].sample));
+  AttributeCauses(trace, kernel, notable, worst, r);
+  return r;
+}
+
+}  // namespace hiltwin::analysis

@@ -1,0 +1,69 @@
+#pragma once
+// Private to the analysis module: just enough SVG for the jitter report's HTML page (axes with
+// linear or log scales, bars, lines, dots, text), written inline so the page needs nothing
+// from outside: no script, no font, no link.
+
+#include <string>
+#include <vector>
+
+namespace hiltwin::analysis::detail {
+
+/// Escapes &, <, >, " for HTML and SVG text.
+[[nodiscard]] std::string HtmlEscape(const std::string& text);
+
+/// One axis: range, scale and label.
+struct SvgAxis {
+  double min = 0.0;
+  double max = 1.0;
+  bool log = false;
+  std::string label;
+  bool ticks = true;     ///< false: a categorical axis, labelled by the caller (XCategory)
+  bool integer = false;  ///< counts: ticks at whole numbers only
+};
+
+/// A chart area of a fixed pixel size; data coordinates map through the axes.
+class SvgChart {
+ public:
+  SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title);
+
+  /// Grid, ticks, tick labels and axis labels.
+  void Axes();
+  /// A filled rectangle between data coordinates (x0, y0) and (x1, y1).
+  void Bar(double x0, double x1, double y0, double y1, const char* colour);
+  /// A polyline through the points (NaN or, on a log axis, values ≤ 0 break the line).
+  void Line(const std::vector<double>& xs, const std::vector<double>& ys, const char* colour);
+  /// A dot at each point.
+  void Dots(const std::vector<double>& xs, const std::vector<double>& ys, const char* colour);
+  /// A dashed vertical (x) or horizontal (y) marker with a label ("" for none: say it in the
+  /// legend).
+  void VerticalMarker(double x, const std::string& label, const char* colour);
+  void HorizontalMarker(double y, const std::string& label, const char* colour);
+  /// Text just above a data position (anchor "start", "middle", "end").
+  void Label(double x, double y, const std::string& text, const char* anchor);
+  /// A category's name under the x axis.
+  void XCategory(double x, const std::string& text);
+  /// Text centred in the plot area (for a chart with nothing to draw).
+  void Note(const std::string& text);
+  /// A legend entry (top right, one per call), a box or (dashed) a line.
+  void Legend(const std::string& text, const char* colour, bool dashed = false);
+
+  /// The finished <svg> element.
+  [[nodiscard]] std::string Finish() const;
+
+  [[nodiscard]] double Px(double x) const;
+  [[nodiscard]] double Py(double y) const;
+
+ private:
+  int width_px_;
+  int height_px_;
+  SvgAxis x_;
+  SvgAxis y_;
+  double left_ = 70.0;
+  double right_ = 20.0;
+  double top_ = 30.0;
+  double bottom_ = 50.0;
+  int legend_entries_ = 0;
+  std::string body_;
+};
+
+}  // namespace hiltwin::analysis::detail

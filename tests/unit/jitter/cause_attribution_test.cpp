@@ -1,0 +1,299 @@
+// The cause of a late cycle from synthesized kernel traces, one class at a time with a known
+// answer, then mixed cases and the ranking.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hiltwin/analysis/jitter_report.h"
+#include "jitter_fixtures.h"
+
+namespace hiltwin::analysis {
+namespace {
+
+using testing::CycleOverride;
+using testing::KernelScript;
+using testing::kLoopCpu;
+using testing::kLoopKernelPrio;
+using testing::kLoopTid;
+using testing::RunSpec;
+using testing::SpecialCycle;
+
+constexpr int kHogPid = 4242;
+constexpr int kHogKernelPrio = 4;  // SCHED_FIFO 95: 99 - 4
+
+// 2000 releases at 50 µs (deadline = period): wake-up 3.0–3.4 µs, compute 20.0–21.2 µs.
+RunSpec KernelRun() {
+  RunSpec spec;
+  spec.releases = 2'000;
+  spec.latency_ns = [](std::uint64_t k) { return 3'000 + static_cast<std::int64_t>(k % 5) * 100; };
+  spec.compute_ns = [](std::uint64_t k) { return 20'000 + static_cast<std::int64_t>(k % 7) * 200; };
+  return spec;
+}
+
+struct Case {
+  RunSpec spec = KernelRun();
+  std::map<std::uint64_t, SpecialCycle> special;
+  std::vector<KernelTask> tasks;
+
+  [[nodiscard]] JitterReport Analyze() const {
+    const TimingTrace trace = testing::MakeTrace(spec);
+    KernelTrace kernel = testing::MakeKernel(trace, special);
+    kernel.tasks = tasks;
+    return AnalyzeJitter(trace, &kernel);
+  }
+};
+
+// The hog runs on the loop's CPU from just after the release; the loop is woken 500 ns after
+// the release and gets the CPU when the hog blocks, `hold_ns` later.
+SpecialCycle HogHoldsTheCpu(int pid, const std::string& comm, int prio, std::int64_t hold_ns) {
+  return [=](KernelScript& k, const scheduler::TimingSample& s) {
+    const std::int64_t r = s.release_ns;
+    k.Switch(r + 100, kLoopCpu, 0, "swapper/1", 120, 0, pid, comm, prio);
+    k.LocalTimer(r + 300, r + 450, kLoopCpu);
+    k.LoopWakeup(r + 500);
+    k.Switch(r + 500 + hold_ns, kLoopCpu, pid, comm, prio, 1, kLoopTid, "hiltwin-loop",
+             kLoopKernelPrio);
+    k.LoopOutToIdle(s.end_ns + 500);
+  };
+}
+// Latency of a cycle whose loop was held off for hold_ns by HogHoldsTheCpu.
+CycleOverride HeldOff(std::int64_t hold_ns, std::int64_t compute_ns = 20'000) {
+  return {500 + hold_ns + 500, compute_ns};
+}
+
+SpecialCycle IrqInStep(int irq, const std::string& name, std::int64_t from_start_ns,
+                       std::int64_t duration_ns) {
+  return [=](KernelScript& k, const scheduler::TimingSample& s) {
+    testing::NormalCycle(k, s);
+    k.Irq(s.start_ns + from_start_ns, s.start_ns + from_start_ns + duration_ns, kLoopCpu, irq, name);
+  };
+}
+
+SpecialCycle Both(const SpecialCycle& a, const SpecialCycle& b) {
+  return [=](KernelScript& k, const scheduler::TimingSample& s) {
+    a(k, s);
+    b(k, s);
+  };
+}
+
+const NotableCycle& NotableAt(const JitterReport& r, std::uint64_t k) {
+  const auto it = std::find_if(r.notable.begin(), r.notable.end(),
+                               [&](const NotableCycle& n) { return n.k == k; });
+  if (it == r.notable.end()) throw std::runtime_error("cycle " + std::to_string(k) + " is not notable");
+  return *it;
+}
+
+TEST(CauseAttribution, PreemptedByAnRtHogWhileTheLoopWasRunnable) {
+  Case c;
+  c.spec.overrides[1000] = HeldOff(2'000'000);
+  c.special[1000] = HogHoldsTheCpu(kHogPid, "rt-hog", kHogKernelPrio, 2'000'000);
+  c.tasks = {{kHogPid, "rt-hog", "SCHED_FIFO", 95}};
+  const JitterReport r = c.Analyze();
+  ASSERT_TRUE(r.kernel_recorded);
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_TRUE(n.missed);
+  EXPECT_EQ(n.cause.cause, CauseClass::kPreempted);
+  EXPECT_EQ(n.cause.thread, "rt-hog");
+  EXPECT_EQ(n.cause.pid, kHogPid);
+  EXPECT_EQ(n.cause.policy, "SCHED_FIFO");
+  EXPECT_EQ(n.cause.priority, 95);
+  EXPECT_EQ(n.cause.duration_ns, 2'000'000);
+  EXPECT_EQ(n.cause.cpu, kLoopCpu);
+  EXPECT_EQ(n.cause.evidence, "preempted by rt-hog (pid 4242, SCHED_FIFO 95) for 2.00 ms");
+}
+
+TEST(CauseAttribution, WithoutTheTaskTableThePolicyComesFromTheKernelPrio) {
+  Case c;
+  c.spec.overrides[1000] = HeldOff(2'000'000);
+  c.special[1000] = HogHoldsTheCpu(kHogPid, "rt-hog", kHogKernelPrio, 2'000'000);
+  const JitterReport r = c.Analyze();
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_EQ(n.cause.cause, CauseClass::kPreempted);
+  EXPECT_EQ(n.cause.policy, "SCHED_FIFO/RR");
+  EXPECT_EQ(n.cause.priority, 95);
+}
+
+TEST(CauseAttribution, AnInterruptHandlerDuringTheStep) {
+  Case c;
+  c.spec.overrides[1000] = {3'000, 60'000};  // 20 µs of work + 40 µs in the handler
+  c.special[1000] = IrqInStep(42, "eth0", 5'000, 40'000);
+  const JitterReport r = c.Analyze();
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_TRUE(n.missed);
+  EXPECT_EQ(n.cause.cause, CauseClass::kInterrupt);
+  EXPECT_EQ(n.cause.interrupt, "eth0");
+  EXPECT_EQ(n.cause.irq, 42);
+  EXPECT_EQ(n.cause.duration_ns, 40'000);
+  EXPECT_EQ(n.cause.evidence, "interrupt: eth0 (irq 42) for 40 us");
+}
+
+TEST(CauseAttribution, PageFaultsOfTheLoopThread) {
+  Case c;
+  c.spec.overrides[1000] = {3'000, 80'000};
+  c.special[1000] = [](KernelScript& k, const scheduler::TimingSample& s) {
+    testing::NormalCycle(k, s);
+    for (int i = 0; i < 20; ++i) {
+      k.Fault(s.start_ns + 1'000 + std::int64_t{3'000} * i, kLoopCpu, kLoopTid,
+              std::uint64_t{0x7f00'0000'0000} + 4096 * static_cast<std::uint64_t>(i));
+    }
+    k.Fault(s.start_ns + 2'000, 0, 4321, 0x1000);  // another process's, elsewhere: not ours
+  };
+  const JitterReport r = c.Analyze();
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_EQ(n.cause.cause, CauseClass::kPageFault);
+  EXPECT_EQ(n.cause.faults, 20u);
+  EXPECT_EQ(n.cause.address, std::uint64_t{0x7f00'0000'0000});
+  // 19 faults charged the 3 µs to the next one; the last one the 22 µs to the end of the step.
+  EXPECT_EQ(n.cause.duration_ns, 19 * 3'000 + 22'000);
+  EXPECT_EQ(n.cause.evidence,
+            "20 page faults of the loop thread (first at 0x7f0000000000) for 79 us");
+}
+
+TEST(CauseAttribution, OwnComputeWhenNothingElseHappened) {
+  Case c;
+  c.spec.overrides[1000] = {3'000, 200'000};
+  const JitterReport r = c.Analyze();
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_EQ(n.cause.cause, CauseClass::kOwnCompute);
+  EXPECT_EQ(n.cause.duration_ns, 200'000 - r.compute.summary.p50_ns);
+  EXPECT_NE(n.cause.evidence.find("own compute: the step took 200 us"), std::string::npos)
+      << n.cause.evidence;
+}
+
+TEST(CauseAttribution, AnIdleCpuThroughTheDelayIsInvisibleToTheGuest) {
+  Case c;
+  c.spec.overrides[1000] = {4'200'000, 20'000};  // the wake-up came 4.2 ms late, CPU idle
+  const JitterReport r = c.Analyze();
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_EQ(n.cause.cause, CauseClass::kInvisible);
+  const std::int64_t excess = n.response_ns - r.response.summary.p50_ns;
+  EXPECT_EQ(n.cause.duration_ns, excess - 800);  // less the 0.8 µs timer interrupt
+  EXPECT_EQ(n.cause.evidence,
+            "nothing ran on CPU 1 for 4.20 ms of the 4.20 ms delay: invisible to the guest "
+            "(hypervisor steal or SMI)");
+}
+
+TEST(CauseAttribution, MixedCasesTheLongestCulpritWins) {
+  Case c;
+  // 1000: held off 300 µs by a SCHED_OTHER thread, then 800 µs in an interrupt: interrupt.
+  c.spec.overrides[1000] = HeldOff(300'000, 820'000);
+  c.special[1000] = Both(HogHoldsTheCpu(77, "kworker/1:1", 120, 300'000),
+                         IrqInStep(30, "nvme0q1", 10'000, 800'000));
+  // 1500: held off 1 ms by the RT hog, then 300 µs in an interrupt: preempted.
+  c.spec.overrides[1500] = HeldOff(1'000'000, 320'000);
+  c.special[1500] = Both(HogHoldsTheCpu(kHogPid, "rt-hog", kHogKernelPrio, 1'000'000),
+                         IrqInStep(30, "nvme0q1", 10'000, 300'000));
+  const JitterReport r = c.Analyze();
+  const NotableCycle& a = NotableAt(r, 1000);
+  EXPECT_EQ(a.cause.cause, CauseClass::kInterrupt);
+  EXPECT_EQ(a.cause.interrupt, "nvme0q1");
+  EXPECT_EQ(a.cause.duration_ns, 800'000);
+  const NotableCycle& b = NotableAt(r, 1500);
+  EXPECT_EQ(b.cause.cause, CauseClass::kPreempted);
+  EXPECT_EQ(b.cause.thread, "rt-hog");
+  EXPECT_EQ(b.cause.duration_ns, 1'000'000);
+}
+
+TEST(CauseAttribution, RankingByCyclesThenMisses) {
+  Case c;
+  c.spec.releases = 20'000;  // enough cycles that p99.9 is an ordinary wake-up
+  for (const std::uint64_t k : {400u, 600u}) {
+    c.spec.overrides[k] = HeldOff(200'000);
+    c.special[k] = HogHoldsTheCpu(kHogPid, "rt-hog", kHogKernelPrio, 200'000);
+  }
+  c.spec.overrides[800] = HeldOff(150'000);
+  c.special[800] = HogHoldsTheCpu(555, "backup", 120, 150'000);
+  c.spec.overrides[1000] = {3'000, 60'000};
+  c.special[1000] = IrqInStep(42, "eth0", 5'000, 40'000);
+  c.spec.overrides[1200] = {300'000, 20'000};
+  c.spec.overrides[1400] = {300'000, 20'000};
+  c.spec.overrides[1600] = {20'000, 20'000};  // a late wake-up that still met its deadline
+  const JitterReport r = c.Analyze();
+  ASSERT_EQ(r.notable.size(), 7u);
+  const NotableCycle& wake_only = NotableAt(r, 1600);
+  EXPECT_FALSE(wake_only.missed);
+  EXPECT_EQ(wake_only.cause.cause, CauseClass::kInvisible);
+  ASSERT_EQ(r.causes.size(), 3u);
+  EXPECT_EQ(r.causes[0].cause, CauseClass::kPreempted);  // 3 cycles, 3 misses
+  EXPECT_EQ(r.causes[0].cycles, 3u);
+  EXPECT_EQ(r.causes[0].misses, 3u);
+  ASSERT_EQ(r.causes[0].culprits.size(), 2u);
+  EXPECT_EQ(r.causes[0].culprits[0], (std::pair<std::string, std::uint64_t>{"rt-hog (pid 4242)", 2}));
+  EXPECT_EQ(r.causes[0].culprits[1], (std::pair<std::string, std::uint64_t>{"backup (pid 555)", 1}));
+  EXPECT_EQ(r.causes[1].cause, CauseClass::kInvisible);  // 3 cycles, 2 misses
+  EXPECT_EQ(r.causes[1].cycles, 3u);
+  EXPECT_EQ(r.causes[1].misses, 2u);
+  EXPECT_EQ(r.causes[2].cause, CauseClass::kInterrupt);
+  EXPECT_EQ(r.causes[2].cycles, 1u);
+}
+
+TEST(CauseAttribution, ACycleOutsideTheKernelRecordingIsNotRecorded) {
+  Case c;
+  c.spec.releases = 20'000;  // enough cycles that 200 µs of compute is above p99.9
+  c.spec.overrides[5] = {3'000, 200'000};
+  c.spec.overrides[1000] = {3'000, 200'000};
+  // The recorder started late: nothing before cycle 500.
+  c.special[0] = [](KernelScript&, const scheduler::TimingSample&) {};
+  const TimingTrace trace = testing::MakeTrace(c.spec);
+  std::map<std::uint64_t, SpecialCycle> special;
+  for (const TracedCycle& cycle : trace.cycles) {
+    if (cycle.sample.cycle < 500) special[cycle.sample.cycle] = c.special[0];
+  }
+  const KernelTrace kernel = testing::MakeKernel(trace, special);
+  const JitterReport r = AnalyzeJitter(trace, &kernel);
+  EXPECT_EQ(NotableAt(r, 5).cause.cause, CauseClass::kNotRecorded);
+  EXPECT_EQ(NotableAt(r, 1000).cause.cause, CauseClass::kOwnCompute);
+}
+
+TEST(CauseAttribution, TheLoopsCpuNotRecordedGivesNoCause) {
+  Case c;
+  c.spec.releases = 20'000;
+  c.spec.overrides[1000] = {3'000, 200'000};
+  const TimingTrace trace = testing::MakeTrace(c.spec);
+  KernelTrace kernel = testing::MakeKernel(trace, {});
+  kernel.cpus = {0};  // the recorder listed only CPU 0
+  const JitterReport r = AnalyzeJitter(trace, &kernel);
+  const NotableCycle& n = NotableAt(r, 1000);
+  EXPECT_EQ(n.cause.cause, CauseClass::kNotRecorded);
+  EXPECT_EQ(n.cause.evidence, "CPU 1, where the loop was, was not recorded");
+  EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.find("CPU 1 was not among the recorded CPUs") != std::string::npos;
+  }));
+}
+
+TEST(CauseAttribution, ATimingLogCannotBeMatchedToKernelEvents) {
+  Case c;
+  c.spec.overrides[1000] = {3'000, 200'000};
+  TimingTrace trace = testing::MakeTrace(c.spec);
+  const KernelTrace kernel = testing::MakeKernel(trace, {});
+  trace.source = TraceSource::kTimingLog;
+  const JitterReport r = AnalyzeJitter(trace, &kernel);
+  EXPECT_FALSE(r.kernel_recorded);
+  EXPECT_TRUE(r.causes.empty());
+  EXPECT_EQ(NotableAt(r, 1000).cause.cause, CauseClass::kNotRecorded);
+  EXPECT_FALSE(r.warnings.empty());
+}
+
+TEST(CauseAttribution, AMillionEventsAreIndexedAndQueriedQuickly) {
+  RunSpec spec = KernelRun();
+  spec.releases = 220'000;  // 11 s at 20 kHz: 1.1 million kernel events
+  for (std::uint64_t k = 1'000; k < spec.releases; k += 1'000) spec.overrides[k] = {3'000, 60'000};
+  const TimingTrace trace = testing::MakeTrace(spec);
+  std::map<std::uint64_t, SpecialCycle> special;
+  for (std::uint64_t k = 1'000; k < spec.releases; k += 1'000) {
+    special[k] = IrqInStep(42, "eth0", 5'000, 40'000);
+  }
+  const KernelTrace kernel = testing::MakeKernel(trace, special);
+  ASSERT_GT(kernel.events.size(), 1'000'000u);
+  const JitterReport r = AnalyzeJitter(trace, &kernel);
+  ASSERT_EQ(r.causes.size(), 1u);
+  EXPECT_EQ(r.causes[0].cause, CauseClass::kInterrupt);
+  EXPECT_EQ(r.causes[0].cycles, 219u);
+}
+
+}  // namespace
+}  // namespace hiltwin::analysis
