@@ -1,116 +1,55 @@
 // Records a real LTTng trace of the hiltwin provider: session daemon, session, emitter
-// process, babeltrace2. Label `integration`. Uses a running session daemon if one answers,
-// otherwise starts one (and stops only that one).
+// process, babeltrace2's text as a second opinion on the fields (hiltwin itself reads CTF
+// through libbabeltrace2, analysis/trace_readers.h). Label `integration`. The daemon and session
+// come from the shared LTTng fixture (tests/fakes/lttng_fixture.h).
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/types.h>
-#include <unistd.h>
 
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
+#include <chrono>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
-namespace {
+#include "fakes/lttng_fixture.h"
+#include "hiltwin/kernel_glue/process.h"
 
-namespace fs = std::filesystem;
+namespace {
 
 constexpr int kEvents = 500;
 
 class TraceSessionTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    home_ = fs::temp_directory_path() / ("hiltwin_lttng_" + std::to_string(::getpid()));
-    fs::remove_all(home_);
-    fs::create_directories(home_);
-    log_ = (home_ / "commands.log").string();
-  }
-
-  void TearDown() override {
-    Run("lttng destroy " + Session());
-    if (started_daemon_) {
-      // The daemon writes its pid under its run directory: /var/run/lttng for root,
-      // $LTTNG_HOME/.lttng otherwise.
-      for (const fs::path& pid_file : {fs::path("/var/run/lttng/lttng-sessiond.pid"),
-                                       home_ / ".lttng" / "lttng-sessiond.pid"}) {
-        std::ifstream in(pid_file);
-        pid_t pid = 0;
-        if (in >> pid && pid > 0) {
-          ::kill(pid, SIGTERM);
-          // Wait for it to go, so a following run does not find a daemon that is dying.
-          for (int i = 0; i < 100 && ::kill(pid, 0) == 0; ++i) ::usleep(50'000);
-          break;
-        }
-      }
-    }
-    fs::remove_all(home_);
-  }
-
-  // Runs a shell command with LTTNG_HOME pointing into the test directory, output appended
-  // to the command log; returns the exit status.
-  int Run(const std::string& command) const {
-    const std::string line =
-        "LTTNG_HOME='" + home_.string() + "' " + command + " >>'" + log_ + "' 2>&1";
-    const int status = std::system(line.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
-  [[nodiscard]] std::string Session() const { return "hiltwin_test_" + std::to_string(::getpid()); }
-
   // Starts a session daemon when none answers (nullopt when none can run here), records the
-  // hiltwin events of `emitter` (a command line) in a fresh session, and returns the text
-  // lines of that process's events only: other suites run hiltwin in parallel.
-  std::optional<std::vector<std::string>> RecordEventsOf(const std::string& emitter) {
-    if (Run("lttng list") != 0) {
-      if (Run("lttng-sessiond --daemonize --no-kernel") != 0) return std::nullopt;
-      started_daemon_ = true;
-    }
-    const std::string trace_dir = (home_ / "trace").string();
-    EXPECT_EQ(Run("lttng create " + Session() + " --output='" + trace_dir + "'"), 0)
-        << CommandLog();
-    EXPECT_EQ(Run("lttng enable-event --userspace --session=" + Session() + " 'hiltwin:*'"), 0)
-        << CommandLog();
-    EXPECT_EQ(Run("lttng add-context --userspace --session=" + Session() + " --type=vpid"), 0)
-        << CommandLog();
-    EXPECT_EQ(Run("lttng start " + Session()), 0) << CommandLog();
-    const std::string pid_path = (home_ / "emitter.pid").string();
-    EXPECT_EQ(Run("sh -c 'echo $$ >\"" + pid_path + "\"; exec " + emitter + "'"), 0)
-        << CommandLog();
-    std::string emitter_pid;
-    std::ifstream(pid_path) >> emitter_pid;
-    EXPECT_FALSE(emitter_pid.empty()) << CommandLog();
-    EXPECT_EQ(Run("lttng stop " + Session()), 0) << CommandLog();
-    const std::string text_path = (home_ / "trace.txt").string();
-    EXPECT_EQ(
-        std::system(
-            ("babeltrace2 '" + trace_dir + "' >'" + text_path + "' 2>>'" + log_ + "'").c_str()),
-        0)
-        << CommandLog();
-    const std::string emitter_context = "vpid = " + emitter_pid + " }";
+  // hiltwin events of `emitter` in a fresh session, and returns the text lines of that
+  // process's events only: other suites run hiltwin in parallel.
+  std::optional<std::vector<std::string>> RecordEventsOf(const std::vector<std::string>& emitter) {
+    if (!lttng_.EnsureDaemon()) return std::nullopt;
+    const std::string trace_dir = (lttng_.home() / "trace").string();
+    const auto recording = lttng_.Record(trace_dir, {emitter}, {});
+    EXPECT_TRUE(recording.ok) << CommandLog();
+    hiltwin::kernel_glue::ProcessOptions options;
+    options.out = hiltwin::kernel_glue::OutputTarget::Capture();
+    options.err = hiltwin::kernel_glue::OutputTarget::Capture();
+    const auto text = hiltwin::kernel_glue::RunProcess({"babeltrace2", trace_dir}, options,
+                                                       std::chrono::seconds(60));
+    EXPECT_TRUE(text.status.Success()) << text.err << CommandLog();
+    const std::string emitter_context =
+        "vpid = " + std::to_string(recording.pids.empty() ? -1 : recording.pids[0]) + " }";
     std::vector<std::string> lines;
-    std::ifstream text(text_path);
-    for (std::string line; std::getline(text, line);) {
-      if (!emitter_pid.empty() && line.find(emitter_context) != std::string::npos) {
-        lines.push_back(line);
-      }
+    std::istringstream in(text.out);
+    for (std::string line; std::getline(in, line);) {
+      if (line.find(emitter_context) != std::string::npos) lines.push_back(line);
     }
     return lines;
   }
 
-  [[nodiscard]] std::string CommandLog() const {
-    std::ifstream in(log_);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
+  [[nodiscard]] std::string CommandLog() const { return lttng_.CommandLog(); }
 
-  fs::path home_;
-  std::string log_;
-  bool started_daemon_ = false;
+  hiltwin::test::LttngFixture lttng_{"tracing_session"};
 };
 
 TEST_F(TraceSessionTest, RecordsEveryEventWithItsFields) {
-  const auto lines = RecordEventsOf("\"" HILTWIN_TRACE_EMITTER "\" " + std::to_string(kEvents));
+  const auto lines = RecordEventsOf({HILTWIN_TRACE_EMITTER, std::to_string(kEvents)});
   if (!lines) GTEST_SKIP() << "cannot start lttng-sessiond here; log:\n" << CommandLog();
   int cycles = 0;
   int violations = 0;
@@ -155,8 +94,8 @@ TEST_F(TraceSessionTest, TheRunAssemblyTracesEveryCycleOfAnyTask) {
   // tracepoint used to fire from the RELbot's own observer, so this task got no trace.
   constexpr int kCycles = 300;
   constexpr int kMissed = 100;
-  const auto lines = RecordEventsOf("\"" HILTWIN_SESSION_EMITTER "\" " + std::to_string(kCycles) +
-                                    " " + std::to_string(kMissed));
+  const auto lines =
+      RecordEventsOf({HILTWIN_SESSION_EMITTER, std::to_string(kCycles), std::to_string(kMissed)});
   if (!lines) GTEST_SKIP() << "cannot start lttng-sessiond here; log:\n" << CommandLog();
   int cycles = 0;
   int injected = 0;

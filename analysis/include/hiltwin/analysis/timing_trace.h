@@ -1,6 +1,6 @@
 #pragma once
 /// One run's loop timing as `hiltwin trace` analyses it, whatever it was read from: an LTTng
-/// CTF trace of the `hiltwin` provider (ctf_reader.h) or a timing log (timing_log_reader.h).
+/// CTF trace of the `hiltwin` provider or a timing log (both readers in trace_readers.h).
 /// Readers fill it; the jitter analysis (jitter_analysis.h) reads nothing else.
 
 #include <cstdint>
@@ -59,18 +59,30 @@ struct TimingTrace {
   std::int64_t period_ns = 0;
   std::int64_t deadline_ns = 0;
   std::uint64_t planned_cycles = 0;      ///< 0: until stopped
+  // LTTng: period, deadline, plan and rules come from loop_start and qos_rule; a trace whose
+  // recording began after the loop started has neither (0 and empty, `loop` absent).
   std::vector<qos::RuleSpec> rules;      ///< the run's QoS rules, in configuration order
   std::optional<LoopThread> loop;        ///< LTTng: from loop_start
   std::vector<TracedCycle> cycles;       ///< in order of k
+  /// LTTng: as recorded. Timing log: one kDeadlineMiss per missed row (a = end - release -
+  /// deadline, exactly what the loop traces), nothing else.
   std::vector<TracedEvent> events;
   bool complete = false;                 ///< LTTng: loop_end seen; timing log: no torn row
-  /// Events the tracer dropped (CTF packet contexts' events_discarded, summed over streams);
-  /// a timing log cannot drop silently (its own drops are in the run report), so 0 there.
+  /// Events the tracer dropped (CTF packet contexts' events_discarded, summed over streams,
+  /// whichever process's they were: per-user buffers share streams between processes);
+  /// timing log: rows its logger dropped (queue full), seen as releases between two rows that
+  /// neither row accounts for (k jumps by more than 1 + releases_skipped).
   std::uint64_t discarded_events = 0;
+  /// Whole packets the tracer lost (CTF packet sequence numbers that jump): their events are
+  /// not in discarded_events, because nobody counted them. 0 for a timing log.
+  std::uint64_t discarded_packets = 0;
   /// LTTng: the process whose events these are (several runs in one trace: the first one,
   /// and `other_processes` says how many more were seen and left out).
   int pid = 0;
   std::uint32_t other_processes = 0;
+  /// LTTng: further loops of that same process (a second loop_start, e.g. `hiltwin tune`'s
+  /// candidate runs), left out: the trace is the process's first run.
+  std::uint32_t other_runs = 0;
 };
 
 /// Thrown by every reader for input it cannot use: the message names the file and the place
