@@ -8,7 +8,8 @@
 //   deadline_miss {k, lateness_ns = k%7 + 30 - 1000} after each missed cycle
 //   qos_violation {rule = 0, k, distance = 0, violations = k/10 + 1} after each missed cycle
 //   io_error {k, kind = (k/50)%4} for k%50 == 0
-//   state_transition {k = 0, from = 2 (ready), to = 3 (run), event = 1} before the cycles
+//   state_transition {k = 0, from = 2 (run), to = 3 (paused), event = 1 (start)} before the
+//              cycles: codes only, not a legal transition (readers decode, not judge)
 //   loop_end {cycles_run = COUNT, releases = COUNT}
 #include <unistd.h>
 
