@@ -46,7 +46,7 @@ function(hiltwin_add_module name)
 endfunction()
 
 # hiltwin_add_gtest(<name> SOURCES <files...> LIBS <targets...> LABELS <labels...>
-#                   [RT_TESTS <regex>] [TIMEOUT s])
+#                   [RT_TESTS <regex>] [TIMEOUT s] [RESOURCE_LOCK name])
 # A GoogleTest executable whose tests CTest discovers one by one, with labels
 # (unit, integration, rt, soak) so suites can be chosen with `ctest -L`.
 # RESOURCE_LOCK: a name CTest never runs two holders of at once (`lttng`: the one session
@@ -70,7 +70,9 @@ function(hiltwin_add_gtest name)
   gtest_discover_tests(${name}
     DISCOVERY_TIMEOUT 60
     TEST_LIST ${name}_TESTS
+    # A test that skips (GTEST_SKIP: no daemon, no privilege) shows as skipped, not passed.
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} ${extra_properties}
+               SKIP_REGULAR_EXPRESSION "\\[  SKIPPED \\]"
     EXTRA_ARGS --gtest_color=no)
   if(ARG_RT_TESTS)
     set(rt_labels ${ARG_LABELS} rt)
