@@ -83,8 +83,9 @@ class LttngSessionTest : public ::testing::Test {
     std::istringstream lines(result.out);
     int cycles = 0;
     for (std::string line; std::getline(lines, line);) {
+      // Both contexts the session adds, vpid and vtid, are on every event.
       if (line.find("hiltwin:cycle:") != std::string::npos &&
-          line.find(vpid) != std::string::npos) {
+          line.find(vpid) != std::string::npos && line.find("vtid = ") != std::string::npos) {
         ++cycles;
       }
     }
