@@ -2,10 +2,12 @@
 
 # Warning set applied to every target of ours, tests and benchmarks included.
 function(hiltwin_target_warnings target)
+  # The C++-only ones apply to C++ sources only, so a C source (a check of a C library's
+  # header, say) builds without "valid for C++ but not for C" noise.
   target_compile_options(${target} PRIVATE
-    -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow -Wnon-virtual-dtor
-    -Wold-style-cast -Woverloaded-virtual -Wdouble-promotion -Wformat=2
-    -Wimplicit-fallthrough -Wcast-align -Wmisleading-indentation)
+    -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow
+    "$<$<COMPILE_LANGUAGE:CXX>:-Wnon-virtual-dtor;-Wold-style-cast;-Woverloaded-virtual>"
+    -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough -Wcast-align -Wmisleading-indentation)
   if(HILTWIN_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

@@ -16,7 +16,7 @@ command -v clang-tidy >/dev/null || {
 }
 cd "$root"
 mapfile -t files < <(find kernel_glue scheduler qos statemachine io tracing runtime analysis \
-                          app_relbot tests bench -name '*.cpp' 2>/dev/null | sort)
+                          trace_capture app_relbot tests bench -name '*.cpp' 2>/dev/null | sort)
 echo "== tidy: function size (at most 80 lines) in ${#files[@]} files"
 findings=$(printf '%s\n' "${files[@]}" |
            xargs -P "$(nproc)" -n 6 clang-tidy -p "$build_dir" --quiet \

@@ -5,7 +5,9 @@
 /// read back here for the cause of every late cycle (cause_attribution.h).
 ///
 /// File format (one header row, then one row per event in time order; empty cells where a
-/// field does not apply; comm names never contain commas — the writer replaces them):
+/// field does not apply (each kind below lists its fields), read back as the default; comm and
+/// name never contain commas or line breaks — the writer replaces them with '_'; address in
+/// hex with 0x):
 ///   time_ns,cpu,event,pid,comm,prio,next_pid,next_comm,next_prio,prev_state,target_cpu,irq,name,
 ///   address
 /// and DIR/kernel_tasks.csv, the threads seen, with their policy when it could be read:
@@ -49,6 +51,8 @@ struct KernelEvent {
   int irq = -1;
   std::string name;          ///< irq handler or softirq vector name
   std::uint64_t address = 0;
+
+  friend bool operator==(const KernelEvent&, const KernelEvent&) = default;
 };
 
 /// A thread seen in the recording, with its scheduling class as read at the end of the
@@ -58,13 +62,17 @@ struct KernelTask {
   std::string comm;
   std::string policy;  ///< "SCHED_FIFO", "SCHED_RR", "SCHED_OTHER", ... or empty
   int rt_priority = 0;
+
+  friend bool operator==(const KernelTask&, const KernelTask&) = default;
 };
 
 struct KernelTrace {
   std::vector<int> cpus;  ///< CPUs recorded
   std::vector<KernelEvent> events;  ///< in time order
-  std::vector<KernelTask> tasks;
+  std::vector<KernelTask> tasks;  ///< by pid; not pid 0 (the idle task is no thread to ask)
   std::uint64_t lost_events = 0;    ///< the ring buffer's overruns, when the recorder knew
+
+  friend bool operator==(const KernelTrace&, const KernelTrace&) = default;
 };
 
 /// Writes DIR/kernel_events.csv and DIR/kernel_tasks.csv; throws std::runtime_error naming the

@@ -15,10 +15,11 @@ namespace hiltwin::trace_capture {
 
 struct KernelRecorderConfig {
   std::string output_dir;
-  std::vector<int> cpus;          ///< CPUs to record; empty: every online CPU
+  std::vector<int> cpus;            ///< CPUs to record; empty: every online CPU
   std::vector<int> collector_cpus;  ///< where the collector thread may run; empty: any
-  int buffer_kb_per_cpu = 16384;  ///< tracefs ring per CPU
-  bool may_mount = true;          ///< mount tracefs at /sys/kernel/tracing when it is not
+  int buffer_kb_per_cpu = 16384;    ///< tracefs ring per CPU
+  bool may_mount = true;            ///< mount tracefs at /sys/kernel/tracing when it is not
+  int drain_period_ms = 100;        ///< how often the collector empties the per-CPU buffers
 };
 
 class KernelRecorder {
@@ -38,8 +39,9 @@ class KernelRecorder {
   /// two files, removes the instance and returns what it wrote. Idempotent.
   const analysis::KernelTrace& Stop();
 
-  /// Empty when this process may record the kernel here; otherwise why not and what to do.
-  [[nodiscard]] static std::string WhyCannotRecord();
+  /// Empty when this process may record the kernel here; otherwise why not and what to do
+  /// (tracefs_access.h). Mounts tracefs when it is not mounted and `may_mount`.
+  [[nodiscard]] static std::string WhyCannotRecord(bool may_mount = true);
 
  private:
   struct State;

@@ -6,13 +6,14 @@
 /// only: it allocates and blocks freely, never on the loop thread.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 namespace hiltwin::trace_capture {
 
 struct LttngSessionConfig {
-  std::string output_dir;     ///< the CTF trace goes under it (created when missing)
-  double rate_hz = 4000.0;    ///< the loop's rate: sizes the channel's sub-buffers
+  std::string output_dir;   ///< the CTF trace goes under it (created when missing)
+  double rate_hz = 4000.0;  ///< the loop's rate: sizes the channel's sub-buffers
   /// Start an lttng-sessiond when none answers (root, or a member of the `tracing` group).
   bool may_start_daemon = true;
 };
@@ -21,16 +22,35 @@ struct LttngSessionConfig {
 struct LttngChannelFigures {
   std::uint64_t discarded_events = 0;  ///< events dropped because the buffers were full
   std::uint64_t lost_packets = 0;
-  std::uint64_t subbuf_bytes = 0;      ///< the channel's sizing, for the report
+  std::uint64_t subbuf_bytes = 0;  ///< the channel's sizing, for the report
   std::uint64_t subbuf_count = 0;
 };
+
+/// How the session's user-space channel is sized for a loop rate (ChannelSizeFor).
+struct LttngChannelSize {
+  std::uint64_t subbuf_bytes = 0;     ///< a power of two
+  std::uint64_t subbuf_count = 0;     ///< a power of two
+  std::uint32_t switch_timer_us = 0;  ///< a sub-buffer goes to the consumer at least this often
+};
+
+/// Bytes of one hiltwin:cycle event in the channel: payload, header and vpid/vtid context.
+inline constexpr std::uint64_t kCycleEventBytes = 80;
+
+/// The channel for a loop at `rate_hz` (one hiltwin:cycle per cycle; the rarer events are a
+/// small fraction): sub-buffers of the next power of two of 0.1 s of events, at least 256 KiB,
+/// 8 of them, a 100 ms switch timer. Pure, so its arithmetic is tested on its own.
+[[nodiscard]] LttngChannelSize ChannelSizeFor(double rate_hz);
+
+/// A session daemon this process started, shared by its sessions (src/session_daemon.h).
+class SessionDaemon;
 
 class LttngSession {
  public:
   /// Everything above, then starts tracing. Throws CaptureError (capture_error.h) with what
   /// to do when the daemon is unreachable and cannot be started, or a session call fails.
   explicit LttngSession(const LttngSessionConfig& config);
-  /// Stop() when still recording; stops the daemon this object started.
+  /// Stop() when still recording; the last session of this process to use a daemon the
+  /// process started stops that daemon (SIGTERM, waiting for it to exit).
   ~LttngSession();
   LttngSession(const LttngSession&) = delete;
   LttngSession& operator=(const LttngSession&) = delete;
@@ -40,12 +60,15 @@ class LttngSession {
   LttngChannelFigures Stop();
 
   [[nodiscard]] const std::string& session_name() const noexcept { return name_; }
-  /// Whether this object started the session daemon (and so will stop it).
-  [[nodiscard]] bool started_daemon() const noexcept { return daemon_pid_ > 0; }
+  /// Whether this process started the session daemon this session uses (and so stops it
+  /// when the last of its sessions is destroyed).
+  [[nodiscard]] bool started_daemon() const noexcept { return daemon_ != nullptr; }
+  /// That daemon's pid; 0 when the daemon was already running (it is left alone).
+  [[nodiscard]] int daemon_pid() const noexcept;
 
  private:
+  std::shared_ptr<SessionDaemon> daemon_;  // null: someone else's daemon, never stopped here
   std::string name_;
-  int daemon_pid_ = 0;
   bool stopped_ = false;
   LttngChannelFigures figures_;
 };
