@@ -97,9 +97,12 @@ double Median(std::vector<double> values) {
 int main(int argc, char** argv) {
   const int rounds = argc > 1 ? std::atoi(argv[1]) : 5;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 3.0;
-  const fs::path dir = fs::temp_directory_path() / ("hiltwin_bench_trace_" + std::to_string(getpid()));
-  std::printf("tracing cost per loop cycle: loop-thread CPU time / cycles, empty task, real time, "
-              "%d alternating rounds of %.1f s, median\n", rounds, seconds);
+  const fs::path dir =
+      fs::temp_directory_path() / ("hiltwin_bench_trace_" + std::to_string(getpid()));
+  std::printf(
+      "tracing cost per loop cycle: loop-thread CPU time / cycles, empty task, real time, "
+      "%d alternating rounds of %.1f s, median\n",
+      rounds, seconds);
   try {
     for (const double rate_hz : {4000.0, 20000.0}) {
       std::vector<double> idle, recording;
@@ -111,10 +114,11 @@ int main(int argc, char** argv) {
         discarded += traced.discarded;
       }
       const double extra = Median(recording) - Median(idle);
-      std::printf("  %5.0f Hz  idle (peer) %7.1f ns  recording %7.1f ns  extra %6.1f ns/cycle "
-                  "(target <= 300: %s)  discarded events %llu\n",
-                  rate_hz, Median(idle), Median(recording), extra, extra <= 300.0 ? "met" : "NOT met",
-                  static_cast<unsigned long long>(discarded));
+      std::printf(
+          "  %5.0f Hz  idle (peer) %7.1f ns  recording %7.1f ns  extra %6.1f ns/cycle "
+          "(target <= 300: %s)  discarded events %llu\n",
+          rate_hz, Median(idle), Median(recording), extra, extra <= 300.0 ? "met" : "NOT met",
+          static_cast<unsigned long long>(discarded));
     }
   } catch (const hiltwin::trace_capture::CaptureError& e) {
     std::fprintf(stderr, "hiltwin_bench_trace: cannot record here: %s\n", e.what());

@@ -7,6 +7,7 @@
 #include <sys/prctl.h>
 #include <time.h>
 
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -35,7 +36,7 @@ int main(int argc, char** argv) {
   prctl(PR_SET_NAME, name.c_str(), 0, 0, 0);
   cpu_set_t set;
   CPU_ZERO(&set);
-  CPU_SET(cpu, &set);
+  CPU_SET(static_cast<std::size_t>(cpu), &set);
   sched_param param{};
   param.sched_priority = priority;
   if (sched_setaffinity(0, sizeof set, &set) != 0 ||

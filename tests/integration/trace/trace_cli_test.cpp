@@ -85,8 +85,8 @@ TEST_F(TraceCli, ARecordedRunHasTheRunsVerdictAndAReportThatAgreesWithIt) {
 
 TEST_F(TraceCli, AnalyzeReadsTheRecordingAgainAndSaysTheSame) {
   const std::string out = Path("trace");
-  ASSERT_LE(Hiltwin({"trace", "--output", out, "--duration", "0.5", "--no-progress",
-                     "--clock", "virtual"})
+  ASSERT_LE(Hiltwin({"trace", "--output", out, "--duration", "0.5", "--no-progress", "--clock",
+                     "virtual"})
                 .exit_code,
             3);
   const json first = ReadJson(out + "/jitter_report.json");
@@ -127,8 +127,8 @@ TEST_F(TraceCli, AnalyzeReadsATraceRecordedByHandWithTheLttngCommand) {
 TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses) {
   if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
   // The competitor: SCHED_FIFO 95 on CPU 1, 3 ms of spinning every 100 ms, above the loop's 80.
-  auto hog = hiltwin::test::Spawn(
-      {HILTWIN_HOG, "hiltwin-hog", "1", "95", "3", "97", "20"}, Path("hog.out"));
+  auto hog = hiltwin::test::Spawn({HILTWIN_HOG, "hiltwin-hog", "1", "95", "3", "97", "20"},
+                                  Path("hog.out"));
   for (int i = 0; i < 100 && !fs::exists(Path("hog.out")); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -137,8 +137,8 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   std::string word;
   if (!(ready >> word) || word != "ready") GTEST_SKIP() << "SCHED_FIFO refused: no competitor";
   const std::string out = Path("trace");
-  const auto r = Hiltwin({"trace", "--kernel", "--output", out, "--duration", "2", "--rate",
-                          "4000", "--cpu", "1", "--priority", "80", "--no-progress"});
+  const auto r = Hiltwin({"trace", "--kernel", "--output", out, "--duration", "2", "--rate", "4000",
+                          "--cpu", "1", "--priority", "80", "--no-progress"});
   if (r.exit_code == 5 && r.err.find("--kernel") != std::string::npos) {
     GTEST_SKIP() << "the kernel cannot be recorded here: " << r.err;
   }
@@ -151,16 +151,18 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   ASSERT_FALSE(top["culprits"].empty());
   EXPECT_NE(top["culprits"][0]["name"].get<std::string>().find("hiltwin-hog"), std::string::npos)
       << top.dump(2);
-  // Every miss the competitor caused names it, with its policy and priority.
-  bool named = false;
+  // The misses the competitor caused name it, with its policy and priority (other threads,
+  // kernel workers say, may preempt the loop too on a busy machine).
+  int named = 0;
   for (const json& cycle : jitter["notable"]) {
-    if (cycle["cause"]["class"] != "preempted") continue;
-    EXPECT_EQ(cycle["cause"]["thread"], "hiltwin-hog");
-    EXPECT_EQ(cycle["cause"]["policy"], "SCHED_FIFO");
-    EXPECT_EQ(cycle["cause"]["priority"], 95);
-    named = true;
+    const json& cause = cycle["cause"];
+    if (cause["class"] != "preempted" || cause["thread"] != "hiltwin-hog") continue;
+    EXPECT_EQ(cause["policy"], "SCHED_FIFO");
+    EXPECT_EQ(cause["priority"], 95);
+    EXPECT_GT(cause["duration_ns"].get<std::int64_t>(), 0);
+    ++named;
   }
-  EXPECT_TRUE(named);
+  EXPECT_GT(named, 0);
 }
 
 TEST_F(TraceCli, KernelWithoutThePermissionExitsFiveWithTheReasonAndTheFix) {
@@ -193,8 +195,8 @@ TEST_F(TraceCli, ATimingLogGivesTheSameReportWithoutLttng) {
   ASSERT_LE(run.exit_code, 3) << run.err;
   const auto analysis = Hiltwin({"trace", "--analyze", Path("timing.csv")});
   ASSERT_EQ(analysis.exit_code, 0) << analysis.err;
-  ExpectAgreement(ReadJson(Path("run.json")), ReadJson(Path("timing.csv.jitter") +
-                                                       "/jitter_report.json"));
+  ExpectAgreement(ReadJson(Path("run.json")),
+                  ReadJson(Path("timing.csv.jitter") + "/jitter_report.json"));
   EXPECT_NE(analysis.out.find("causes were not recorded"), std::string::npos);
 }
 
