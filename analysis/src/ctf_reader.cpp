@@ -213,7 +213,10 @@ struct ProcessTrace {
 /// Turns the time-ordered messages into the TimingTrace of one process.
 class TraceBuilder {
  public:
-  explicit TraceBuilder(const std::string& dir) : dir_(dir) {}
+  /// `pid` > 0: keep that process; otherwise the first to start its loop.
+  TraceBuilder(const std::string& dir, int pid) : dir_(dir) {
+    if (pid > 0) chosen_ = pid;
+  }
 
   void OnMessage(const bt_message* message);
   [[nodiscard]] TimingTrace Finish();
@@ -638,7 +641,7 @@ std::vector<std::string> FindCtfTraces(const fs::path& dir) {
 
 }  // namespace
 
-TimingTrace ReadCtfTrace(const std::string& dir) {
+TimingTrace ReadCtfTrace(const std::string& dir, int pid) {
   std::error_code error;
   if (!fs::is_directory(dir, error)) {
     throw TraceReadError("no LTTng trace in " + dir +
@@ -651,7 +654,7 @@ TimingTrace ReadCtfTrace(const std::string& dir) {
                          ": no CTF `metadata` file below it; record one with `hiltwin trace "
                          "--output DIR` or pass a timing log file");
   }
-  TraceBuilder builder(dir);
+  TraceBuilder builder(dir, pid);
   SinkState sink{&builder, nullptr};
   CtfGraph graph(dir, traces, sink);
   graph.Run();

@@ -3,6 +3,7 @@
 #include "hiltwin/app_relbot/trace_run.h"
 
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -67,6 +68,7 @@ void StartCapture(const TraceOptions& o, Capture& capture) {
     trace_capture::LttngSessionConfig lttng;
     lttng.output_dir = o.output_dir;
     lttng.rate_hz = o.run.session.rate_hz;
+    lttng.only_pid = static_cast<int>(::getpid());
     capture.lttng.emplace(lttng);
     spdlog::info("recording LTTng session {} into {}", capture.lttng->session_name(), o.output_dir);
     if (o.kernel) {
@@ -191,7 +193,8 @@ int TraceTwin(const TraceOptions& o) {
     const trace_capture::LttngChannelFigures figures = capture.lttng->Stop();
     spdlog::info("LTTng session stopped: {} events discarded", figures.discarded_events);
     WriteText(o.output_dir + "/run_report.json", runtime::ToJson(outcome.report).dump(2) + "\n");
-    const analysis::TimingTrace trace = analysis::ReadCtfTrace(o.output_dir);
+    const analysis::TimingTrace trace =
+        analysis::ReadCtfTrace(o.output_dir, static_cast<int>(::getpid()));
     analysis::JitterReport report = Analyze(trace, kernel ? &*kernel : nullptr);
     for (const std::string& line : CompareWithRunReport(outcome.report, report)) {
       report.warnings.push_back("the trace disagrees with the run report: " + line);

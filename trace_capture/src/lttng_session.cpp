@@ -125,6 +125,25 @@ void EnableEventsAndContexts(const Handle& handle) {
   }
 }
 
+/// The session's user-space process tracker: only `pid`'s events are recorded.
+void TrackOnly(const std::string& session, int pid) {
+  lttng_process_attr_tracker_handle* tracker = nullptr;
+  Check(lttng_session_get_tracker_handle(session.c_str(), LTTNG_DOMAIN_UST,
+                                         LTTNG_PROCESS_ATTR_VIRTUAL_PROCESS_ID, &tracker),
+        "getting the process tracker");
+  const std::unique_ptr<lttng_process_attr_tracker_handle,
+                        decltype(&lttng_process_attr_tracker_handle_destroy)>
+      owned(tracker, &lttng_process_attr_tracker_handle_destroy);
+  if (lttng_process_attr_tracker_handle_set_tracking_policy(tracker,
+                                                            LTTNG_TRACKING_POLICY_INCLUDE_SET) !=
+          LTTNG_PROCESS_ATTR_TRACKER_HANDLE_STATUS_OK ||
+      lttng_process_attr_virtual_process_id_tracker_handle_add_pid(tracker, pid) !=
+          LTTNG_PROCESS_ATTR_TRACKER_HANDLE_STATUS_OK) {
+    throw CaptureError("LTTng: cannot restrict session " + session + " to process " +
+                       std::to_string(pid));
+  }
+}
+
 // lttng_stop_tracing() waits for the consumer the same way, but without a bound.
 void StopAndWaitForData(const std::string& name) {
   Check(lttng_stop_tracing_no_wait(name.c_str()), "stopping session " + name);
@@ -200,6 +219,7 @@ LttngSession::LttngSession(const LttngSessionConfig& config)
     const Handle handle(name_);
     EnableChannel(handle, size);
     EnableEventsAndContexts(handle);
+    if (config.only_pid > 0) TrackOnly(name_, config.only_pid);
     Check(lttng_start_tracing(name_.c_str()), "starting session " + name_);
   } catch (...) {
     DestroyQuietly(name_);

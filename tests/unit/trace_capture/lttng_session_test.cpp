@@ -134,6 +134,23 @@ TEST_F(LttngSessionTest, RecordsEveryCycleOfTheEmitterWithNothingDiscarded) {
   ExpectDaemonHandledRightly(daemon_pid);
 }
 
+TEST_F(LttngSessionTest, ASessionForOneProcessRecordsNoOtherProcess) {
+  int daemon_pid = 0;
+  {
+    LttngSessionConfig config = Config("only");
+    config.only_pid = static_cast<int>(::getpid());  // this test, which emits nothing
+    LttngSession session(config);
+    daemon_pid = session.daemon_pid();
+    const int emitter = RunEmitter(kCycles / 5);
+    session.Stop();
+    // Nothing recorded at all (no stream, no trace folder), or nothing of the emitter's.
+    if (HasMetadata(base_ / "only")) {
+      EXPECT_EQ(CyclesOf(base_ / "only", emitter), 0);
+    }
+  }
+  ExpectDaemonHandledRightly(daemon_pid);
+}
+
 TEST_F(LttngSessionTest, ASecondSessionKeepsTheDaemonWhileTheFirstEnds) {
   int daemon_pid = 0;
   {

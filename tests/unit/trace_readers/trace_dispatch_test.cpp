@@ -53,7 +53,8 @@ TEST_F(TraceDispatchTest, AFolderWithOtherFilesButNoMetadataHasNoTrace) {
   fs::create_directories(dir_ / "ust" / "uid" / "0" / "64-bit");
   std::ofstream(dir_ / "ust" / "uid" / "0" / "64-bit" / "channel0_0") << "not a stream";
   std::ofstream(dir_ / "kernel_events.csv") << "time_ns\n";
-  EXPECT_THAT(ErrorOf(ReadCtfTrace, dir_.string()), HasSubstr("no CTF `metadata` file below it"));
+  EXPECT_THAT(ErrorOf([](const std::string& p) { return ReadCtfTrace(p); }, dir_.string()),
+              HasSubstr("no CTF `metadata` file below it"));
 }
 
 TEST_F(TraceDispatchTest, AFileIsReadAsATimingLog) {
@@ -81,7 +82,7 @@ TEST_F(TraceDispatchTest, AMissingPathSaysWhatIsAccepted) {
 TEST_F(TraceDispatchTest, ReadCtfTraceRefusesAFile) {
   const std::string path = (dir_ / "file").string();
   std::ofstream(path) << "x";
-  EXPECT_THAT(ErrorOf(ReadCtfTrace, path),
+  EXPECT_THAT(ErrorOf([](const std::string& p) { return ReadCtfTrace(p); }, path),
               HasSubstr("no LTTng trace in " + path + ": it is not a folder"));
 }
 

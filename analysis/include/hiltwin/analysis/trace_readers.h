@@ -13,8 +13,9 @@ namespace hiltwin::analysis {
 
 /// Reads the CTF trace under `dir` (searched recursively for CTF `metadata`: `lttng create
 /// --output=DIR` puts it in DIR/ust/uid/<uid>/64-bit/). Several hiltwin processes in one trace:
-/// the first one to start its loop (other_processes counts the rest).
-[[nodiscard]] TimingTrace ReadCtfTrace(const std::string& dir);
+/// the first one to start its loop (other_processes counts the rest), or process `pid` when
+/// it is given (`hiltwin trace` knows its own).
+[[nodiscard]] TimingTrace ReadCtfTrace(const std::string& dir, int pid = 0);
 
 /// Reads a timing log written by `hiltwin run --timing-log FILE`.
 [[nodiscard]] TimingTrace ReadTimingLog(const std::string& path);

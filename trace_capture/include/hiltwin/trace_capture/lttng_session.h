@@ -16,6 +16,9 @@ struct LttngSessionConfig {
   double rate_hz = 4000.0;  ///< the loop's rate: sizes the channel's sub-buffers
   /// Start an lttng-sessiond when none answers (root, or a member of the `tracing` group).
   bool may_start_daemon = true;
+  /// Record only this process's events (0: every process of the user). `hiltwin trace` passes
+  /// its own pid, so other hiltwin processes running meanwhile stay out of its trace.
+  int only_pid = 0;
 };
 
 /// What the tracer says about the channel after the run.
