@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fakes/alloc_counter.h"
+#include "fakes/loop_allocations.h"
 #include "hiltwin/analysis/trace_readers.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
@@ -42,18 +43,7 @@ class HeldInputsTask final : public runtime::RunTask {
   std::uint64_t exchanges_ = 0;
 };
 
-class LoopAllocations final : public runtime::LoopThreadHooks {
- public:
-  void BeforeLoop() noexcept override { counter_.emplace(); }
-  void AfterLoop() noexcept override {
-    count = counter_->count();
-    counter_.reset();
-  }
-  std::uint64_t count = ~std::uint64_t{0};
-
- private:
-  std::optional<test::ScopedAllocationCount> counter_;
-};
+using test::LoopAllocations;
 
 TEST(RecordingLoop, AllocatesNothingAndEveryEventIsInTheTrace) {
   const fs::path dir =

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fakes/alloc_counter.h"
+#include "fakes/loop_allocations.h"
 #include "hiltwin/app_relbot/ecs_gains.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
@@ -18,19 +19,7 @@
 namespace hiltwin::app::test {
 namespace {
 
-/// Counts the loop thread's allocations between BeforeLoop and AfterLoop.
-class LoopAllocations final : public runtime::LoopThreadHooks {
- public:
-  void BeforeLoop() noexcept override { counter_.emplace(); }
-  void AfterLoop() noexcept override {
-    count = counter_->count();
-    counter_.reset();
-  }
-  std::uint64_t count = ~std::uint64_t{0};
-
- private:
-  std::optional<hiltwin::test::ScopedAllocationCount> counter_;
-};
+using hiltwin::test::LoopAllocations;
 
 std::string TempLog(const char* name) {
   return (std::filesystem::temp_directory_path() /

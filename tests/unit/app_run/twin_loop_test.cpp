@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "fakes/alloc_counter.h"
+#include "fakes/loop_allocations.h"
 #include "hiltwin/app_relbot/input_profile.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_params.h"
@@ -23,19 +24,7 @@ namespace {
 
 constexpr std::uint64_t kCycles = 20'000;
 
-/// Counts the loop thread's allocations between BeforeLoop and AfterLoop.
-class LoopAllocations final : public runtime::LoopThreadHooks {
- public:
-  void BeforeLoop() noexcept override { counter_.emplace(); }
-  void AfterLoop() noexcept override {
-    count = counter_->count();
-    counter_.reset();
-  }
-  std::uint64_t count = ~std::uint64_t{0};
-
- private:
-  std::optional<test::ScopedAllocationCount> counter_;
-};
+using test::LoopAllocations;
 
 struct TwinRig {
   explicit TwinRig(const std::string& log_path)
