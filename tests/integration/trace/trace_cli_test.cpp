@@ -113,12 +113,30 @@ TEST_F(TraceCli, AnalyzeReadsATraceRecordedByHandWithTheLttngCommand) {
   ASSERT_EQ(lttng({"create", session, "--output=" + out}).exit_code, 0);
   ASSERT_EQ(lttng({"enable-event", "--userspace", "--session=" + session, "hiltwin:*"}).exit_code,
             0);
+  // Only the run's own process: other suites run hiltwin meanwhile. The shell writes its pid,
+  // waits until it is tracked, then becomes `hiltwin run` (same pid).
+  const std::string pid_file = Path("run.pid");
+  auto run = hiltwin::test::Spawn(
+      {"sh", "-c",
+       "echo $$ > '" + pid_file + "'; while [ ! -e '" + pid_file +
+           ".go' ]; do sleep 0.05; done; "
+           "exec '" HILTWIN_BINARY "' run --duration 0.5 --clock virtual --no-progress --report '" +
+           Path("run.json") + "'"},
+      Path("run.out"));
+  std::string pid;
+  for (int i = 0; i < 200 && pid.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::ifstream(pid_file) >> pid;
+  }
+  ASSERT_FALSE(pid.empty());
+  ASSERT_EQ(lttng({"track", "--userspace", "--session=" + session, "--vpid=" + pid}).exit_code, 0);
   ASSERT_EQ(lttng({"start", session}).exit_code, 0);
-  const auto run = Hiltwin({"run", "--duration", "0.5", "--clock", "virtual", "--no-progress",
-                            "--report", Path("run.json")});
+  std::ofstream(pid_file + ".go") << "go\n";
+  const auto status = run.WaitFor(std::chrono::seconds(60));
   ASSERT_EQ(lttng({"stop", session}).exit_code, 0);
   ASSERT_EQ(lttng({"destroy", session}).exit_code, 0);
-  ASSERT_LE(run.exit_code, 3) << run.err;
+  ASSERT_TRUE(status.has_value());
+  ASSERT_TRUE(status->exited && status->code >= 0 && status->code <= 3) << status->Describe();
   const auto analysis = Hiltwin({"trace", "--analyze", out});
   ASSERT_EQ(analysis.exit_code, 0) << analysis.err;
   ExpectAgreement(ReadJson(Path("run.json")), ReadJson(out + "/jitter_report.json"));
