@@ -11,12 +11,18 @@ namespace hiltwin::analysis {
 
 const char* ToString(CauseClass cause) noexcept {
   switch (cause) {
-    case CauseClass::kPreempted: return "preempted";
-    case CauseClass::kInterrupt: return "interrupt";
-    case CauseClass::kPageFault: return "page_fault";
-    case CauseClass::kOwnCompute: return "own_compute";
-    case CauseClass::kInvisible: return "invisible";
-    case CauseClass::kNotRecorded: return "not_recorded";
+    case CauseClass::kPreempted:
+      return "preempted";
+    case CauseClass::kInterrupt:
+      return "interrupt";
+    case CauseClass::kPageFault:
+      return "page_fault";
+    case CauseClass::kOwnCompute:
+      return "own_compute";
+    case CauseClass::kInvisible:
+      return "invisible";
+    case CauseClass::kNotRecorded:
+      return "not_recorded";
   }
   return "unknown";
 }
@@ -50,9 +56,9 @@ void CountReleases(const TimingTrace& trace, JitterReport& r) {
     judged_releases += 1 + c.sample.releases_skipped;
   }
   r.misses = r.clusters.misses;
-  r.miss_pct = judged_releases == 0 ? 0.0
-                                    : static_cast<double>(r.misses) * 100.0 /
-                                          static_cast<double>(judged_releases);
+  r.miss_pct = judged_releases == 0
+                   ? 0.0
+                   : static_cast<double>(r.misses) * 100.0 / static_cast<double>(judged_releases);
 }
 
 // Every judged miss and every wake-up above the latency p99.9, in order of k.
@@ -61,8 +67,8 @@ std::vector<std::size_t> NotableIndices(const TimingTrace& trace, const detail::
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < trace.cycles.size(); ++i) {
     const TracedCycle& c = trace.cycles[i];
-    const bool late_wake = stats.latency_recorded[i] &&
-                           c.sample.wake_ns - c.sample.release_ns > latency_p999_ns;
+    const bool late_wake =
+        stats.latency_recorded[i] && c.sample.wake_ns - c.sample.release_ns > latency_p999_ns;
     if ((c.judged && c.sample.missed) || late_wake) out.push_back(i);
   }
   return out;
@@ -120,7 +126,8 @@ void TraceWarnings(const TimingTrace& trace, const detail::CycleStats& stats, Ji
   if (trace.other_processes > 0) {
     r.warnings.push_back("the trace holds " + std::to_string(trace.other_processes) +
                          " other hiltwin processes; only pid " + std::to_string(trace.pid) +
-                         " is analysed");
+                         " is analysed (choose another with `hiltwin trace --analyze DIR --pid "
+                         "N`)");
   }
 }
 
@@ -162,8 +169,8 @@ void AttributeCauses(const TimingTrace& trace, const KernelTrace* kernel,
   auto attribute = [&](std::size_t i, NotableCycle& n) {
     const TracedCycle& c = trace.cycles[i];
     // A cycle that is notable only for its wake-up (no miss) is explained up to the wake.
-    const bool wake_only = !(c.judged && c.sample.missed) &&
-                           n.response_ns <= r.response.summary.p999_ns;
+    const bool wake_only =
+        !(c.judged && c.sample.missed) && n.response_ns <= r.response.summary.p999_ns;
     n.cause = attributor.Attribute(WindowOf(c.sample, wake_only, r));
   };
   for (std::size_t j = 0; j < notable.size(); ++j) attribute(notable[j], r.notable[j]);
@@ -175,8 +182,9 @@ void AttributeCauses(const TimingTrace& trace, const KernelTrace* kernel,
 
 JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel) {
   if (trace.cycles.empty()) {
-    throw TraceReadError(trace.path + ": the trace holds no cycle of the loop (was the run "
-                                      "traced, and did it get past its start?)");
+    throw TraceReadError(trace.path +
+                         ": the trace holds no cycle of the loop (was the run "
+                         "traced, and did it get past its start?)");
   }
   JitterReport r;
   r.source = trace.source;

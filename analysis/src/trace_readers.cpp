@@ -17,12 +17,19 @@ const char* ToString(TraceSource source) noexcept {
   return "unknown";
 }
 
-TimingTrace ReadTrace(const std::string& path) {
+TimingTrace ReadTrace(const std::string& path, int pid) {
   namespace fs = std::filesystem;
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
-  if (fs::is_directory(status)) return ReadCtfTrace(path);
-  if (fs::is_regular_file(status)) return ReadTimingLog(path);
+  if (fs::is_directory(status)) return ReadCtfTrace(path, pid);
+  if (fs::is_regular_file(status)) {
+    if (pid > 0) {
+      throw TraceReadError(path +
+                           ": a timing log holds one process's cycles; a process id "
+                           "only chooses among the processes of an LTTng trace folder");
+    }
+    return ReadTimingLog(path);
+  }
   const std::string what = fs::exists(status) ? "is neither a folder nor a regular file"
                            : error && error != std::errc::no_such_file_or_directory
                                ? "cannot be examined: " + error.message()

@@ -14,8 +14,8 @@ namespace {
 void RefuseRunFlagsWithAnalyze(const CLI::App& app) {
   for (const CLI::Option* option : app.get_options()) {
     const std::string name = option->get_name();
-    if (option->count() == 0 || name == "--analyze" || name == "--output" || name == "--help" ||
-        name == "--log-level") {
+    if (option->count() == 0 || name == "--analyze" || name == "--output" || name == "--pid" ||
+        name == "--help" || name == "--log-level") {
       continue;
     }
     throw CommandError(ExitCode::kUsage,
@@ -50,8 +50,19 @@ Command AddTraceCommand(CLI::App& parent) {
                 "tracefs readable) and name the cause of every late cycle");
   app->add_option("--analyze", o->analyze_path,
                   "analyse this trace folder or timing log instead of running");
+  app->add_option("--pid", o->analyze_pid,
+                  "with --analyze: report on this process of a trace holding several (default: "
+                  "the first to start its loop)")
+      ->check(CLI::PositiveNumber);
   return {app, [o, app] {
-            if (o->analyze_path.empty()) return TraceTwin(*o);
+            if (o->analyze_path.empty()) {
+              if (o->analyze_pid != 0) {
+                throw CommandError(ExitCode::kUsage,
+                                   "--pid goes with --analyze: a recording made by trace keeps "
+                                   "only its own process");
+              }
+              return TraceTwin(*o);
+            }
             RefuseRunFlagsWithAnalyze(*app);
             return AnalyzeTrace(*o);
           }};

@@ -218,7 +218,7 @@ int AnalyzeTrace(const TraceOptions& o) {
   if (dir.empty()) dir = is_folder ? path : path + ".jitter";
   try {
     spdlog::info("reading {}", path);
-    const analysis::TimingTrace trace = analysis::ReadTrace(path);
+    const analysis::TimingTrace trace = analysis::ReadTrace(path, o.analyze_pid);
     std::optional<analysis::KernelTrace> kernel;
     if (is_folder && analysis::HasKernelTrace(path)) kernel = analysis::ReadKernelTrace(path);
     const analysis::JitterReport report = Analyze(trace, kernel ? &*kernel : nullptr);

@@ -241,6 +241,14 @@ TEST_F(TraceCli, BadInputExitsTwoNamingTheFileAndThePlace) {
   r = Hiltwin({"trace", "--analyze", Path("timing.csv"), "--rate", "1000"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--rate"), std::string::npos) << r.err;
+  // A process id chooses among a trace's processes: not for a timing log, not for a recording.
+  r = Hiltwin({"trace", "--analyze", Path("timing.csv"), "--pid", "42"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("timing log holds one process"), std::string::npos) << r.err;
+  r = Hiltwin({"trace", "--output", Path("new"), "--pid", "42", "--duration", "0.1"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--pid goes with --analyze"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(Path("new")));
 }
 
 TEST_F(TraceCli, ARecordingIntoAFolderThatHoldsFilesIsRefusedBeforeAnythingRuns) {

@@ -43,7 +43,7 @@ class TraceDispatchTest : public ::testing::Test {
 TEST_F(TraceDispatchTest, AFolderIsReadAsAnLttngTrace) {
   // Empty: the CTF reader's own refusal proves ReadTrace chose it.
   const std::string path = dir_.string();
-  EXPECT_EQ(ErrorOf(ReadTrace, path),
+  EXPECT_EQ(ErrorOf([](const std::string& p) { return ReadTrace(p); }, path),
             "no LTTng trace in " + path +
                 ": no CTF `metadata` file below it; record one with `hiltwin trace --output DIR` "
                 "or pass a timing log file");
@@ -73,7 +73,7 @@ TEST_F(TraceDispatchTest, AFileIsReadAsATimingLog) {
 
 TEST_F(TraceDispatchTest, AMissingPathSaysWhatIsAccepted) {
   const std::string path = (dir_ / "nowhere").string();
-  EXPECT_EQ(ErrorOf(ReadTrace, path),
+  EXPECT_EQ(ErrorOf([](const std::string& p) { return ReadTrace(p); }, path),
             path +
                 " does not exist; pass an LTTng trace folder (`hiltwin trace --output DIR`) "
                 "or a timing log file (`hiltwin run --timing-log FILE`)");

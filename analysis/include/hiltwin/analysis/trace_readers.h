@@ -22,6 +22,7 @@ namespace hiltwin::analysis {
 
 /// A folder: ReadCtfTrace; a file: ReadTimingLog; anything else: TraceReadError saying what
 /// `hiltwin trace --analyze` accepts.
-[[nodiscard]] TimingTrace ReadTrace(const std::string& path);
+/// `pid` > 0 picks that process of a trace folder (refused for a timing log).
+[[nodiscard]] TimingTrace ReadTrace(const std::string& path, int pid = 0);
 
 }  // namespace hiltwin::analysis

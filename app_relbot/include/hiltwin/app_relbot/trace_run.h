@@ -18,6 +18,7 @@ struct TraceOptions {
   std::string output_dir;    ///< where the trace and the report go
   bool kernel = false;       ///< also record the kernel's scheduler and interrupt events
   std::string analyze_path;  ///< set: analyse this trace folder or timing log, run nothing
+  int analyze_pid = 0;       ///< with analyze_path: the process of the trace to report on
 };
 
 /// Records, runs, analyses; returns the run's exit code (or 5 when the recording or its
