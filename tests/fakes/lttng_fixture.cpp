@@ -55,12 +55,17 @@ LttngFixture::~LttngFixture() {
   }
 }
 
-int LttngFixture::Run(const std::vector<std::string>& argv, int timeout_ms) {
+std::vector<std::string> LttngFixture::LoggedCommand(const std::vector<std::string>& argv) {
   std::vector<std::string> command = {"env", "LTTNG_HOME=" + home_.string()};
   command.insert(command.end(), argv.begin(), argv.end());
   log_ += "$";
   for (const std::string& word : argv) log_ += " " + word;
   log_ += "\n";
+  return command;
+}
+
+int LttngFixture::Run(const std::vector<std::string>& argv, int timeout_ms) {
+  const std::vector<std::string> command = LoggedCommand(argv);
   kernel_glue::ProcessOptions options;
   options.out = kernel_glue::OutputTarget::Capture();
   options.err = kernel_glue::OutputTarget::SameAsStdout();
@@ -166,11 +171,7 @@ bool LttngFixture::StartSession(const std::string& trace_dir, const SessionOptio
 
 pid_t LttngFixture::RunTraced(const std::vector<std::string>& argv) {
   // `env` execs the program, so the pid is the traced process's (its vpid in the trace).
-  std::vector<std::string> command = {"env", "LTTNG_HOME=" + home_.string()};
-  command.insert(command.end(), argv.begin(), argv.end());
-  log_ += "$";
-  for (const std::string& word : argv) log_ += " " + word;
-  log_ += "\n";
+  const std::vector<std::string> command = LoggedCommand(argv);
   kernel_glue::ProcessOptions options;
   options.out = kernel_glue::OutputTarget::Capture();
   options.err = kernel_glue::OutputTarget::SameAsStdout();

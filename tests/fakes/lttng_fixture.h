@@ -74,6 +74,8 @@ class LttngFixture {
  private:
   /// Runs argv under `env LTTNG_HOME=...`; output goes to the log.
   int Run(const std::vector<std::string>& argv, int timeout_ms);
+  /// `argv` under `env LTTNG_HOME=...` (env execs it: same pid), written to the command log.
+  std::vector<std::string> LoggedCommand(const std::vector<std::string>& argv);
   void StopOwnDaemon();
 
   std::filesystem::path home_;
