@@ -69,6 +69,7 @@ void StartCapture(const TraceOptions& o, Capture& capture) {
     lttng.output_dir = o.output_dir;
     lttng.rate_hz = o.run.session.rate_hz;
     lttng.only_pid = static_cast<int>(::getpid());
+    lttng.await_registration = true;  // a daemon started just now has not seen us yet
     capture.lttng.emplace(lttng);
     spdlog::info("recording LTTng session {} into {}", capture.lttng->session_name(), o.output_dir);
     if (o.kernel) {

@@ -78,6 +78,38 @@ class Handle {
   lttng_handle* handle_ = nullptr;
 };
 
+// Whether process `pid` has registered with the daemon: the daemon lists the tracepoints of
+// registered applications only, each with its pid.
+bool Registered(int pid) {
+  lttng_domain domain = UserSpace();
+  const std::unique_ptr<lttng_handle, decltype(&lttng_destroy_handle)> handle(
+      lttng_create_handle(nullptr, &domain), &lttng_destroy_handle);
+  if (!handle) throw CaptureError("LTTng: no handle for listing tracepoints");
+  lttng_event* events = nullptr;
+  const int count = Check(lttng_list_tracepoints(handle.get(), &events), "listing tracepoints");
+  const std::unique_ptr<lttng_event, decltype(&std::free)> owned(events, &std::free);
+  for (int i = 0; i < count; ++i) {
+    if (events[i].pid == pid) return true;
+  }
+  return false;
+}
+
+void AwaitRegistration(int pid, int timeout_ms) {
+  if (Registered(pid)) return;
+  spdlog::info("waiting for process {} to register with the LTTng session daemon", pid);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  while (!Registered(pid)) {
+    if (std::chrono::steady_clock::now() >= deadline) {
+      throw CaptureError("LTTng: process " + std::to_string(pid) +
+                         " did not register with the session daemon within " +
+                         std::to_string(timeout_ms) +
+                         " ms, so its events could not be recorded; is the daemon one it may "
+                         "reach (its own user's, or root's)?");
+    }
+    std::this_thread::sleep_for(kPollTick);
+  }
+}
+
 void CreateSession(const std::string& name, const std::string& output_dir) {
   // The daemon writes the trace, from its own working directory: give it an absolute path.
   const fs::path dir = fs::absolute(output_dir);
@@ -214,6 +246,9 @@ LttngSession::LttngSession(const LttngSessionConfig& config)
   const LttngChannelSize size = ChannelSizeFor(config.rate_hz);
   figures_.subbuf_bytes = size.subbuf_bytes;
   figures_.subbuf_count = size.subbuf_count;
+  if (config.only_pid > 0 && config.await_registration) {
+    AwaitRegistration(config.only_pid, config.registration_timeout_ms);
+  }
   CreateSession(name_, config.output_dir);
   try {
     const Handle handle(name_);

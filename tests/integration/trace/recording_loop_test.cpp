@@ -61,7 +61,8 @@ TEST(RecordingLoop, AllocatesNothingAndEveryEventIsInTheTrace) {
   try {
     // Sized for 100 kHz: a virtual-clock run fires its events far faster than real time.
     recording.emplace(trace_capture::LttngSessionConfig{
-        .output_dir = dir.string(), .rate_hz = 100'000.0, .only_pid = static_cast<int>(getpid())});
+        .output_dir = dir.string(), .rate_hz = 100'000.0, .only_pid = static_cast<int>(getpid()),
+        .await_registration = true});
   } catch (const trace_capture::CaptureError& e) {
     GTEST_SKIP() << e.what();
   }

@@ -151,6 +151,56 @@ TEST_F(LttngSessionTest, ASessionForOneProcessRecordsNoOtherProcess) {
   ExpectDaemonHandledRightly(daemon_pid);
 }
 
+// The race `hiltwin trace` has with itself: its process runs before the daemon it starts, so
+// LTTng-UST registers late (a retry 5 s on, at worst). Awaiting registration must record the
+// process from its first event. (With a daemon already running, registration is immediate and
+// this checks only that awaiting it costs nothing.)
+TEST_F(LttngSessionTest, AProcessRunningBeforeTheDaemonIsRecordedFromItsFirstEvent) {
+  const fs::path go = base_ / "go";
+  fs::create_directories(base_);
+  ProcessOptions options;
+  options.out = OutputTarget::Discard();
+  Process emitter =
+      Process::Start({HILTWIN_TRACE_EMITTER, std::to_string(kCycles), go.string()}, options);
+  const int emitter_pid = emitter.pid();  // pid() is -1 once reaped
+  int daemon_pid = 0;
+  {
+    LttngSessionConfig config = Config("early");
+    config.only_pid = emitter_pid;
+    config.await_registration = true;
+    LttngSession session(config);
+    daemon_pid = session.daemon_pid();
+    std::ofstream(go) << "go\n";
+    const auto status = emitter.WaitFor(std::chrono::seconds(30));
+    ASSERT_TRUE(status && status->Success()) << (status ? status->Describe() : "still running");
+    EXPECT_EQ(session.Stop().discarded_events, 0U);
+    EXPECT_EQ(CyclesOf(base_ / "early", emitter_pid), kCycles);
+  }
+  ExpectDaemonHandledRightly(daemon_pid);
+}
+
+TEST_F(LttngSessionTest, AwaitingAProcessThatNeverRegistersSaysSoInsteadOfRecordingNothing) {
+  ProcessOptions options;
+  options.out = OutputTarget::Discard();
+  Process sleeper = Process::Start({"sleep", "30"}, options);  // no LTTng-UST in it
+  LttngSessionConfig config = Config("never");
+  config.only_pid = sleeper.pid();
+  config.await_registration = true;
+  config.registration_timeout_ms = 300;
+  try {
+    LttngSession session(config);
+    ADD_FAILURE() << "no CaptureError";
+  } catch (const CaptureError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("process " + std::to_string(sleeper.pid()) +
+                                        " did not register with the session daemon within 300 ms"));
+  }
+  sleeper.Kill(SIGKILL);
+  // A daemon started for the refused session went with it.
+  if (!daemon_was_alive_) {
+    EXPECT_NE(lttng_session_daemon_alive(), 1);
+  }
+}
+
 TEST_F(LttngSessionTest, ASecondSessionKeepsTheDaemonWhileTheFirstEnds) {
   int daemon_pid = 0;
   {

@@ -1,5 +1,6 @@
 // Emits a known sequence of every hiltwin tracepoint, for the live-session tests and the CTF
-// reader's known-answer tests: `<exe> COUNT`.
+// reader's known-answer tests: `<exe> COUNT [GO_FILE]`. With GO_FILE it waits until that file
+// exists before the first event: a process already running when the session daemon starts.
 //   loop_start {tid = gettid, cpu = 0, policy = 1, priority = 80, period_ns = 1000,
 //               deadline_ns = 1000, planned_cycles = COUNT, rules = 1}
 //   qos_rule   {rule = 0, kind = 0 (mk_firm), m = 3, k = 4, n = 0, max_miss_ppm = 0}
@@ -13,14 +14,20 @@
 //   loop_end {cycles_run = COUNT, releases = COUNT}
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
+#include <thread>
 
 #include "hiltwin/tracing/trace.h"
 
 int main(int argc, char** argv) {
-  if (argc != 2) return 2;
+  if (argc != 2 && argc != 3) return 2;
   const auto count = static_cast<std::uint64_t>(std::strtoull(argv[1], nullptr, 10));
+  while (argc == 3 && !std::filesystem::exists(argv[2])) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   HILTWIN_TRACE(loop_start, static_cast<std::int32_t>(::gettid()), 0, 1, 80, std::int64_t{1000},
                 std::int64_t{1000}, count, std::uint32_t{1});
   HILTWIN_TRACE(qos_rule, std::uint32_t{0}, std::uint8_t{0}, std::uint32_t{3}, std::uint32_t{4},

@@ -19,6 +19,13 @@ struct LttngSessionConfig {
   /// Record only this process's events (0: every process of the user). `hiltwin trace` passes
   /// its own pid, so other hiltwin processes running meanwhile stay out of its trace.
   int only_pid = 0;
+  /// With only_pid: wait (up to registration_timeout_ms) until that process has registered
+  /// with the daemon before recording. A process that was running before the daemon started
+  /// registers late (LTTng-UST retries after 5 s), and the events it fires meanwhile are lost:
+  /// `hiltwin trace` traces itself, so it waits. The process must link LTTng-UST.
+  bool await_registration = false;
+  /// LTTng-UST's 5 s retry, with margin.
+  int registration_timeout_ms = 12'000;
 };
 
 /// What the tracer says about the channel after the run.
