@@ -166,18 +166,39 @@ bool LttngFixture::StartSession(const std::string& trace_dir, const SessionOptio
     context.insert(context.end(), channel.begin(), channel.end());
     if (Lttng(context) != 0) return false;
   }
+  only_traced_ = options.only_traced;
+  // `untrack --all` leaves the inclusion set empty: nothing is recorded until RunTraced adds a pid.
+  if (only_traced_ &&
+      Lttng({"untrack", "--userspace", "--session=" + session_, "--vpid", "--all"}) != 0) {
+    return false;
+  }
   return Lttng({"start", session_}) == 0;
 }
 
 pid_t LttngFixture::RunTraced(const std::vector<std::string>& argv) {
-  // `env` execs the program, so the pid is the traced process's (its vpid in the trace).
-  const std::vector<std::string> command = LoggedCommand(argv);
+  // `env` (and the holding shell) exec the program, so the pid is the traced process's (its
+  // vpid in the trace).
+  std::vector<std::string> command = LoggedCommand(argv);
+  const fs::path go = home_ / ("go_" + std::to_string(++traced_count_));
+  if (only_traced_) {
+    // The shell waits for the go file, then becomes the command; its words stay arguments
+    // ("$@"), never shell text.
+    command.insert(command.begin(), {"sh", "-c",
+                                     "while [ ! -e \"$0\" ]; do sleep 0.01; done; exec \"$@\"",
+                                     go.string()});
+  }
   kernel_glue::ProcessOptions options;
   options.out = kernel_glue::OutputTarget::Capture();
   options.err = kernel_glue::OutputTarget::SameAsStdout();
   try {
     kernel_glue::Process process = kernel_glue::Process::Start(command, options);
     const pid_t pid = process.pid();
+    if (only_traced_) {
+      const bool tracked = Lttng({"track", "--userspace", "--session=" + session_,
+                                  "--vpid=" + std::to_string(pid)}) == 0;
+      std::ofstream(go) << "go\n";
+      if (!tracked) return -1;  // `process` kills its child as it goes
+    }
     const std::optional<kernel_glue::ExitStatus> status =
         process.WaitFor(std::chrono::milliseconds(kTracedTimeoutMs));
     log_ += process.out();

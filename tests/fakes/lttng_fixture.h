@@ -38,13 +38,17 @@ class LttngFixture {
     /// enable-channel), e.g. so small that a fast emitter overruns it and events are dropped.
     std::uint64_t subbuf_bytes = 0;
     std::uint32_t subbuffers = 2;
+    /// Record only the processes RunTraced starts (the session's vpid tracker holds exactly
+    /// them): other suites run hiltwin meanwhile, and their events must not mix in.
+    bool only_traced = true;
   };
 
   /// Creates the session writing to `trace_dir`, enables the events (in their own channel if
   /// asked), adds the vpid context if asked, and starts recording.
   [[nodiscard]] bool StartSession(const std::string& trace_dir, const SessionOptions& options);
   /// Runs `argv` to its end while the session records; its pid, or -1 when it did not start,
-  /// failed or timed out (the log says which).
+  /// failed or timed out (the log says which). With `only_traced` the process is held back
+  /// until the session tracks its pid, so it is recorded from its first event.
   pid_t RunTraced(const std::vector<std::string>& argv);
   /// Stops recording: the trace on disk is then complete and readable.
   [[nodiscard]] bool StopSession();
@@ -82,6 +86,8 @@ class LttngFixture {
   std::string session_;
   std::string log_;
   bool session_created_ = false;
+  bool only_traced_ = false;  // of the session started last
+  int traced_count_ = 0;      // names each RunTraced's go file
   pid_t own_daemon_pid_ = -1;
 };
 
