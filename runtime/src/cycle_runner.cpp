@@ -24,6 +24,7 @@ CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
       task_log_columns_(config.task_log_columns),
       period_ns_(config.period_ns),
       deadline_ns_(config.deadline_ns),
+      virtual_compute_ns_(config.virtual_compute_ns),
       violations_seen_(monitor.rules().size(), 0) {}
 
 scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
@@ -63,6 +64,9 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   if (extra_ns > 0) {
     HILTWIN_TRACE(overrun_injected, context.cycle, extra_ns);
     clock_.SpendNs(extra_ns);
+  }
+  if (!virtual_compute_ns_.empty()) {
+    clock_.SpendNs(virtual_compute_ns_[context.cycle % virtual_compute_ns_.size()]);
   }
   if (step_status_.code == StepStatus::Code::kModelFault) {
     NoteFault(StopReason::kModelFault, context.cycle, step_status_.reason);

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "hiltwin/kernel_glue/clock.h"
@@ -53,6 +54,8 @@ struct CycleRunnerConfig {
   std::size_t task_log_columns = 0;
   kernel_glue::TimeNs period_ns = 0;
   kernel_glue::TimeNs deadline_ns = 0;
+  /// Virtual clock: compute time charged to cycle k, table[k % size] (virtual_costs.h).
+  std::span<const kernel_glue::TimeNs> virtual_compute_ns;
 };
 
 class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleObserver {
@@ -100,6 +103,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   std::size_t task_log_columns_;
   kernel_glue::TimeNs period_ns_;
   kernel_glue::TimeNs deadline_ns_;
+  std::span<const kernel_glue::TimeNs> virtual_compute_ns_;
   std::array<double, tracing::kMaxLogColumns> row_{};
   std::vector<std::uint64_t> violations_seen_;  ///< per rule, as last traced
   kernel_glue::TimeNs timing_base_ns_ = 0;       ///< release 0's time, for the timing log

@@ -13,6 +13,7 @@
 
 #include <cmath>
 
+#include "costed_virtual_clock.h"
 #include "cycle_runner.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "hiltwin/tracing/trace.h"
@@ -24,9 +25,30 @@
 namespace hiltwin::runtime {
 namespace {
 
-std::unique_ptr<kernel_glue::Clock> MakeClock(ClockKind kind) {
-  if (kind == ClockKind::kVirtual) return std::make_unique<kernel_glue::VirtualClock>();
-  return std::make_unique<kernel_glue::MonotonicClock>();
+std::unique_ptr<kernel_glue::Clock> MakeClock(const SessionConfig& config) {
+  if (config.clock == ClockKind::kRealtime) return std::make_unique<kernel_glue::MonotonicClock>();
+  if (config.virtual_costs.wake_latency_ns.empty()) {
+    return std::make_unique<kernel_glue::VirtualClock>();
+  }
+  return std::make_unique<CostedVirtualClock>(config.virtual_costs.wake_latency_ns);
+}
+
+void CheckVirtualCosts(const SessionConfig& config) {
+  if (config.virtual_costs.empty()) return;
+  if (config.clock != ClockKind::kVirtual) {
+    // On the real clock the machine charges its own costs; replaying a table on top of them
+    // would count every cost twice.
+    throw std::invalid_argument("virtual cycle costs apply to the virtual clock only");
+  }
+  const auto negative = [](const std::vector<kernel_glue::TimeNs>& table) {
+    for (const kernel_glue::TimeNs ns : table) {
+      if (ns < 0) return true;
+    }
+    return false;
+  };
+  if (negative(config.virtual_costs.wake_latency_ns) || negative(config.virtual_costs.compute_ns)) {
+    throw std::invalid_argument("a virtual cycle cost is negative; costs are durations >= 0 ns");
+  }
 }
 
 std::unique_ptr<tracing::CsvLogger> MakeLogger(const SessionConfig& config, const RunTask& task,
@@ -119,6 +141,7 @@ void CheckConfig(const SessionConfig& config) {
                                 ")");
   }
   config.injector.CheckFiresWithin(planned);
+  CheckVirtualCosts(config);
   if (config.peer && (config.peer->link == nullptr || !(config.peer->timeout_s >= 0.0))) {
     throw std::invalid_argument("waiting for the peer needs a link and a timeout of 0 s or more");
   }
@@ -146,7 +169,7 @@ struct RunSession::LoopResult {
 RunSession::RunSession(SessionConfig config, RunTask& task)
     : config_((CheckConfig(config), std::move(config))),  // checked before anything is built
       task_(task),
-      clock_(MakeClock(config_.clock)),
+      clock_(MakeClock(config_)),
       monitor_(config_.qos),
       executive_(*clock_, config_.executive),
       allowed_cpus_(kernel_glue::AllowedCpus()) {
@@ -166,6 +189,7 @@ RunSession::RunSession(SessionConfig config, RunTask& task)
   runner.task_log_columns = task_.LogColumns().size();
   runner.period_ns = executive_.config().period_ns;
   runner.deadline_ns = executive_.deadline_ns();
+  runner.virtual_compute_ns = config_.virtual_costs.compute_ns;
   runner_ = std::make_unique<CycleRunner>(task_, *clock_, lifecycle_, monitor_, config_.injector,
                                           runner);
   executive_.AddObserver(*runner_);

@@ -111,7 +111,7 @@ StopCause Executive::Run(CyclicTask& task) noexcept {
     sample.wake_ns = clock_.NowNs();
     sample.start_ns = clock_.NowNs();
     const CycleContext context{k, sample.release_ns, period_ns,
-                               static_cast<TimeNs>(k) * period_ns};
+                               static_cast<TimeNs>(k) * period_ns, sample.start_ns};
     const CycleAction task_action = task.Step(context);
     sample.end_ns = clock_.NowNs();
     sample.io_ns = task.IoNsOfLastStep();

@@ -287,6 +287,42 @@ TEST(RunSession, RefusesAConfigurationThatCouldNotJudgeOrInjectAnything) {
   EXPECT_THROW(RunSession(std::move(late), task), std::invalid_argument);
 }
 
+TEST(RunSessionVirtualCosts, ComputeCostsChargeEveryStepAndMissWhereTheyPassTheDeadline) {
+  ScriptedTask task;
+  SessionConfig config = VirtualConfig(1000);  // 1 kHz: deadline = period = 1 ms
+  config.virtual_costs.compute_ns = {900'000, 1'100'000};
+  const RunReport r = RunScripted(task, std::move(config));
+  // Odd cycles end 0.1 ms past their deadline; the even cycle after each starts late but
+  // ends exactly on its own (end == deadline is met).
+  EXPECT_EQ(r.misses.deadline_misses, 500U);
+  EXPECT_EQ(r.compute.max_ns, 1'100'000);
+  EXPECT_EQ(r.compute.min_ns, 900'000);
+  EXPECT_EQ(r.verdict, qos::Verdict::kFlagged);
+}
+
+TEST(RunSessionVirtualCosts, WakeLatencyDelaysOnlySleepsThatWait) {
+  ScriptedTask task;
+  SessionConfig config = VirtualConfig(1000);
+  config.virtual_costs.wake_latency_ns = {0, 0, 0, 1'200'000};
+  const RunReport r = RunScripted(task, std::move(config));
+  // Every 4th sleep wakes 1.2 ms late (a miss); the next release has passed by then, so that
+  // cycle runs without sleeping and draws no latency: misses at cycles 3, 8, 13, ...
+  EXPECT_EQ(r.misses.deadline_misses, 200U);
+  EXPECT_EQ(r.latency.count, 800U);  // latency counts only cycles that slept
+  EXPECT_EQ(r.latency.max_ns, 1'200'000);
+}
+
+TEST(RunSessionVirtualCosts, AreRefusedOnTheRealClockAndWhenNegative) {
+  ScriptedTask task;
+  SessionConfig real = VirtualConfig(100);
+  real.clock = ClockKind::kRealtime;
+  real.virtual_costs.compute_ns = {1000};
+  EXPECT_THROW(RunSession(std::move(real), task), std::invalid_argument);
+  SessionConfig negative = VirtualConfig(100);
+  negative.virtual_costs.wake_latency_ns = {5, -1};
+  EXPECT_THROW(RunSession(std::move(negative), task), std::invalid_argument);
+}
+
 TEST(RunSession, TheLogHasTheTaskColumnsThenTheTimingColumns) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("hiltwin_session_log_" + std::to_string(getpid()) + ".csv"))

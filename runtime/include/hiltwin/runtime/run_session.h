@@ -26,6 +26,7 @@
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_report.h"
 #include "hiltwin/runtime/run_task.h"
+#include "hiltwin/runtime/virtual_costs.h"
 #include "hiltwin/scheduler/executive.h"
 #include "hiltwin/statemachine/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
@@ -62,6 +63,9 @@ struct SessionConfig {
   qos::QosConfig qos;
   kernel_glue::RtSetupRequest rt;  ///< applied to the loop thread (realtime clock only)
   OverrunInjector injector;
+  /// Virtual clock only: the wake-up latency and compute time every cycle is charged
+  /// (virtual_costs.h). Empty: the virtual loop takes no time.
+  VirtualCycleCosts virtual_costs;
   std::optional<LogConfig> log;
   /// Every cycle's time stamps, through a second RT-safe logger (tracing/timing_log_format.h):
   /// the trace for users who may not use LTTng. Empty: none.

@@ -30,6 +30,7 @@ struct CycleContext {
   TimeNs release_ns = 0;     ///< absolute release time
   TimeNs period_ns = 0;
   TimeNs model_time_ns = 0;  ///< k·period: the model time this step integrates to from
+  TimeNs start_ns = 0;       ///< when this step began (the board exchange follows at once)
 };
 
 /// The user's cyclic work: I/O, model step, I/O. Runs on the real-time thread, so it must
