@@ -14,6 +14,7 @@
 #include "hiltwin/app_relbot/input_profile.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/app_relbot/twin_build.h"
 #include "hiltwin/app_relbot/twin_task.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/kernel_glue/clock.h"
@@ -34,60 +35,6 @@ void Validate(const TwinRunOptions& o) {
     Usage("--input-rate: the controller rate must be positive and not above --rate (" +
           Num(o.session.rate_hz) + " Hz)");
   }
-}
-
-/// The RELbot twin behind its FPGA link, built from the flags; owns everything the task uses.
-struct Twin {
-  RelbotParams params = DefaultRelbotParams();
-  Integrator integrator = Integrator::kRk4;
-  std::optional<InputProfile> profile;
-  std::unique_ptr<io::IoBackend> backend;
-  std::unique_ptr<ProfilePwmSource> pwm_source;
-  std::unique_ptr<io::IcoBoardInverse> driver;
-  std::optional<RelbotModel> model;
-  io::WheelGeometry geometry;
-  std::optional<TwinTask> task;
-  std::string input_name;
-};
-
-void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin) {
-  try {
-    if (!o.config_path.empty()) twin.params = LoadRelbotParams(o.config_path);
-    twin.integrator = ParseIntegrator(o.integrator);
-    twin.profile.emplace(LoadInputProfile(o.input));
-  } catch (const ConfigError& e) {
-    Usage(e.what());
-  } catch (const ProfileError& e) {
-    Usage(e.what());
-  } catch (const std::invalid_argument& e) {
-    Usage(e.what());
-  }
-}
-
-/// Builds the model (a rate it cannot integrate stably is refused here, exit 2), opens the
-/// link and checks the board's identity (exit 2 / 5), then builds the task.
-std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs period_ns) {
-  auto twin = std::make_unique<Twin>();
-  LoadTwinConfiguration(o, *twin);
-  try {
-    twin->model.emplace(twin->params, twin->integrator, static_cast<double>(period_ns) * 1e-9);
-  } catch (const ConfigError& e) {
-    Usage("--rate " + Num(o.session.rate_hz) + ": " + e.what());
-  }
-  twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
-  twin->pwm_source = std::make_unique<ProfilePwmSource>(*twin->profile, o.controller_rate_hz);
-  // Only the mock board plays the profile; on a wire or real SPI the controller drives the PWM.
-  const bool profile_drives = twin->backend->kind() == io::BackendSpec::Kind::kMock;
-  if (io::EmulatedFpga* board = twin->backend->emulated_board();
-      board != nullptr && profile_drives) {
-    board->SetPwmSource(twin->pwm_source.get());
-  }
-  twin->input_name = profile_drives ? twin->profile->name() : "the controller on " + o.session.io;
-  twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
-  InitBoard(*twin->driver, period_ns);
-  twin->geometry = WheelGeometryOf(twin->params);
-  twin->task.emplace(*twin->driver, *twin->model, twin->geometry);
-  return twin;
 }
 
 void PrintStartLines(const char* command, const SessionOptions& o, std::uint64_t planned,

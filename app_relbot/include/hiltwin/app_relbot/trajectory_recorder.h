@@ -1,0 +1,46 @@
+#pragma once
+/// The twin as its controller sees it: a RunTask that forwards every call to a TwinTask and
+/// records, for each stepped cycle, when its board exchange happened and the wheel positions
+/// its step computed. `hiltwin tune` turns the record into the RMS error the controller sees
+/// (analysis::ControllerViewRmsError). The storage is reserved up front: on the loop thread
+/// the recorder only writes into it, and stops recording (never allocates) once it is full.
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/app_relbot/twin_task.h"
+#include "hiltwin/runtime/run_task.h"
+
+namespace hiltwin::app {
+
+class TrajectoryRecorder final : public runtime::RunTask {
+ public:
+  /// `twin` is not owned and must outlive the recorder; room for `capacity_cycles` cycles.
+  TrajectoryRecorder(TwinTask& twin, kernel_glue::TimeNs period_ns, std::size_t capacity_cycles);
+
+  io::ExchangeStatus Exchange(bool live_outputs) noexcept override {
+    return twin_.Exchange(live_outputs);
+  }
+  runtime::StepStatus Step(const scheduler::CycleContext& context) noexcept override;
+  [[nodiscard]] std::vector<std::string> LogColumns() const override {
+    return twin_.LogColumns();
+  }
+  [[nodiscard]] double LogTimeS() const noexcept override { return twin_.LogTimeS(); }
+  void FillLogRow(std::span<double> values) const noexcept override { twin_.FillLogRow(values); }
+
+  /// The record so far (read after the run).
+  [[nodiscard]] const analysis::TwinTrajectory& trajectory() const noexcept { return record_; }
+  /// Cycles that did not fit (0 unless the run outlasted the capacity).
+  [[nodiscard]] std::size_t cycles_not_recorded() const noexcept { return not_recorded_; }
+
+ private:
+  TwinTask& twin_;
+  analysis::TwinTrajectory record_;
+  std::size_t capacity_;
+  std::size_t not_recorded_ = 0;
+};
+
+}  // namespace hiltwin::app

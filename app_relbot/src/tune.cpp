@@ -1,0 +1,289 @@
+// `hiltwin tune` (tune.h): measure, recommend, validate. The maths is analysis/tuning.h's;
+// this file measures and runs, always through the shared run assembly and the twin of
+// `hiltwin run` (twin_build.h).
+#include "hiltwin/app_relbot/tune.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <utility>
+
+#include "hiltwin/app_relbot/command.h"
+#include "hiltwin/app_relbot/relbot_reference.h"
+#include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/app_relbot/trajectory_recorder.h"
+#include "hiltwin/app_relbot/twin_build.h"
+#include "hiltwin/scheduler/executive.h"
+#include "tune_measure.h"
+
+namespace hiltwin::app {
+namespace {
+
+[[noreturn]] void Usage(const std::string& message) {
+  throw CommandError(ExitCode::kUsage, message);
+}
+
+bool IsVirtual(const TuneOptions& o) { return o.clock == "virtual"; }
+
+bool AllInjected(const TuneOptions& o) {
+  return o.inject_compute_us && o.inject_overhead_us && o.inject_latency_us;
+}
+
+kernel_glue::TimeNs NsOfUs(double us) { return static_cast<kernel_glue::TimeNs>(std::llround(us * 1e3)); }
+
+void CheckInjection(const std::optional<double>& us, const char* flag, const TuneOptions& o) {
+  if (!us) return;
+  if (!IsVirtual(o)) {
+    Usage(std::string(flag) + ": injected costs replace measurements on the virtual clock only; "
+          "add --clock virtual, or drop it to measure this machine");
+  }
+  if (!std::isfinite(*us) || *us < 0.0 || *us > 1e6) {
+    Usage(std::string(flag) + " " + Num(*us) + ": must be 0 .. 1000000 microseconds");
+  }
+}
+
+/// Refuses, before anything is measured, a lowest candidate the model cannot integrate
+/// stably (the run would refuse it only after minutes of measuring).
+void CheckModelRunsAt(const TuneOptions& o, double rate_hz) {
+  Twin twin;
+  LoadTwinConfiguration(TwinOptionsFor(o, rate_hz, o.validate_seconds, true), twin);
+  const double max_step_s = RelbotMaxStableStepS(twin.params, twin.integrator);
+  if (1.0 / rate_hz > max_step_s) {
+    Usage("--candidates: " + Num(rate_hz) + " Hz is too slow for the " +
+          std::string(IntegratorName(twin.integrator)) + " integrator to run this model stably " +
+          "(it needs at least " + Num(std::ceil(1.0 / max_step_s)) +
+          " Hz); drop it or choose another --integrator");
+  }
+}
+
+/// The cost tables a virtual validation run replays: each step costs a measured (or the
+/// injected) compute time plus the loop overhead; each sleep wakes after the injected latency.
+runtime::VirtualCycleCosts VirtualCostsOf(const TuneOptions& o, const StepCost& step,
+                                          double overhead_ns) {
+  runtime::VirtualCycleCosts costs;
+  const auto overhead = static_cast<kernel_glue::TimeNs>(std::llround(overhead_ns));
+  if (o.inject_compute_us) {
+    costs.compute_ns = {NsOfUs(*o.inject_compute_us) + overhead};
+  } else {
+    costs.compute_ns.reserve(step.samples_ns.size());
+    for (const kernel_glue::TimeNs ns : step.samples_ns) costs.compute_ns.push_back(ns + overhead);
+  }
+  if (o.inject_latency_us && *o.inject_latency_us > 0.0) {
+    costs.wake_latency_ns = {NsOfUs(*o.inject_latency_us)};
+  }
+  return costs;
+}
+
+/// Reference positions at every controller sample instant of the validation window.
+analysis::ReferenceSamples MakeReference(const TuneOptions& o) {
+  Twin twin;
+  LoadTwinConfiguration(TwinOptionsFor(o, o.controller_rate_hz, o.validate_seconds, true), twin);
+  const double controller_period_s = 1.0 / o.controller_rate_hz;
+  ReferenceOptions reference;
+  reference.input_hold_s = controller_period_s;
+  const std::vector<RelbotOutputs> outputs = SimulateReference(
+      twin.params, *twin.profile, o.validate_seconds, controller_period_s, reference);
+  analysis::ReferenceSamples samples;
+  samples.controller_period_s = controller_period_s;
+  for (const RelbotOutputs& out : outputs) {
+    samples.wheel_left_m.push_back(out.wheel_left_m);
+    samples.wheel_right_m.push_back(out.wheel_right_m);
+  }
+  return samples;
+}
+
+/// Runs the procedure's steps in order and reports each to the progress callback.
+class TuneProcedure {
+ public:
+  TuneProcedure(const TuneOptions& o, const TuneProgress& progress)
+      : o_(o), progress_(progress) {
+    policy_.controller_rate_hz = o.controller_rate_hz;
+    policy_.tolerance_m = o.tolerance_m;
+    policy_.max_rate_hz = scheduler::kMaxRateHz;
+    const double multiples = std::floor(policy_.max_rate_hz / o.controller_rate_hz);
+    const double accuracy_steps = std::ceil(std::log2(std::max(multiples, 1.0))) + 1.0;
+    steps_total_ = 3.0 + static_cast<double>(o.candidates_hz.size()) * 2.0 + 1.0 + accuracy_steps;
+  }
+
+  analysis::TuneReport Run() {
+    analysis::TuneReport report;
+    report.clock = o_.clock;
+    report.validate_seconds = o_.validate_seconds;
+    report.policy = policy_;
+    Measure(report);
+    Next("searching the accuracy bound (virtual runs against the reference)");
+    reference_ = MakeReference(o_);
+    report.input = reference_input_;
+    report.accuracy = analysis::AccuracyBound(
+        [this](double rate_hz) {
+          Next("accuracy at " + Num(rate_hz) + " Hz");
+          // A rate the integrator cannot run stably is no bound; the search goes higher.
+          if (1.0 / rate_hz > max_stable_step_s_) return std::numeric_limits<double>::infinity();
+          return RunRecorded(rate_hz, true, {}).rms_error_m;
+        },
+        policy_);
+    report.recommendation =
+        analysis::Recommend(report.measured, report.accuracy.bound_hz, policy_);
+    Validate(report);
+    report.validation = analysis::SummariseValidation(report.candidates);
+    return report;
+  }
+
+ private:
+  void Next(const std::string& what) {
+    progress_(std::min(steps_done_ / steps_total_, 1.0), what);
+    steps_done_ += 1.0;
+  }
+
+  void Measure(analysis::TuneReport& report);
+  void Validate(analysis::TuneReport& report);
+  analysis::CandidateResult RunRecorded(double rate_hz, bool virtual_clock,
+                                        runtime::VirtualCycleCosts costs);
+
+  const TuneOptions& o_;
+  const TuneProgress& progress_;
+  analysis::TuningPolicy policy_;
+  analysis::ReferenceSamples reference_;
+  std::string reference_input_;
+  double max_stable_step_s_ = 0.0;
+  StepCost step_;
+  double steps_total_ = 1.0;
+  double steps_done_ = 0.0;
+};
+
+void TuneProcedure::Measure(analysis::TuneReport& report) {
+  analysis::TimingMeasurements& m = report.measured;
+  m.injected = AllInjected(o_);
+  if (!m.injected) {
+    Next("checking this machine (doctor)");
+    report.machine_warnings = MachineWarnings();
+  }
+  Next("timing the model step");
+  step_ = o_.inject_compute_us ? InjectedStepCost(NsOfUs(*o_.inject_compute_us))
+                               : MeasureStepCost(TwinOptionsFor(o_, o_.candidates_hz.back(), 1.0, true));
+  m.step_compute = step_.summary;
+  Next("timing the loop's own work per cycle");
+  m.loop_overhead_ns = o_.inject_overhead_us
+                           ? static_cast<double>(NsOfUs(*o_.inject_overhead_us))
+                           : MeasureLoopOverheadNs(TwinOptionsFor(o_, 4000.0, 1.0, true),
+                                                   step_.summary.mean_ns);
+  for (const double rate_hz : o_.candidates_hz) {
+    Next("wake-up latency at " + Num(rate_hz) + " Hz");
+    if (IsVirtual(o_)) {
+      m.wake_latency.push_back({rate_hz, ConstantSummary(NsOfUs(o_.inject_latency_us.value_or(0.0)))});
+    } else {
+      m.wake_latency.push_back({rate_hz, MeasureWakeLatency(TwinOptionsFor(o_, rate_hz, o_.latency_seconds, false))});
+    }
+  }
+  Twin twin;
+  LoadTwinConfiguration(TwinOptionsFor(o_, o_.controller_rate_hz, 1.0, true), twin);
+  report.model = "RELbot twin, " + std::string(IntegratorName(twin.integrator));
+  reference_input_ = twin.profile->name();
+  max_stable_step_s_ = RelbotMaxStableStepS(twin.params, twin.integrator);
+}
+
+void TuneProcedure::Validate(analysis::TuneReport& report) {
+  std::vector<double> rates = o_.candidates_hz;
+  const double recommended = report.recommendation.recommended_hz;
+  // A recommendation capped below the controller rate (a machine too slow for this twin) is
+  // reported with its warning but cannot run: the twin must answer every controller sample.
+  if (recommended >= o_.controller_rate_hz &&
+      std::find(rates.begin(), rates.end(), recommended) == rates.end()) {
+    rates.push_back(recommended);
+  }
+  std::sort(rates.begin(), rates.end());
+  const runtime::VirtualCycleCosts costs =
+      IsVirtual(o_) ? VirtualCostsOf(o_, step_, report.measured.loop_overhead_ns)
+                    : runtime::VirtualCycleCosts{};
+  for (const double rate_hz : rates) {
+    Next("validating " + Num(rate_hz) + " Hz for " + Num(o_.validate_seconds) + " s");
+    analysis::CandidateResult result = RunRecorded(rate_hz, IsVirtual(o_), costs);
+    result.recommended = rate_hz == recommended;
+    report.candidates.push_back(std::move(result));
+  }
+  progress_(1.0, "done");
+}
+
+analysis::CandidateResult TuneProcedure::RunRecorded(double rate_hz, bool virtual_clock,
+                                                     runtime::VirtualCycleCosts costs) {
+  const TwinRunOptions t = TwinOptionsFor(o_, rate_hz, o_.validate_seconds, virtual_clock);
+  const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(rate_hz);
+  const std::unique_ptr<Twin> twin = BuildTwin(t, period_ns);
+  runtime::SessionConfig config = MakeSessionConfig(t.session, TuneRole(o_.controller_rate_hz), *twin->backend);
+  config.task_name = "RELbot twin";
+  config.virtual_costs = std::move(costs);
+  TrajectoryRecorder recorder(*twin->task, period_ns, PlannedCycles(t.session));
+  const runtime::RunReport run = RunSessionOf(std::move(config), recorder);
+  analysis::CandidateResult result;
+  result.rate_hz = rate_hz;
+  result.releases = run.misses.cycles_judged;
+  result.deadline_misses = run.misses.misses_judged;
+  result.miss_pct = run.misses.miss_pct_judged;
+  result.qos_verdict = qos::ToString(run.verdict);
+  result.rms_error_m = analysis::ControllerViewRmsError(recorder.trajectory(), reference_);
+  return result;
+}
+
+}  // namespace
+
+TwinRunOptions TwinOptionsFor(const TuneOptions& o, double rate_hz, double seconds,
+                              bool virtual_clock) {
+  TwinRunOptions t;
+  t.session.rate_hz = rate_hz;
+  t.session.duration_s = seconds;
+  t.session.clock = virtual_clock ? "virtual" : "realtime";
+  t.session.io = "mock";  // the profile plays into the emulated board, as `run` does
+  t.session.no_progress = true;  // tune draws its own progress bar
+  t.session.priority = o.priority;
+  t.session.cpus = o.cpus;
+  t.input = o.input;
+  t.controller_rate_hz = o.controller_rate_hz;
+  t.config_path = o.config_path;
+  t.integrator = o.integrator;
+  return t;
+}
+
+void CheckTuneOptions(const TuneOptions& o) {
+  if (!std::isfinite(o.controller_rate_hz) || o.controller_rate_hz <= 0.0 ||
+      o.controller_rate_hz > scheduler::kMaxRateHz) {
+    Usage("--controller-rate " + Num(o.controller_rate_hz) +
+          ": must be a rate in Hz above 0 and at most 50000 (the thesis's ECS runs at 1000)");
+  }
+  if (!std::isfinite(o.tolerance_m) || o.tolerance_m <= 0.0) {
+    Usage("--tolerance-m " + Num(o.tolerance_m) +
+          ": must be a positive distance in metres (default 0.0001 = 0.1 mm)");
+  }
+  try {
+    analysis::CheckCandidateRates(o.candidates_hz, scheduler::kMaxRateHz);
+  } catch (const std::invalid_argument& e) {
+    Usage(std::string("--candidates: ") + e.what());
+  }
+  if (o.candidates_hz.front() < o.controller_rate_hz) {
+    Usage("--candidates: " + Num(o.candidates_hz.front()) +
+          " Hz is below --controller-rate " + Num(o.controller_rate_hz) +
+          " Hz; a twin slower than its controller cannot answer every sample");
+  }
+  if (!std::isfinite(o.validate_seconds) || o.validate_seconds < 0.1 || o.validate_seconds > 3600.0) {
+    Usage("--validate-seconds " + Num(o.validate_seconds) + ": must be 0.1 .. 3600");
+  }
+  if (!std::isfinite(o.latency_seconds) || o.latency_seconds < 0.1 || o.latency_seconds > 600.0) {
+    Usage("--latency-seconds " + Num(o.latency_seconds) + ": must be 0.1 .. 600");
+  }
+  CheckInjection(o.inject_compute_us, "--inject-compute-us", o);
+  CheckInjection(o.inject_overhead_us, "--inject-overhead-us", o);
+  CheckInjection(o.inject_latency_us, "--inject-latency-us", o);
+  for (const double rate_hz : o.candidates_hz) {
+    CheckTwinRunOptions(TwinOptionsFor(o, rate_hz, o.validate_seconds, IsVirtual(o)));
+  }
+  CheckModelRunsAt(o, o.candidates_hz.front());
+}
+
+analysis::TuneReport RunTune(const TuneOptions& o, const TuneProgress& progress) {
+  CheckTuneOptions(o);
+  TuneProcedure procedure(o, progress);
+  return procedure.Run();
+}
+
+}  // namespace hiltwin::app
