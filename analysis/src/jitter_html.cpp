@@ -118,19 +118,12 @@ std::string CausesSvg(const JitterReport& r) {
 
 namespace {
 
-constexpr const char* kStyle =
-    "body{font-family:sans-serif;margin:24px auto;max-width:960px;color:#222;background:#fff}"
-    "h1{font-size:22px;margin-bottom:4px}h2{font-size:17px;margin-top:28px}"
-    ".sub{color:#666;margin-top:0}"
+// The summary cards, on top of the page style every analysis page shares.
+constexpr const char* kCardStyle =
     ".cards{display:flex;flex-wrap:wrap;gap:10px;margin:14px 0}"
     ".card{border:1px solid #ddd;border-radius:6px;padding:8px 12px;min-width:120px}"
     ".card b{display:block;font-size:20px}.card span{color:#666;font-size:12px}"
-    ".bad b{color:#d62728}"
-    "svg{border:1px solid #eee;margin:6px 0;font-size:11px;fill:#222}"
-    "svg .grid{stroke:#eee}svg .frame{fill:none;stroke:#888}"
-    "svg .marker{stroke-dasharray:4 3;stroke-width:1.5}"
-    "svg .title{font-size:14px;font-weight:bold}svg .note{font-size:15px;fill:#666}"
-    "pre{background:#f7f7f7;border:1px solid #e5e5e5;padding:12px;font-size:12px;overflow-x:auto}";
+    ".bad b{color:#d62728}";
 
 std::string Card(const std::string& value, const std::string& what, bool bad) {
   return std::string("<div class=\"card") + (bad ? " bad" : "") + "\"><b>" +
@@ -164,7 +157,8 @@ std::string WriteJitterHtml(const JitterReport& report, const TimingTrace& trace
     throw std::runtime_error("cannot write " + path + ": check that the directory exists and is writable");
   }
   out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-      << "<title>hiltwin jitter report</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n"
+      << "<title>hiltwin jitter report</title>\n<style>" << detail::kPageStyle << kCardStyle
+      << "</style>\n</head>\n<body>\n"
       << "<h1>hiltwin jitter report</h1>\n<p class=\"sub\">" << detail::HtmlEscape(report.path)
       << " (" << detail::SourceName(report.source) << "), period "
       << detail::FormatDuration(report.period_ns) << ", deadline "

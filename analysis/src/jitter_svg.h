@@ -1,12 +1,24 @@
 #pragma once
-// Private to the analysis module: just enough SVG for the jitter report's HTML page (axes with
-// linear or log scales, bars, lines, dots, text), written inline so the page needs nothing
-// from outside: no script, no font, no link.
+// Private to the analysis module: just enough SVG for the HTML pages of the jitter report and
+// of `hiltwin tune` (axes with linear or log scales, bars, lines, dots, text), written inline
+// so a page needs nothing from outside: no script, no font, no link.
 
 #include <string>
 #include <vector>
 
 namespace hiltwin::analysis::detail {
+
+/// The CSS every analysis HTML page shares: the page, its headings, the charts' classes and
+/// the preformatted text report.
+inline constexpr const char* kPageStyle =
+    "body{font-family:sans-serif;margin:24px auto;max-width:960px;color:#222;background:#fff}"
+    "h1{font-size:22px;margin-bottom:4px}h2{font-size:17px;margin-top:28px}"
+    ".sub{color:#666;margin-top:0}"
+    "svg{border:1px solid #eee;margin:6px 0;font-size:11px;fill:#222}"
+    "svg .grid{stroke:#eee}svg .frame{fill:none;stroke:#888}"
+    "svg .marker{stroke-dasharray:4 3;stroke-width:1.5}"
+    "svg .title{font-size:14px;font-weight:bold}svg .note{font-size:15px;fill:#666}"
+    "pre{background:#f7f7f7;border:1px solid #e5e5e5;padding:12px;font-size:12px;overflow-x:auto}";
 
 /// Escapes &, <, >, " for HTML and SVG text.
 [[nodiscard]] std::string HtmlEscape(const std::string& text);
