@@ -15,7 +15,7 @@ namespace hiltwin::analysis::detail {
 /// than the rate it allows.
 [[nodiscard]] std::string HzText(double rate_hz);
 
-/// "35.0 us" from nanoseconds.
+/// "35.0 us" from nanoseconds; below 10 us with three decimals ("0.118 us").
 [[nodiscard]] std::string UsText(double ns);
 
 /// "0.100 mm" from metres.

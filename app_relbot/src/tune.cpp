@@ -15,6 +15,7 @@
 #include "hiltwin/app_relbot/session_options.h"
 #include "hiltwin/app_relbot/trajectory_recorder.h"
 #include "hiltwin/app_relbot/twin_build.h"
+#include "hiltwin/io/conversions.h"
 #include "hiltwin/scheduler/executive.h"
 #include "tune_measure.h"
 
@@ -76,15 +77,41 @@ runtime::VirtualCycleCosts VirtualCostsOf(const TuneOptions& o, const StepCost& 
   return costs;
 }
 
-/// Reference positions at every controller sample instant of the validation window.
+/// The profile as the twin's board reads it: sampled at the controller's instants over the
+/// window and measured by the PWM reader (11 bits, io/conversions.h). The reference is driven
+/// by exactly this, so it differs from the twin only by what the twin's rate changes (the
+/// integration step, the sampling and the one-period delay), not by the reader's resolution,
+/// which no rate can improve.
+InputProfile DutyAsTheBoardReadsIt(const InputProfile& profile, double controller_rate_hz,
+                                   double seconds) {
+  const auto read = [](double duty) { return io::PwmToDuty(io::PwmReaderValue(duty)); };
+  const auto samples = static_cast<std::size_t>(std::ceil(seconds * controller_rate_hz)) + 1;
+  std::vector<ProfileKnot> knots;
+  knots.reserve(2 * samples);
+  for (std::size_t j = 0; j < samples; ++j) {
+    const double t_s = static_cast<double>(j) / controller_rate_hz;
+    const Duty duty = profile.At(t_s);
+    const Duty held{read(duty.left), read(duty.right)};
+    if (j > 0) knots.push_back({t_s, knots.back().duty});  // the held value up to the step
+    knots.push_back({t_s, held});
+  }
+  knots.push_back({static_cast<double>(samples) / controller_rate_hz, knots.back().duty});
+  return InputProfile::FromKnots(profile.name() + " as read by the board", std::move(knots));
+}
+
+/// Reference positions at every controller sample instant of the validation window: the same
+/// model integrated by Boost.Odeint's adaptive Dormand-Prince at 1e-10 tolerances (a "much
+/// higher rate" than any twin), sampled without delay.
 analysis::ReferenceSamples MakeReference(const TuneOptions& o) {
   Twin twin;
   LoadTwinConfiguration(TwinOptionsFor(o, o.controller_rate_hz, o.validate_seconds, true), twin);
   const double controller_period_s = 1.0 / o.controller_rate_hz;
   ReferenceOptions reference;
   reference.input_hold_s = controller_period_s;
+  const InputProfile input =
+      DutyAsTheBoardReadsIt(*twin.profile, o.controller_rate_hz, o.validate_seconds);
   const std::vector<RelbotOutputs> outputs = SimulateReference(
-      twin.params, *twin.profile, o.validate_seconds, controller_period_s, reference);
+      twin.params, input, o.validate_seconds, controller_period_s, reference);
   analysis::ReferenceSamples samples;
   samples.controller_period_s = controller_period_s;
   for (const RelbotOutputs& out : outputs) {

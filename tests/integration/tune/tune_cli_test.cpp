@@ -27,7 +27,7 @@ hiltwin::test::RunResult Tune(std::vector<std::string> extra, int timeout_ms = 2
 std::vector<std::string> ThesisVirtual(std::vector<std::string> extra) {
   std::vector<std::string> argv = {"--clock", "virtual", "--inject-compute-us", "85",
                                    "--inject-overhead-us", "35", "--inject-latency-us", "0",
-                                   "--validate-seconds", "1"};
+                                   "--validate-seconds", "3"};
   argv.insert(argv.end(), extra.begin(), extra.end());
   return argv;
 }

@@ -86,7 +86,7 @@ TEST(EcsLoop, ClosedLoopRunsInARunSessionWithoutAllocating) {
 /// the reference run of thesis §5.2.
 struct ReferenceTwin {
   explicit ReferenceTwin(const InputProfile& profile)
-      : source(profile, 1000.0),
+      : source(profile, 1000.0, 4000.0),
         model(params, Integrator::kRk4, 2.5e-4),
         task(driver, model, geometry) {
     board.SetPwmSource(&source);

@@ -29,7 +29,7 @@ using test::LoopAllocations;
 struct TwinRig {
   explicit TwinRig(const std::string& log_path)
       : profile(OpenLoopProfile()),
-        pwm_source(profile, 1000.0),
+        pwm_source(profile, 1000.0, 4000.0),
         backend(io::OpenBackend("mock", io::BackendOptions{})),
         driver(backend->bus()),
         params(DefaultRelbotParams()),

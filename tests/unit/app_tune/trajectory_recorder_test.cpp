@@ -35,7 +35,7 @@ struct RecordedRun {
   double last_left_m = 0.0;
 };
 
-RecordedRun Run(double seconds, runtime::VirtualCycleCosts costs, std::size_t capacity) {
+RecordedRun RunRecorded(double seconds, runtime::VirtualCycleCosts costs, std::size_t capacity) {
   const TwinRunOptions o = VirtualTwin(seconds);
   const std::unique_ptr<Twin> twin = BuildTwin(o, kPeriodNs);
   runtime::SessionConfig config =
@@ -58,13 +58,13 @@ TEST(TrajectoryRecorder, RecordsEveryExchangeAtItsChargedTimeWithoutAllocating) 
   runtime::VirtualCycleCosts costs;
   costs.compute_ns = {100'000};
   costs.wake_latency_ns = {30'000};
-  const RecordedRun run = Run(1.0, costs, 4000);
+  const RecordedRun run = RunRecorded(2.0, costs, 8000);  // the profile rests for 1 s
   EXPECT_EQ(run.allocations, 0U) << "malloc counted: " << test::MallocIsCounted();
-  ASSERT_EQ(run.trajectory.exchange_time_s.size(), 4000U);
+  ASSERT_EQ(run.trajectory.exchange_time_s.size(), 8000U);
   EXPECT_EQ(run.not_recorded, 0U);
   EXPECT_DOUBLE_EQ(run.trajectory.period_s, 250e-6);
   // Every cycle slept (130 us of work in 250 us) and woke 30 us late: exchange k at k T + 30 us.
-  for (std::size_t k = 0; k < 4000; k += 997) {
+  for (std::size_t k = 0; k < 8000; k += 997) {
     EXPECT_NEAR(run.trajectory.exchange_time_s[k], static_cast<double>(k) * 250e-6 + 30e-6, 1e-12)
         << "cycle " << k;
   }
@@ -74,7 +74,7 @@ TEST(TrajectoryRecorder, RecordsEveryExchangeAtItsChargedTimeWithoutAllocating) 
 }
 
 TEST(TrajectoryRecorder, StopsRecordingWhenFullAndCountsWhatItLeftOut) {
-  const RecordedRun run = Run(0.5, {}, 1500);
+  const RecordedRun run = RunRecorded(0.5, {}, 1500);
   EXPECT_EQ(run.allocations, 0U);
   EXPECT_EQ(run.trajectory.exchange_time_s.size(), 1500U);
   EXPECT_EQ(run.not_recorded, 500U);

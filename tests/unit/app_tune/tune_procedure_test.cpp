@@ -16,7 +16,7 @@ namespace {
 TuneOptions ThesisCosts() {
   TuneOptions o;
   o.clock = "virtual";
-  o.validate_seconds = 1.0;
+  o.validate_seconds = 3.0;  // openloop rests for 1 s, then steps and ramps
   o.inject_compute_us = 85.0;
   o.inject_overhead_us = 35.0;
   o.inject_latency_us = 0.0;

@@ -74,7 +74,7 @@ TEST(Recommend, LatencyAwareMaximumCapsTheAccuracyBound) {
   EXPECT_EQ(rec.recommended_hz, 18'181.0);
   EXPECT_EQ(rec.deciding_bound, DecidingBound::kLatencyMax);
   EXPECT_THAT(rec.reason, HasSubstr("capped at the latency-aware maximum 18181 Hz (p99.9 wake-up "
-                                    "latency 45.0 us + p99.9 compute 5.0 us + overhead 5.0 us)"));
+                                    "latency 45.0 us + p99.9 compute 5.000 us + overhead 5.000 us)"));
   EXPECT_TRUE(Mentions(rec, "the accuracy bound 20000 Hz is above the rate this machine can hold"));
 }
 
