@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <limits>
 #include <span>
@@ -10,23 +9,12 @@
 #include <tuple>
 
 #include "hiltwin/analysis/series.h"
+#include "string_format.h"
 
 namespace hiltwin::analysis {
 namespace {
 
-[[gnu::format(printf, 1, 2)]] std::string Format(const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  va_list copy;
-  va_copy(copy, args);
-  const int size = std::vsnprintf(nullptr, 0, format, copy);
-  va_end(copy);
-  std::string out(static_cast<std::size_t>(std::max(size, 0)) + 1, '\0');
-  std::vsnprintf(out.data(), out.size(), format, args);
-  va_end(args);
-  out.resize(static_cast<std::size_t>(std::max(size, 0)));
-  return out;
-}
+using detail::Format;
 
 std::string Num(double v) { return Format("%.6g", v); }
 

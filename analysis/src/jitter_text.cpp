@@ -1,48 +1,40 @@
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <string>
 
 #include "hiltwin/analysis/jitter_outputs.h"
 #include "jitter_format.h"
+#include "string_format.h"
 
 namespace hiltwin::analysis {
 namespace {
 
-std::string Printf(const char* format, ...) __attribute__((format(printf, 1, 2)));
-std::string Printf(const char* format, ...) {
-  char line[512];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(line, sizeof line, format, args);
-  va_end(args);
-  return line;
-}
+using detail::Format;
 
 double Us(std::int64_t ns) { return static_cast<double>(ns) / 1e3; }
 
 void Header(const JitterReport& r, std::string& out) {
   out += "hiltwin jitter report: " + r.path + " (" + detail::SourceName(r.source) + ")\n";
-  out += Printf("period %s, deadline %s; %llu cycles (%llu judged), %llu releases skipped\n",
+  out += Format("period %s, deadline %s; %llu cycles (%llu judged), %llu releases skipped\n",
                 detail::FormatDuration(r.period_ns).c_str(),
                 detail::FormatDuration(r.deadline_ns).c_str(),
                 static_cast<unsigned long long>(r.cycles),
                 static_cast<unsigned long long>(r.cycles_judged),
                 static_cast<unsigned long long>(r.releases_skipped));
-  out += Printf("deadline misses: %llu (%.3f %% of judged releases, skipped ones included)\n",
+  out += Format("deadline misses: %llu (%.3f %% of judged releases, skipped ones included)\n",
                 static_cast<unsigned long long>(r.misses), r.miss_pct);
-  out += Printf("%llu events discarded by the tracer; kernel: ",
+  out += Format("%llu events discarded by the tracer; kernel: ",
                 static_cast<unsigned long long>(r.discarded_events));
-  out += r.kernel_recorded ? Printf("recorded, %llu events lost\n",
+  out += r.kernel_recorded ? Format("recorded, %llu events lost\n",
                                     static_cast<unsigned long long>(r.kernel_lost_events))
                            : std::string("not recorded\n");
   out += std::string("trace complete: ") + (r.trace_complete ? "yes" : "no");
   if (r.loop) {
     const bool rt = r.loop->policy == 1 || r.loop->policy == 2;  // SCHED_FIFO, SCHED_RR
-    out += Printf("; loop thread tid %d on CPU %d (%s", r.loop->tid, r.loop->cpu,
+    out += Format("; loop thread tid %d on CPU %d (%s", r.loop->tid, r.loop->cpu,
                   detail::PolicyName(r.loop->policy));
-    out += rt ? Printf(" %d)", r.loop->priority) : std::string(")");
+    out += rt ? Format(" %d)", r.loop->priority) : std::string(")");
   }
   out += "\n\n";
 }
@@ -52,7 +44,7 @@ void Table(const JitterReport& r, std::string& out) {
   for (const Distribution* d : {&r.latency, &r.period_jitter, &r.compute, &r.response}) {
     const scheduler::TimingSummary& s = d->summary;
     std::string name = d->name == "period_jitter" ? "period jitter |x|" : d->name;
-    out += Printf("%-17s %8llu %9.1f %9.1f %9.1f %9.1f %9.1f\n", name.c_str(),
+    out += Format("%-17s %8llu %9.1f %9.1f %9.1f %9.1f %9.1f\n", name.c_str(),
                   static_cast<unsigned long long>(s.count), Us(s.min_ns), Us(s.p50_ns),
                   Us(s.p99_ns), Us(s.p999_ns), Us(s.max_ns));
   }
@@ -81,8 +73,8 @@ void AsciiHistogram(const Distribution& d, std::string& out) {
     const double scale = std::log10(static_cast<double>(most) + 1.0);
     const auto width = static_cast<std::size_t>(
         std::lround(40.0 * std::log10(static_cast<double>(counts[i]) + 1.0) / scale));
-    const std::string upper = i + 1 < edges.size() ? Printf("%g", Us(edges[i + 1])) : "inf";
-    out += Printf("  %8g - %-6s us |%-40s %llu\n", Us(edges[i]), upper.c_str(),
+    const std::string upper = i + 1 < edges.size() ? Format("%g", Us(edges[i + 1])) : "inf";
+    out += Format("  %8g - %-6s us |%-40s %llu\n", Us(edges[i]), upper.c_str(),
                   std::string(width, '#').c_str(), static_cast<unsigned long long>(counts[i]));
   }
   out += "\n";
@@ -90,13 +82,13 @@ void AsciiHistogram(const Distribution& d, std::string& out) {
 
 void Clusters(const JitterReport& r, std::string& out) {
   const MissClusters& c = r.clusters;
-  out += Printf("misses: %llu in %llu bursts; longest burst %llu releases from k=%llu\n",
+  out += Format("misses: %llu in %llu bursts; longest burst %llu releases from k=%llu\n",
                 static_cast<unsigned long long>(c.misses), static_cast<unsigned long long>(c.bursts),
                 static_cast<unsigned long long>(c.longest_burst),
                 static_cast<unsigned long long>(c.longest_burst_start_k));
   for (const MissClusters::RuleWindows& w : c.windows) {
     out += "  " + qos::Describe(w.rule) +
-           Printf(": %llu windows held a miss, at most %llu misses in one window\n",
+           Format(": %llu windows held a miss, at most %llu misses in one window\n",
                   static_cast<unsigned long long>(w.windows_touched),
                   static_cast<unsigned long long>(w.max_misses_in_window));
   }
@@ -108,11 +100,11 @@ void Clusters(const JitterReport& r, std::string& out) {
 namespace {
 
 void Worst(const JitterReport& r, std::string& out) {
-  out += Printf("%zu worst cycles by response time (t: seconds since the first release):\n",
+  out += Format("%zu worst cycles by response time (t: seconds since the first release):\n",
                 r.worst.size());
   out += "         k          t    latency    compute   response  miss  cause\n";
   for (const NotableCycle& n : r.worst) {
-    out += Printf("  %8llu %10.6f %10s %10s %10s  %-4s  %s\n", static_cast<unsigned long long>(n.k),
+    out += Format("  %8llu %10.6f %10s %10s %10s  %-4s  %s\n", static_cast<unsigned long long>(n.k),
                   static_cast<double>(n.release_ns - r.first_release_ns) * 1e-9,
                   detail::FormatDuration(n.latency_ns).c_str(),
                   detail::FormatDuration(n.compute_ns).c_str(),
@@ -128,16 +120,16 @@ void Causes(const JitterReport& r, std::string& out) {
     out += std::string(detail::kCausesNotRecorded) + "\n\n";
     return;
   }
-  out += Printf("causes of the %zu notable cycles (every miss, every wake-up above p99.9 = %s):\n",
+  out += Format("causes of the %zu notable cycles (every miss, every wake-up above p99.9 = %s):\n",
                 r.notable.size(), detail::FormatDuration(r.latency.summary.p999_ns).c_str());
   if (r.causes.empty()) out += "  none: no cycle missed and no wake-up was above p99.9\n";
   if (!r.causes.empty()) out += "  cause          cycles  misses  top culprits\n";
   for (const CauseCount& c : r.causes) {
     std::string culprits;
     for (const auto& [name, cycles] : c.culprits) {
-      culprits += (culprits.empty() ? "" : ", ") + name + Printf(" x%llu", static_cast<unsigned long long>(cycles));
+      culprits += (culprits.empty() ? "" : ", ") + name + Format(" x%llu", static_cast<unsigned long long>(cycles));
     }
-    out += Printf("  %-13s %7llu %7llu  %s\n", ToString(c.cause),
+    out += Format("  %-13s %7llu %7llu  %s\n", ToString(c.cause),
                   static_cast<unsigned long long>(c.cycles),
                   static_cast<unsigned long long>(c.misses), culprits.c_str());
   }

@@ -6,10 +6,9 @@
 #include <cstdint>
 #include <string>
 
-namespace hiltwin::analysis::detail {
+#include "string_format.h"
 
-/// printf into a std::string of any length.
-[[nodiscard]] std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
+namespace hiltwin::analysis::detail {
 
 /// "8333 Hz": whole hertz, floored like the recommendation, so a bound never reads higher
 /// than the rate it allows.

@@ -80,6 +80,40 @@ TEST(TuneProcedure, ATighterToleranceRaisesTheRateToTheAccuracyBound) {
   EXPECT_EQ(r.recommendation.deciding_bound, analysis::DecidingBound::kAccuracy);
 }
 
+struct BoundCase {
+  const char* name;
+  double compute_us, overhead_us, latency_us, tolerance_m;
+  double recommended_hz;
+  analysis::DecidingBound bound;
+};
+
+TEST(TuneProcedure, EachBoundDecidesWhereItsInjectedCostsSayItMust) {
+  using analysis::DecidingBound;
+  // A 1 mm tolerance is met at the 1 kHz controller rate itself, so accuracy stays out of the
+  // timing cases; 0.02 mm needs more than the 8333 Hz the thesis's costs allow.
+  const BoundCase cases[] = {
+      {"slow machine: 75 % of 4 kHz is below 4x 1 kHz", 200, 50, 0, 1e-3, 4000,
+       DecidingBound::kControllerFloor},
+      {"fast machine: 75 % of 50 kHz is above 10x 1 kHz", 10, 10, 0, 1e-3, 10000,
+       DecidingBound::kControllerCeiling},
+      {"80 us latency: 1 / 200 us", 85, 35, 80, 1e-3, 5000, DecidingBound::kLatencyMax},
+      {"accuracy wants more than 1 / 120 us", 85, 35, 0, 2e-5, 8333, DecidingBound::kTimingMax},
+  };
+  for (const BoundCase& c : cases) {
+    TuneOptions o = ThesisCosts();
+    o.candidates_hz = {1000.0};
+    o.inject_compute_us = c.compute_us;
+    o.inject_overhead_us = c.overhead_us;
+    o.inject_latency_us = c.latency_us;
+    o.tolerance_m = c.tolerance_m;
+    const analysis::TuneReport r = Tune(o);
+    EXPECT_EQ(r.recommendation.recommended_hz, c.recommended_hz) << c.name;
+    EXPECT_EQ(r.recommendation.deciding_bound, c.bound)
+        << c.name << ": " << r.recommendation.reason;
+    EXPECT_EQ(At(r, c.recommended_hz).qos_verdict, "PASS") << c.name;  // and it holds
+  }
+}
+
 TEST(TuneProcedure, IsDeterministicOnTheVirtualClockWithInjectedCosts) {
   TuneOptions o = ThesisCosts();
   o.candidates_hz = {2000.0, 16000.0};
