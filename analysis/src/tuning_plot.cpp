@@ -26,11 +26,21 @@ constexpr const char* kOrange = "#ff7f0e";
 constexpr const char* kRed = "#d62728";
 constexpr const char* kPurple = "#9467bd";
 constexpr const char* kGrey = "#7f7f7f";
+constexpr const char* kBrown = "#8c564b";
+
+// The two timing bounds are charted only up to the scheduler's limit: a fast model's method-2
+// maximum can be megahertz and would squash every run into the left edge.
+bool OnChart(double rate_hz, const TuneReport& r) {
+  return rate_hz > 0.0 && rate_hz <= r.policy.max_rate_hz;
+}
 
 // The rate axis spans the candidates and every marked bound.
 SvgAxis RateAxis(const TuneReport& r) {
   const Recommendation& rec = r.recommendation;
-  std::vector<double> rates_hz = {rec.timing_max_hz, rec.recommended_hz};
+  std::vector<double> rates_hz = {rec.recommended_hz};
+  for (const double bound_hz : {rec.timing_max_hz, rec.latency_max_hz}) {
+    if (OnChart(bound_hz, r)) rates_hz.push_back(bound_hz);
+  }
   if (rec.accuracy_bound_hz) rates_hz.push_back(*rec.accuracy_bound_hz);
   for (const CandidateResult& c : r.candidates) rates_hz.push_back(c.rate_hz);
   for (const AccuracyPoint& p : r.accuracy.points) rates_hz.push_back(p.rate_hz);
@@ -41,10 +51,24 @@ SvgAxis RateAxis(const TuneReport& r) {
   return {lo_hz / 1.5, std::max(hi_hz * 1.5, lo_hz * 10.0), true, "twin update rate [Hz]"};
 }
 
-// The three rates both charts mark, with one legend entry each.
-void RateMarkers(SvgChart& chart, const Recommendation& rec) {
-  chart.VerticalMarker(rec.timing_max_hz, "", kGrey);
-  chart.Legend("timing maximum " + HzText(rec.timing_max_hz), kGrey, true);
+// A bound's dashed marker with its legend entry; beyond the chart only the legend, saying so.
+void BoundMarker(SvgChart& chart, const TuneReport& r, double rate_hz, const std::string& name,
+                 const char* colour) {
+  if (OnChart(rate_hz, r)) {
+    chart.VerticalMarker(rate_hz, "", colour);
+    chart.Legend(name + " " + HzText(rate_hz), colour, true);
+  } else {
+    chart.Legend(name + " " + HzText(rate_hz) + " (off the chart: above " +
+                     HzText(r.policy.max_rate_hz) + ")",
+                 colour, true);
+  }
+}
+
+// The rates both charts mark, with one legend entry each.
+void RateMarkers(SvgChart& chart, const TuneReport& r) {
+  const Recommendation& rec = r.recommendation;
+  BoundMarker(chart, r, rec.timing_max_hz, "timing maximum", kGrey);
+  BoundMarker(chart, r, rec.latency_max_hz, "latency-aware maximum", kBrown);
   if (rec.accuracy_bound_hz) {
     chart.VerticalMarker(*rec.accuracy_bound_hz, "", kPurple);
     chart.Legend("accuracy bound " + HzText(*rec.accuracy_bound_hz), kPurple, true);
@@ -72,7 +96,7 @@ std::string MissSvg(const TuneReport& r) {
   }
   if (r.candidates.empty()) chart.Note("no validation runs");
   chart.Legend("validation runs", kBlue);
-  RateMarkers(chart, r.recommendation);
+  RateMarkers(chart, r);
   return chart.Finish();
 }
 
@@ -101,7 +125,7 @@ std::string ErrorSvg(const TuneReport& r) {
   if (r.candidates.empty() && r.accuracy.points.empty()) chart.Note("no error was measured");
   chart.Legend("validation runs", kBlue);
   chart.Legend("accuracy search", kOrange);
-  RateMarkers(chart, r.recommendation);
+  RateMarkers(chart, r);
   return chart.Finish();
 }
 
@@ -120,8 +144,9 @@ void WriteTunePlotHtml(const TuneReport& report, const std::string& html_path) {
       << "<h1>hiltwin tune: recommended " << HzText(rec.recommended_hz) << "</h1>\n"
       << "<p class=\"sub\">" << HtmlEscape(report.model) << ", " << HtmlEscape(report.clock)
       << " clock; decided by: " << HtmlEscape(rec.reason) << "</p>\n"
-      << "<p>Dashed lines: grey the timing maximum 1/(overhead + compute), purple the accuracy "
-         "bound, green the recommended rate; red the RMS error tolerance.</p>\n"
+      << "<p>Dashed lines: grey the timing maximum 1/(overhead + compute), brown the "
+         "latency-aware maximum, purple the accuracy bound, green the recommended rate; red the "
+         "RMS error tolerance.</p>\n"
       << "<h2>Deadline misses</h2>\n"
       << MissSvg(report) << "<h2>Accuracy</h2>\n"
       << ErrorSvg(report) << "<h2>Report</h2>\n<pre>" << HtmlEscape(FormatTuneText(report))

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -16,6 +17,7 @@
 #include "hiltwin/app_relbot/trajectory_recorder.h"
 #include "hiltwin/app_relbot/twin_build.h"
 #include "hiltwin/io/conversions.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/scheduler/executive.h"
 #include "tune_measure.h"
 
@@ -160,8 +162,19 @@ class TuneProcedure {
 
  private:
   void Next(const std::string& what) {
+    StopIfAsked(what);
     progress_(std::min(steps_done_ / steps_total_, 1.0), what);
     steps_done_ += 1.0;
+  }
+
+  /// SIGINT or SIGTERM ends the run in progress cleanly (RunSession), and tune with it: a
+  /// procedure missing a step recommends nothing.
+  static void StopIfAsked(const std::string& next) {
+    if (!kernel_glue::StopRequested()) return;
+    throw CommandError(ExitCode::kAborted,
+                       std::string("stopped by ") +
+                           (kernel_glue::StopSignal() == SIGTERM ? "SIGTERM" : "SIGINT") +
+                           " before " + next + ": no recommendation (run it again to the end)");
   }
 
   void Measure(analysis::TuneReport& report);
@@ -230,6 +243,7 @@ void TuneProcedure::Validate(analysis::TuneReport& report) {
     result.recommended = rate_hz == recommended;
     report.candidates.push_back(std::move(result));
   }
+  StopIfAsked("the summary");
   progress_(1.0, "done");
 }
 

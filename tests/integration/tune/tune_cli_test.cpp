@@ -2,7 +2,11 @@
 // names, the whole procedure on the virtual clock with the thesis's injected costs (exact and
 // repeatable, JSON, text table and HTML plot), and a short real-clock tune.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <filesystem>
 #include <fstream>
@@ -140,6 +144,35 @@ TEST(TuneCli, OnTheRealClockItMeasuresThisMachineAndValidatesEveryCandidate) {
   EXPECT_GT(j.at("max_rate_hz").get<double>(), 0.0);
   EXPECT_GE(j.at("candidates").size(), 2U);
   EXPECT_FALSE(j.at("measured").at("injected").get<bool>());
+}
+
+TEST_F(TuneFiles, OnTheRealClockSigintStopsTheProcedureAndRecommendsNothing) {
+  // Without --no-progress and without a terminal, tune prints one line per step on stderr.
+  hiltwin::kernel_glue::Process tune = hiltwin::test::Spawn(
+      {HILTWIN_BINARY, "tune", "--candidates", "1000,2000", "--validate-seconds", "30",
+       "--latency-seconds", "0.2", "--priority", "0"},
+      Path("out.txt"));
+  bool validating = false;
+  for (int i = 0; i < 600 && !validating; ++i) {  // up to 60 s for the measuring steps
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::ifstream err(Path("out.txt.err"));
+    std::stringstream text;
+    text << err.rdbuf();
+    validating = text.str().find("validating 1000 Hz") != std::string::npos;
+  }
+  ASSERT_TRUE(validating) << "tune never reached its first validation run";
+  ASSERT_EQ(kill(tune.pid(), SIGINT), 0);
+  const auto status = tune.WaitFor(std::chrono::seconds(20));
+  ASSERT_TRUE(status.has_value()) << "still running 20 s after SIGINT";
+  EXPECT_TRUE(status->exited && status->code == 4) << status->Describe();
+  std::ifstream err(Path("out.txt.err"));
+  std::stringstream text;
+  text << err.rdbuf();
+  EXPECT_NE(text.str().find("stopped by SIGINT"), std::string::npos) << text.str();
+  std::ifstream out(Path("out.txt"));
+  std::stringstream report;
+  report << out.rdbuf();
+  EXPECT_EQ(report.str().find("Recommendation"), std::string::npos) << report.str();
 }
 
 }  // namespace
