@@ -49,8 +49,7 @@ class ProgressBar {
     const std::string bar = std::string(static_cast<std::size_t>(filled), '#') +
                             std::string(static_cast<std::size_t>(kWidth - filled), '-');
     std::fprintf(stderr, "%shiltwin tune: [%s] %3d %% %-52s%s", tty_ ? "\r" : "", bar.c_str(),
-                 static_cast<int>(std::lround(fraction * 100.0)), what.c_str(),
-                 tty_ ? "" : "\n");
+                 static_cast<int>(std::lround(fraction * 100.0)), what.c_str(), tty_ ? "" : "\n");
     std::fflush(stderr);
     drawn_ = true;
   }
@@ -75,8 +74,8 @@ void WriteReportFile(const std::string& path, const analysis::TuneReport& report
   std::ofstream file(path, std::ios::out | std::ios::trunc);
   file << analysis::ToJson(report).dump(2) << '\n';
   if (!file.flush()) {
-    throw CommandError(ExitCode::kIo, "--report " + path + ": cannot write it (" +
-                                          std::strerror(errno) + ")");
+    throw CommandError(ExitCode::kIo,
+                       "--report " + path + ": cannot write it (" + std::strerror(errno) + ")");
   }
 }
 
@@ -87,9 +86,8 @@ int RunTuneCommand(const TuneCommandOptions& o) {
   analysis::TuneReport report;
   {
     ProgressBar bar(!o.no_progress);
-    report = RunTune(o.tune, [&bar](double fraction, const std::string& what) {
-      bar.Show(fraction, what);
-    });
+    report = RunTune(
+        o.tune, [&bar](double fraction, const std::string& what) { bar.Show(fraction, what); });
   }
   if (o.json) {
     std::printf("%s\n", analysis::ToJson(report).dump(2).c_str());

@@ -34,12 +34,15 @@ bool AllInjected(const TuneOptions& o) {
   return o.inject_compute_us && o.inject_overhead_us && o.inject_latency_us;
 }
 
-kernel_glue::TimeNs NsOfUs(double us) { return static_cast<kernel_glue::TimeNs>(std::llround(us * 1e3)); }
+kernel_glue::TimeNs NsOfUs(double us) {
+  return static_cast<kernel_glue::TimeNs>(std::llround(us * 1e3));
+}
 
 void CheckInjection(const std::optional<double>& us, const char* flag, const TuneOptions& o) {
   if (!us) return;
   if (!IsVirtual(o)) {
-    Usage(std::string(flag) + ": injected costs replace measurements on the virtual clock only; "
+    Usage(std::string(flag) +
+          ": injected costs replace measurements on the virtual clock only; "
           "add --clock virtual, or drop it to measure this machine");
   }
   if (!std::isfinite(*us) || *us < 0.0 || *us > 1e6) {
@@ -112,8 +115,8 @@ analysis::ReferenceSamples MakeReference(const TuneOptions& o) {
   reference.input_hold_s = controller_period_s;
   const InputProfile input =
       DutyAsTheBoardReadsIt(*twin.profile, o.controller_rate_hz, o.validate_seconds);
-  const std::vector<RelbotOutputs> outputs = SimulateReference(
-      twin.params, input, o.validate_seconds, controller_period_s, reference);
+  const std::vector<RelbotOutputs> outputs =
+      SimulateReference(twin.params, input, o.validate_seconds, controller_period_s, reference);
   analysis::ReferenceSamples samples;
   samples.controller_period_s = controller_period_s;
   for (const RelbotOutputs& out : outputs) {
@@ -126,8 +129,7 @@ analysis::ReferenceSamples MakeReference(const TuneOptions& o) {
 /// Runs the procedure's steps in order and reports each to the progress callback.
 class TuneProcedure {
  public:
-  TuneProcedure(const TuneOptions& o, const TuneProgress& progress)
-      : o_(o), progress_(progress) {
+  TuneProcedure(const TuneOptions& o, const TuneProgress& progress) : o_(o), progress_(progress) {
     policy_.controller_rate_hz = o.controller_rate_hz;
     policy_.tolerance_m = o.tolerance_m;
     policy_.max_rate_hz = scheduler::kMaxRateHz;
@@ -153,8 +155,7 @@ class TuneProcedure {
           return RunRecorded(rate_hz, true, {}).rms_error_m;
         },
         policy_);
-    report.recommendation =
-        analysis::Recommend(report.measured, report.accuracy.bound_hz, policy_);
+    report.recommendation = analysis::Recommend(report.measured, report.accuracy.bound_hz, policy_);
     Validate(report);
     report.validation = analysis::SummariseValidation(report.candidates);
     return report;
@@ -201,20 +202,24 @@ void TuneProcedure::Measure(analysis::TuneReport& report) {
     report.machine_warnings = MachineWarnings();
   }
   Next("timing the model step");
-  step_ = o_.inject_compute_us ? InjectedStepCost(NsOfUs(*o_.inject_compute_us))
-                               : MeasureStepCost(TwinOptionsFor(o_, o_.candidates_hz.back(), 1.0, true));
+  step_ = o_.inject_compute_us
+              ? InjectedStepCost(NsOfUs(*o_.inject_compute_us))
+              : MeasureStepCost(TwinOptionsFor(o_, o_.candidates_hz.back(), 1.0, true));
   m.step_compute = step_.summary;
   Next("timing the loop's own work per cycle");
-  m.loop_overhead_ns = o_.inject_overhead_us
-                           ? static_cast<double>(NsOfUs(*o_.inject_overhead_us))
-                           : MeasureLoopOverheadNs(TwinOptionsFor(o_, 4000.0, 1.0, true),
-                                                   step_.summary.mean_ns);
+  m.loop_overhead_ns =
+      o_.inject_overhead_us
+          ? static_cast<double>(NsOfUs(*o_.inject_overhead_us))
+          : MeasureLoopOverheadNs(TwinOptionsFor(o_, o_.candidates_hz.back(), 1.0, true),
+                                  step_.summary.mean_ns);
   for (const double rate_hz : o_.candidates_hz) {
     Next("wake-up latency at " + Num(rate_hz) + " Hz");
     if (IsVirtual(o_)) {
-      m.wake_latency.push_back({rate_hz, ConstantSummary(NsOfUs(o_.inject_latency_us.value_or(0.0)))});
+      m.wake_latency.push_back(
+          {rate_hz, ConstantSummary(NsOfUs(o_.inject_latency_us.value_or(0.0)))});
     } else {
-      m.wake_latency.push_back({rate_hz, MeasureWakeLatency(TwinOptionsFor(o_, rate_hz, o_.latency_seconds, false))});
+      m.wake_latency.push_back(
+          {rate_hz, MeasureWakeLatency(TwinOptionsFor(o_, rate_hz, o_.latency_seconds, false))});
     }
   }
   Twin twin;
@@ -252,7 +257,8 @@ analysis::CandidateResult TuneProcedure::RunRecorded(double rate_hz, bool virtua
   const TwinRunOptions t = TwinOptionsFor(o_, rate_hz, o_.validate_seconds, virtual_clock);
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(t, period_ns);
-  runtime::SessionConfig config = MakeSessionConfig(t.session, TuneRole(o_.controller_rate_hz), *twin->backend);
+  runtime::SessionConfig config =
+      MakeSessionConfig(t.session, TuneRole(o_.controller_rate_hz), *twin->backend);
   config.task_name = "RELbot twin";
   config.virtual_costs = std::move(costs);
   TrajectoryRecorder recorder(*twin->task, period_ns, PlannedCycles(t.session));
@@ -275,7 +281,7 @@ TwinRunOptions TwinOptionsFor(const TuneOptions& o, double rate_hz, double secon
   t.session.rate_hz = rate_hz;
   t.session.duration_s = seconds;
   t.session.clock = virtual_clock ? "virtual" : "realtime";
-  t.session.io = "mock";  // the profile plays into the emulated board, as `run` does
+  t.session.io = "mock";         // the profile plays into the emulated board, as `run` does
   t.session.no_progress = true;  // tune draws its own progress bar
   t.session.priority = o.priority;
   t.session.cpus = o.cpus;
@@ -302,11 +308,12 @@ void CheckTuneOptions(const TuneOptions& o) {
     Usage(std::string("--candidates: ") + e.what());
   }
   if (o.candidates_hz.front() < o.controller_rate_hz) {
-    Usage("--candidates: " + Num(o.candidates_hz.front()) +
-          " Hz is below --controller-rate " + Num(o.controller_rate_hz) +
+    Usage("--candidates: " + Num(o.candidates_hz.front()) + " Hz is below --controller-rate " +
+          Num(o.controller_rate_hz) +
           " Hz; a twin slower than its controller cannot answer every sample");
   }
-  if (!std::isfinite(o.validate_seconds) || o.validate_seconds < 0.1 || o.validate_seconds > 3600.0) {
+  if (!std::isfinite(o.validate_seconds) || o.validate_seconds < 0.1 ||
+      o.validate_seconds > 3600.0) {
     Usage("--validate-seconds " + Num(o.validate_seconds) + ": must be 0.1 .. 3600");
   }
   if (!std::isfinite(o.latency_seconds) || o.latency_seconds < 0.1 || o.latency_seconds > 600.0) {

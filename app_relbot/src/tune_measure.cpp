@@ -58,8 +58,13 @@ StepCost MeasureStepCost(const TwinRunOptions& t) {
 }
 
 scheduler::TimingSummary ConstantSummary(kernel_glue::TimeNs ns) {
-  return {.count = 1, .min_ns = ns, .mean_ns = static_cast<double>(ns), .p50_ns = ns,
-          .p99_ns = ns, .p999_ns = ns, .max_ns = ns};
+  return {.count = 1,
+          .min_ns = ns,
+          .mean_ns = static_cast<double>(ns),
+          .p50_ns = ns,
+          .p99_ns = ns,
+          .p999_ns = ns,
+          .max_ns = ns};
 }
 
 StepCost InjectedStepCost(kernel_glue::TimeNs ns) { return {ConstantSummary(ns), {ns}}; }
@@ -70,21 +75,21 @@ double MeasureLoopOverheadNs(const TwinRunOptions& t, double step_mean_ns) {
   flat_out.session.duration_s = kOverheadCycles / t.session.rate_hz;
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(t.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(flat_out, period_ns);
-  runtime::SessionConfig config = MakeSessionConfig(
-      flat_out.session, TuneRole(t.controller_rate_hz),
-      *twin->backend);
+  runtime::SessionConfig config =
+      MakeSessionConfig(flat_out.session, TuneRole(t.controller_rate_hz), *twin->backend);
   const auto start = std::chrono::steady_clock::now();
   const runtime::RunReport report = RunSessionOf(std::move(config), *twin->task);
   const double wall_ns =
       std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
-  const double per_cycle_ns = wall_ns / static_cast<double>(std::max<std::uint64_t>(report.cycles_run, 1));
+  const double per_cycle_ns =
+      wall_ns / static_cast<double>(std::max<std::uint64_t>(report.cycles_run, 1));
   return std::max(0.0, per_cycle_ns - step_mean_ns);
 }
 
 scheduler::TimingSummary MeasureWakeLatency(const TwinRunOptions& t) {
   const std::unique_ptr<io::IoBackend> board = OpenBoard(t.session, io::Image::kIcoboardInverse);
-  runtime::SessionConfig config = MakeSessionConfig(
-      t.session, TuneRole(t.controller_rate_hz), *board);
+  runtime::SessionConfig config =
+      MakeSessionConfig(t.session, TuneRole(t.controller_rate_hz), *board);
   config.task_name = "idle loop";
   IdleTask idle;
   return RunSessionOf(std::move(config), idle).latency;
@@ -92,8 +97,8 @@ scheduler::TimingSummary MeasureWakeLatency(const TwinRunOptions& t) {
 
 std::vector<analysis::TuneWarning> MachineWarnings() {
   // The findings that change the timing this procedure measures; doctor lists the rest.
-  constexpr std::array<std::string_view, 4> kDeciding = {"governor", "sched_fifo",
-                                                         "virtualisation", "steal_time"};
+  constexpr std::array<std::string_view, 4> kDeciding = {"governor", "sched_fifo", "virtualisation",
+                                                         "steal_time"};
   const kernel_glue::ProbeReport probe = kernel_glue::RunRtProbe();
   std::vector<analysis::TuneWarning> warnings;
   for (const std::string_view id : kDeciding) {

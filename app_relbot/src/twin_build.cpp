@@ -38,8 +38,8 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
     Usage("--rate " + Num(o.session.rate_hz) + ": " + e.what());
   }
   twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
-  twin->pwm_source = std::make_unique<ProfilePwmSource>(*twin->profile, o.controller_rate_hz,
-                                                        o.session.rate_hz);
+  twin->pwm_source =
+      std::make_unique<ProfilePwmSource>(*twin->profile, o.controller_rate_hz, o.session.rate_hz);
   // Only the mock board plays the profile; on a wire or real SPI the controller drives the PWM.
   const bool profile_drives = twin->backend->kind() == io::BackendSpec::Kind::kMock;
   if (io::EmulatedFpga* board = twin->backend->emulated_board();

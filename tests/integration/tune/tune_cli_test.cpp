@@ -6,13 +6,12 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <thread>
-
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fakes/process.h"
@@ -29,9 +28,16 @@ hiltwin::test::RunResult Tune(std::vector<std::string> extra, int timeout_ms = 2
 
 /// The thesis's costs (§3.8.2: overhead 35 us, compute 85 us) on the virtual clock, short runs.
 std::vector<std::string> ThesisVirtual(std::vector<std::string> extra) {
-  std::vector<std::string> argv = {"--clock", "virtual", "--inject-compute-us", "85",
-                                   "--inject-overhead-us", "35", "--inject-latency-us", "0",
-                                   "--validate-seconds", "3"};
+  std::vector<std::string> argv = {"--clock",
+                                   "virtual",
+                                   "--inject-compute-us",
+                                   "85",
+                                   "--inject-overhead-us",
+                                   "35",
+                                   "--inject-latency-us",
+                                   "0",
+                                   "--validate-seconds",
+                                   "3"};
   argv.insert(argv.end(), extra.begin(), extra.end());
   return argv;
 }
@@ -125,10 +131,9 @@ TEST(TuneCli, TheTextReportHasTheValidationTableAndNamesTheDecidingBound) {
 TEST(TuneCli, AMachineTooSlowForTheControllerRateExitsThree) {
   // 300 us of work and 1 ms of wake-up latency: the latency-aware maximum is 1 / 1.3 ms =
   // 769 Hz, below the 1 kHz controller, so no rate can answer every controller sample.
-  const hiltwin::test::RunResult r =
-      Tune({"--clock", "virtual", "--inject-compute-us", "250", "--inject-overhead-us", "50",
-            "--inject-latency-us", "1000", "--validate-seconds", "0.5", "--candidates",
-            "1000,2000"});
+  const hiltwin::test::RunResult r = Tune(
+      {"--clock", "virtual", "--inject-compute-us", "250", "--inject-overhead-us", "50",
+       "--inject-latency-us", "1000", "--validate-seconds", "0.5", "--candidates", "1000,2000"});
   EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
   EXPECT_NE(r.out.find("769"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("below the controller"), std::string::npos) << r.err;
@@ -136,8 +141,8 @@ TEST(TuneCli, AMachineTooSlowForTheControllerRateExitsThree) {
 
 TEST(TuneCli, OnTheRealClockItMeasuresThisMachineAndValidatesEveryCandidate) {
   const hiltwin::test::RunResult r =
-      Tune({"--json", "--candidates", "1000,2000", "--validate-seconds", "0.3",
-            "--latency-seconds", "0.2", "--priority", "0"});
+      Tune({"--json", "--candidates", "1000,2000", "--validate-seconds", "0.3", "--latency-seconds",
+            "0.2", "--priority", "0"});
   ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.err;  // a stalled VM may flag it
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_GT(j.at("measured").at("step_compute_us").at("mean").get<double>(), 0.0);
@@ -149,7 +154,7 @@ TEST(TuneCli, OnTheRealClockItMeasuresThisMachineAndValidatesEveryCandidate) {
 TEST_F(TuneFiles, OnTheRealClockSigintStopsTheProcedureAndRecommendsNothing) {
   // Without --no-progress and without a terminal, tune prints one line per step on stderr.
   hiltwin::kernel_glue::Process tune = hiltwin::test::Spawn(
-      {HILTWIN_BINARY, "tune", "--candidates", "1000,2000", "--validate-seconds", "30",
+      {HILTWIN_BINARY, "tune", "--candidates", "1000,2000", "--validate-seconds", "10",
        "--latency-seconds", "0.2", "--priority", "0"},
       Path("out.txt"));
   bool validating = false;

@@ -2,13 +2,12 @@
 // figures (overhead 35 us + compute 85 us, §3.8.2) give its recommendation, the validation
 // verdicts follow from the costs exactly, the accuracy bound decides when the tolerance asks
 // for more, and two runs give the same report.
-#include "hiltwin/app_relbot/tune.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "hiltwin/app_relbot/command.h"
+#include "hiltwin/app_relbot/tune.h"
 
 namespace hiltwin::app {
 namespace {

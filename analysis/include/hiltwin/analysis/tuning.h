@@ -76,22 +76,22 @@ struct AccuracySearch {
 /// error falls with the rate: a twin at a multiple of the controller's rate sees every
 /// controller sample at a release). Evaluates the highest multiple first; when it fails there
 /// is no bound. Each rate is evaluated at most once.
-[[nodiscard]] AccuracySearch AccuracyBound(const std::function<double(double rate_hz)>& rms_error_at,
-                                           const TuningPolicy& policy);
+[[nodiscard]] AccuracySearch AccuracyBound(
+    const std::function<double(double rate_hz)>& rms_error_at, const TuningPolicy& policy);
 
 /// The recommendation and every figure it came from.
 struct Recommendation {
-  double timing_max_hz = 0.0;   ///< 1 / (loop_overhead + mean step compute), method 2
+  double timing_max_hz = 0.0;  ///< 1 / (loop_overhead + mean step compute), method 2
   /// 1 / (worst p99.9 wake latency over the measured rates + p99.9 step compute + overhead):
   /// the highest rate whose deadline (= period) holds the p99.9 cycle. The worst rate's
   /// latency is used because latency between measured rates is unknown.
   double latency_max_hz = 0.0;
   double worst_latency_p999_ns = 0.0;  ///< the latency figure latency_max_hz used
-  double heuristic_hz = 0.0;     ///< fraction_of_max * timing_max clamped to the 4-10x window
+  double heuristic_hz = 0.0;           ///< fraction_of_max * timing_max clamped to the 4-10x window
   std::optional<double> accuracy_bound_hz;
-  double recommended_hz = 0.0;   ///< whole hertz
+  double recommended_hz = 0.0;  ///< whole hertz
   DecidingBound deciding_bound = DecidingBound::kTimingFraction;
-  std::string reason;            ///< one sentence: which bound decided and with what figures
+  std::string reason;                 ///< one sentence: which bound decided and with what figures
   std::vector<std::string> warnings;  ///< e.g. the timing cannot reach 4x the controller rate
 };
 
@@ -111,12 +111,12 @@ struct Recommendation {
 /// One validation run.
 struct CandidateResult {
   double rate_hz = 0.0;
-  std::uint64_t releases = 0;          ///< judged releases
+  std::uint64_t releases = 0;  ///< judged releases
   std::uint64_t deadline_misses = 0;
   double miss_pct = 0.0;
-  std::string qos_verdict;             ///< "PASS", "FLAGGED", "ABORTED"
-  double rms_error_m = 0.0;            ///< as the controller sees it, against the reference
-  bool recommended = false;            ///< the recommended rate (added to the list if absent)
+  std::string qos_verdict;   ///< "PASS", "FLAGGED", "ABORTED"
+  double rms_error_m = 0.0;  ///< as the controller sees it, against the reference
+  bool recommended = false;  ///< the recommended rate (added to the list if absent)
 };
 
 /// What the validation table says.

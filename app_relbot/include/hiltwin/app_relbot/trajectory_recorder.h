@@ -25,9 +25,7 @@ class TrajectoryRecorder final : public runtime::RunTask {
     return twin_.Exchange(live_outputs);
   }
   runtime::StepStatus Step(const scheduler::CycleContext& context) noexcept override;
-  [[nodiscard]] std::vector<std::string> LogColumns() const override {
-    return twin_.LogColumns();
-  }
+  [[nodiscard]] std::vector<std::string> LogColumns() const override { return twin_.LogColumns(); }
   [[nodiscard]] double LogTimeS() const noexcept override { return twin_.LogTimeS(); }
   void FillLogRow(std::span<double> values) const noexcept override { twin_.FillLogRow(values); }
 

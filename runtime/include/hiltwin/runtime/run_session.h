@@ -48,7 +48,7 @@ struct PeerWait {
   /// Waiting longer than this ends the run as an I/O fault; 0: start at once without waiting
   /// (cycles without a peer are then counted as peer_absent_cycles).
   double timeout_s = 30.0;
-  std::string start_hint;        ///< the command that starts the other side, for messages
+  std::string start_hint;  ///< the command that starts the other side, for messages
 };
 
 /// A validated run, as plain data (cactus-rt style config struct).
