@@ -269,7 +269,15 @@ analysis::CandidateResult TuneProcedure::RunRecorded(double rate_hz, bool virtua
   result.deadline_misses = run.misses.misses_judged;
   result.miss_pct = run.misses.miss_pct_judged;
   result.qos_verdict = qos::ToString(run.verdict);
-  result.rms_error_m = analysis::ControllerViewRmsError(recorder.trajectory(), reference_);
+  // A run cut short by SIGINT at its start has no error to report, and tune ends here.
+  StopIfAsked("the error of the " + Num(rate_hz) + " Hz run");
+  try {
+    result.rms_error_m = analysis::ControllerViewRmsError(recorder.trajectory(), reference_);
+  } catch (const std::invalid_argument&) {
+    // A run that ended before the first controller sample (a fault at start-up) has no error;
+    // NaN is "not measured" in the summary and null in the JSON.
+    result.rms_error_m = std::numeric_limits<double>::quiet_NaN();
+  }
   return result;
 }
 
