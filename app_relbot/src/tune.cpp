@@ -107,9 +107,7 @@ InputProfile DutyAsTheBoardReadsIt(const InputProfile& profile, double controlle
 /// Reference positions at every controller sample instant of the validation window: the same
 /// model integrated by Boost.Odeint's adaptive Dormand-Prince at 1e-10 tolerances (a "much
 /// higher rate" than any twin), sampled without delay.
-analysis::ReferenceSamples MakeReference(const TuneOptions& o) {
-  Twin twin;
-  LoadTwinConfiguration(TwinOptionsFor(o, o.controller_rate_hz, o.validate_seconds, true), twin);
+analysis::ReferenceSamples MakeReference(const TuneOptions& o, const Twin& twin) {
   const double controller_period_s = 1.0 / o.controller_rate_hz;
   ReferenceOptions reference;
   reference.input_hold_s = controller_period_s;
@@ -133,6 +131,8 @@ class TuneProcedure {
     policy_.controller_rate_hz = o.controller_rate_hz;
     policy_.tolerance_m = o.tolerance_m;
     policy_.max_rate_hz = scheduler::kMaxRateHz;
+    LoadTwinConfiguration(TwinOptionsFor(o, o.controller_rate_hz, o.validate_seconds, true),
+                          config_);
     const double multiples = std::floor(policy_.max_rate_hz / o.controller_rate_hz);
     const double accuracy_steps = std::ceil(std::log2(std::max(multiples, 1.0))) + 1.0;
     steps_total_ = 3.0 + static_cast<double>(o.candidates_hz.size()) * 2.0 + 1.0 + accuracy_steps;
@@ -145,13 +145,14 @@ class TuneProcedure {
     report.policy = policy_;
     Measure(report);
     Next("searching the accuracy bound (virtual runs against the reference)");
-    reference_ = MakeReference(o_);
-    report.input = reference_input_;
+    reference_ = MakeReference(o_, config_);
+    report.input = config_.profile->name();
     report.accuracy = analysis::AccuracyBound(
-        [this](double rate_hz) {
+        [this, max_stable_step_s =
+                   RelbotMaxStableStepS(config_.params, config_.integrator)](double rate_hz) {
           Next("accuracy at " + Num(rate_hz) + " Hz");
           // A rate the integrator cannot run stably is no bound; the search goes higher.
-          if (1.0 / rate_hz > max_stable_step_s_) return std::numeric_limits<double>::infinity();
+          if (1.0 / rate_hz > max_stable_step_s) return std::numeric_limits<double>::infinity();
           return RunRecorded(rate_hz, true, {}).rms_error_m;
         },
         policy_);
@@ -187,8 +188,7 @@ class TuneProcedure {
   const TuneProgress& progress_;
   analysis::TuningPolicy policy_;
   analysis::ReferenceSamples reference_;
-  std::string reference_input_;
-  double max_stable_step_s_ = 0.0;
+  Twin config_;  ///< parameters, integrator and profile, loaded once (no board, no task)
   StepCost step_;
   double steps_total_ = 1.0;
   double steps_done_ = 0.0;
@@ -202,9 +202,8 @@ void TuneProcedure::Measure(analysis::TuneReport& report) {
     report.machine_warnings = MachineWarnings();
   }
   Next("timing the model step");
-  step_ = o_.inject_compute_us
-              ? InjectedStepCost(NsOfUs(*o_.inject_compute_us))
-              : MeasureStepCost(TwinOptionsFor(o_, o_.candidates_hz.back(), 1.0, true));
+  step_ = o_.inject_compute_us ? InjectedStepCost(NsOfUs(*o_.inject_compute_us))
+                               : MeasureStepCost(config_, o_.candidates_hz.back());
   m.step_compute = step_.summary;
   Next("timing the loop's own work per cycle");
   m.loop_overhead_ns =
@@ -222,11 +221,7 @@ void TuneProcedure::Measure(analysis::TuneReport& report) {
           {rate_hz, MeasureWakeLatency(TwinOptionsFor(o_, rate_hz, o_.latency_seconds, false))});
     }
   }
-  Twin twin;
-  LoadTwinConfiguration(TwinOptionsFor(o_, o_.controller_rate_hz, 1.0, true), twin);
-  report.model = "RELbot twin, " + std::string(IntegratorName(twin.integrator));
-  reference_input_ = twin.profile->name();
-  max_stable_step_s_ = RelbotMaxStableStepS(twin.params, twin.integrator);
+  report.model = "RELbot twin, " + std::string(IntegratorName(config_.integrator));
 }
 
 void TuneProcedure::Validate(analysis::TuneReport& report) {

@@ -35,10 +35,8 @@ SessionRole TuneRole(double controller_rate_hz) {
   return {"tune", "controller", "hiltwin ecs", controller_rate_hz};
 }
 
-StepCost MeasureStepCost(const TwinRunOptions& t) {
-  Twin twin;
-  LoadTwinConfiguration(t, twin);
-  const double step_s = 1.0 / t.session.rate_hz;
+StepCost MeasureStepCost(const Twin& twin, double rate_hz) {
+  const double step_s = 1.0 / rate_hz;
   RelbotModel model(twin.params, twin.integrator, step_s);
   kernel_glue::MonotonicClock clock;
   scheduler::TimingStats stats;

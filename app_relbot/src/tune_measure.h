@@ -7,6 +7,7 @@
 #include "hiltwin/analysis/tuning_report.h"
 #include "hiltwin/app_relbot/session_options.h"
 #include "hiltwin/app_relbot/tune.h"
+#include "hiltwin/app_relbot/twin_build.h"
 #include "hiltwin/app_relbot/twin_run.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/scheduler/timing_stats.h"
@@ -28,9 +29,10 @@ struct StepCost {
   std::vector<kernel_glue::TimeNs> samples_ns;
 };
 
-/// Times RelbotModel::Step alone, `kStepWarmup` steps and then `kStepSamples` timed ones,
-/// driven by the input profile so every branch of the castor friction is taken.
-[[nodiscard]] StepCost MeasureStepCost(const TwinRunOptions& t);
+/// Times RelbotModel::Step alone (twin's parameters and integrator, the step of `rate_hz`),
+/// `kStepWarmup` steps and then `kStepSamples` timed ones, driven by twin's input profile so
+/// every branch of the castor friction is taken. Only the configuration of `twin` is used.
+[[nodiscard]] StepCost MeasureStepCost(const Twin& twin, double rate_hz);
 
 /// An injected step cost: one sample, every figure equal to it.
 [[nodiscard]] StepCost InjectedStepCost(kernel_glue::TimeNs ns);
