@@ -17,6 +17,9 @@ packages=(
   rt-tests valgrind bc                          # cyclictest peer, callgrind counts, bench arithmetic
   clang-tidy                                    # scripts/tidy.sh: the function-size rule
   gnuplot-nox                                   # `hiltwin assess --plot`
+  cyclonedds-dev cyclonedds-tools               # telemetry over DDS (idlc generates the types)
+  libcpp-httplib-dev                            # the live web page (--web)
+  chromium                                      # the web page test (headless)
 )
 
 # One dpkg-query for all: names it does not know at all are missing too.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hiltwin/io/icoboard.h"
+#include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/scheduler/cycle.h"
 
 namespace hiltwin::runtime {
@@ -51,6 +52,12 @@ class RunTask {
   /// LogColumns() entry. Real-time path.
   [[nodiscard]] virtual double LogTimeS() const noexcept = 0;
   virtual void FillLogRow(std::span<double> values) const noexcept = 0;
+
+  /// What the task publishes as telemetry (telemetry.h); called once, before the run.
+  [[nodiscard]] virtual TelemetryShape TelemetryShapeOf() const { return {}; }
+  /// The task's telemetry values for the last completed step, matching TelemetryShapeOf().
+  /// Real-time path: called every cycle while telemetry is on.
+  virtual void FillTelemetry(TaskTelemetry& out) const noexcept { static_cast<void>(out); }
 };
 
 }  // namespace hiltwin::runtime

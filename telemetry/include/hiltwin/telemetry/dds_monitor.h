@@ -1,0 +1,54 @@
+#pragma once
+/// `hiltwin monitor`'s side of DDS: finds every hiltwin task on a domain (any participant that
+/// publishes an `rt/<ns>/timing` topic, found through DDS's built-in publication topic, as
+/// `ros2 topic list` does), reads their timing records, and sends commands to one of them.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hiltwin/runtime/telemetry.h"
+
+namespace hiltwin::telemetry {
+
+/// The latest timing record of one task on the domain.
+struct MonitorEntry {
+  std::string ns;
+  std::string role;
+  double rate_hz = 0.0;
+  double time_s = 0.0;
+  std::uint64_t cycle = 0;
+  std::uint64_t cycles_planned = 0;
+  std::uint64_t deadline_misses = 0;
+  double latency_p99_us = 0.0;
+  std::optional<std::uint32_t> distance_to_violation;
+  std::string verdict;  ///< "PASS", "FLAGGED", "ABORTED"
+  std::string state;    ///< lifecycle state name
+  bool final = false;   ///< the task has published its last record
+  double age_s = 0.0;   ///< since this entry's last record arrived (monitor's monotonic clock)
+};
+
+class DdsMonitor {
+ public:
+  /// Joins `domain` as a participant; throws std::invalid_argument / std::runtime_error.
+  explicit DdsMonitor(std::uint32_t domain);
+  ~DdsMonitor();
+  DdsMonitor(const DdsMonitor&) = delete;
+  DdsMonitor& operator=(const DdsMonitor&) = delete;
+
+  /// Discovers new tasks and takes every record that arrived; returns every task seen so far,
+  /// sorted by namespace.
+  [[nodiscard]] std::vector<MonitorEntry> Poll();
+
+  /// Sends `command` to rt/<ns>/command once a reader there is matched, waiting up to
+  /// `timeout_s`. Returns "" when delivered, else why not (for the message; exit 2).
+  [[nodiscard]] std::string SendCommand(const std::string& ns, runtime::RemoteCommand command,
+                                        double timeout_s);
+
+ private:
+  struct State;
+  State* state_;
+};
+
+}  // namespace hiltwin::telemetry
