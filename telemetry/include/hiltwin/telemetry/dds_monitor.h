@@ -31,7 +31,8 @@ struct MonitorEntry {
 
 class DdsMonitor {
  public:
-  /// Joins `domain` as a participant; throws std::invalid_argument / std::runtime_error.
+  /// Joins `domain` as a participant; throws std::invalid_argument (domain above 232) or
+  /// std::runtime_error (Cyclone refused: the message says how to fix it).
   explicit DdsMonitor(std::uint32_t domain);
   ~DdsMonitor();
   DdsMonitor(const DdsMonitor&) = delete;
@@ -41,8 +42,12 @@ class DdsMonitor {
   /// sorted by namespace.
   [[nodiscard]] std::vector<MonitorEntry> Poll();
 
+  /// Every namespace discovered so far (a task may be listed before its first record).
+  [[nodiscard]] std::vector<std::string> Namespaces() const;
+
   /// Sends `command` to rt/<ns>/command once a reader there is matched, waiting up to
-  /// `timeout_s`. Returns "" when delivered, else why not (for the message; exit 2).
+  /// `timeout_s`, then waits up to 2 s for the reader's acknowledgement. Returns "" when
+  /// delivered, else why not (for the message; exit 2).
   [[nodiscard]] std::string SendCommand(const std::string& ns, runtime::RemoteCommand command,
                                         double timeout_s);
 

@@ -1,0 +1,225 @@
+// `--telemetry dds[:DOMAIN]`: one task's telemetry as ROS 2 topics (sinks.h). Every call after
+// Open comes from the telemetry thread, so the sink needs no lock; Publish and PollCommands
+// never throw and never wait on the network.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dds_common.h"
+#include "hiltwin/telemetry/sinks.h"
+#include "ros_types.h"
+
+namespace hiltwin::telemetry {
+namespace {
+
+using runtime::RemoteCommand;
+
+// A task time in seconds as builtin_interfaces/Time (sec, nanosec in [0, 1e9)).
+builtin_interfaces_msg_dds__Time_ StampOf(double time_s) noexcept {
+  constexpr double kNsPerS = 1e9;
+  if (!std::isfinite(time_s) || time_s < 0.0) return {0, 0};
+  double whole_s = std::floor(time_s);
+  double ns = std::round((time_s - whole_s) * kNsPerS);
+  if (ns >= kNsPerS) {  // 0.9999999999 s rounds up to the next second
+    whole_s += 1.0;
+    ns = 0.0;
+  }
+  return {static_cast<std::int32_t>(whole_s), static_cast<std::uint32_t>(ns)};
+}
+
+class DdsSink final : public runtime::TelemetrySink {
+ public:
+  explicit DdsSink(std::uint32_t domain)
+      : domain_(domain),
+        participant_(dds::CreateParticipant(domain, "--telemetry dds:" + std::to_string(domain))) {}
+
+  void Open(const runtime::TelemetryShape& shape, const std::string& ns) override;
+  void Publish(const runtime::TelemetryRecord& record) noexcept override;
+  void PollCommands(const runtime::CommandPort& port) noexcept override;
+  [[nodiscard]] std::string Describe() const override;
+
+ private:
+  void PublishJoints(const runtime::TelemetryRecord& record) noexcept;
+  void PublishTiming(const runtime::TelemetryRecord& record) noexcept;
+  void Write(dds_entity_t writer, const void* sample, const char* leaf) noexcept;
+  void Handle(std::int32_t code, const runtime::CommandPort& port) const noexcept;
+
+  std::uint32_t domain_;
+  dds::Entity participant_;  // owns every topic, writer and reader below
+  bool has_pose_ = false;
+  std::string ns_;
+  std::string command_topic_;
+  dds_entity_t pose_writer_ = 0;
+  dds_entity_t joints_writer_ = 0;
+  dds_entity_t timing_writer_ = 0;
+  dds_entity_t command_reader_ = 0;
+  std::vector<std::string> joint_names_;
+  std::vector<char*> joint_name_ptrs_;  // JointState_::name points here (Cyclone's char**)
+  std::uint64_t write_failures_ = 0;    // the first is reported, the rest only counted
+};
+
+void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) {
+  if (!ns_.empty()) throw std::runtime_error("DDS telemetry: the sink is already open as " + ns_);
+  if (shape.joint_names.size() > runtime::kMaxTelemetryJoints) {
+    throw std::runtime_error("DDS telemetry: " + std::to_string(shape.joint_names.size()) +
+                             " joints; at most " + std::to_string(runtime::kMaxTelemetryJoints));
+  }
+  const dds_entity_t pp = participant_.get();
+  // Samples are the latest state: a slow reader loses old ones rather than slowing us down.
+  const dds::QosPtr stream = dds::MakeQos(10, dds::Durability::kVolatile);
+  // Depth 1 and transient-local: a monitor that joins late sees every task at once.
+  const dds::QosPtr latest = dds::MakeQos(1, dds::Durability::kTransientLocal);
+  const dds::QosPtr commands = dds::MakeQos(32, dds::Durability::kVolatile);
+  has_pose_ = shape.has_pose;
+  if (has_pose_) {
+    const std::string name = dds::TopicName(ns, "pose");
+    pose_writer_ = dds::Check(
+        dds_create_writer(pp, dds::CreateTopic(pp, &geometry_msgs_msg_dds__Pose2D__desc, name),
+                          stream.get(), nullptr),
+        "DDS writer " + name);
+  }
+  const std::string joints = dds::TopicName(ns, "joint_states");
+  joints_writer_ = dds::Check(
+      dds_create_writer(pp, dds::CreateTopic(pp, &sensor_msgs_msg_dds__JointState__desc, joints),
+                        stream.get(), nullptr),
+      "DDS writer " + joints);
+  const std::string timing = dds::TopicName(ns, "timing");
+  timing_writer_ =
+      dds::Check(dds_create_writer(pp, dds::CreateTopic(pp, &hiltwin_msg_dds__Timing__desc, timing),
+                                   latest.get(), nullptr),
+                 "DDS writer " + timing);
+  command_topic_ = dds::TopicName(ns, "command");
+  command_reader_ = dds::Check(
+      dds_create_reader(pp, dds::CreateTopic(pp, &std_msgs_msg_dds__Int32__desc, command_topic_),
+                        commands.get(), nullptr),
+      "DDS reader " + command_topic_);
+  joint_names_ = shape.joint_names;
+  joint_name_ptrs_.clear();
+  for (std::string& name : joint_names_) joint_name_ptrs_.push_back(name.data());
+  ns_ = ns;
+}
+
+void DdsSink::Publish(const runtime::TelemetryRecord& record) noexcept {
+  if (timing_writer_ <= 0) return;  // not open
+  if (has_pose_) {
+    const geometry_msgs_msg_dds__Pose2D_ pose{record.task.x_m, record.task.y_m,
+                                              record.task.theta_rad};
+    Write(pose_writer_, &pose, "pose");
+  }
+  PublishJoints(record);
+  PublishTiming(record);
+}
+
+void DdsSink::PublishJoints(const runtime::TelemetryRecord& record) noexcept {
+  static char empty[] = "";  // Cyclone's char* fields are not const; it only reads them
+  std::array<double, runtime::kMaxTelemetryJoints> position_rad = record.task.joint_position_rad;
+  const auto count = static_cast<std::uint32_t>(
+      std::min<std::size_t>(record.task.joint_count, joint_name_ptrs_.size()));
+  sensor_msgs_msg_dds__JointState_ msg{};
+  msg.header.stamp = StampOf(record.time_s);
+  msg.header.frame_id = empty;
+  msg.name = {count, count, joint_name_ptrs_.data(), false};
+  msg.position = {count, count, position_rad.data(), false};
+  msg.velocity = {0, 0, nullptr, false};
+  msg.effort = {0, 0, nullptr, false};
+  Write(joints_writer_, &msg, "joint_states");
+}
+
+void DdsSink::PublishTiming(const runtime::TelemetryRecord& record) noexcept {
+  hiltwin_msg_dds__Timing_ msg{};
+  msg.ns = ns_.data();
+  msg.role = const_cast<char*>(record.role.c_str());
+  msg.rate_hz = record.rate_hz;
+  msg.time_s = record.time_s;
+  msg.cycle = record.cycle;
+  msg.cycles_planned = record.cycles_planned;
+  msg.deadline_misses = record.deadline_misses;
+  msg.latency_p99_us = record.latency_p99_us;
+  msg.latency_max_us = record.latency_max_us;
+  msg.distance_to_violation =
+      record.distance_to_violation ? static_cast<std::int64_t>(*record.distance_to_violation) : -1;
+  msg.verdict = const_cast<char*>(qos::ToString(record.verdict_so_far));
+  msg.state = const_cast<char*>(statemachine::ToString(record.state));
+  msg.final = record.final;
+  Write(timing_writer_, &msg, "timing");
+}
+
+void DdsSink::Write(dds_entity_t writer, const void* sample, const char* leaf) noexcept {
+  const dds_return_t rc = dds_write(writer, sample);
+  if (rc >= 0) return;
+  if (write_failures_++ == 0) {
+    std::fprintf(stderr,
+                 "hiltwin: DDS write on rt/%s/%s failed (%s); telemetry goes on, further "
+                 "failures are not reported\n",
+                 ns_.c_str(), leaf, dds_strretcode(rc));
+  }
+}
+
+void DdsSink::PollCommands(const runtime::CommandPort& port) noexcept {
+  if (command_reader_ <= 0) return;
+  constexpr std::size_t kBatch = 16;
+  for (;;) {
+    std::array<void*, kBatch> samples{};  // null: Cyclone lends its own buffers
+    std::array<dds_sample_info_t, kBatch> infos{};
+    const dds_return_t n = dds_take(command_reader_, samples.data(), infos.data(), kBatch, kBatch);
+    if (n <= 0) return;
+    const auto taken = static_cast<std::size_t>(n);
+    for (std::size_t i = 0; i < taken; ++i) {
+      if (infos[i].valid_data)
+        Handle(static_cast<const std_msgs_msg_dds__Int32_*>(samples[i])->data, port);
+    }
+    static_cast<void>(dds_return_loan(command_reader_, samples.data(), n));
+    if (taken < kBatch) return;
+  }
+}
+
+// One stderr line per command, accepted or not: this runs on the telemetry thread, where
+// printing is allowed, and a user who sent a command wants to see what became of it.
+void DdsSink::Handle(std::int32_t code, const runtime::CommandPort& port) const noexcept {
+  const std::optional<RemoteCommand> command = runtime::RemoteCommandOf(code);
+  if (!command) {
+    std::fprintf(stderr,
+                 "hiltwin: ignored command code %d on %s: not a command (1 INITIALISE, 2 START, "
+                 "3 STOP, 4 RESET, 5 PAUSE, 6 QUIT)\n",
+                 static_cast<int>(code), command_topic_.c_str());
+    return;
+  }
+  try {
+    std::string why;
+    if (port && port(*command, why)) {
+      std::fprintf(stderr, "hiltwin: %s received on %s\n", runtime::ToString(*command),
+                   command_topic_.c_str());
+    } else {
+      std::fprintf(stderr, "hiltwin: %s on %s refused: %s\n", runtime::ToString(*command),
+                   command_topic_.c_str(),
+                   why.empty() ? "this task takes no commands" : why.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hiltwin: %s on %s failed: %s\n", runtime::ToString(*command),
+                 command_topic_.c_str(), e.what());
+  } catch (...) {
+    std::fprintf(stderr, "hiltwin: %s on %s failed\n", runtime::ToString(*command),
+                 command_topic_.c_str());
+  }
+}
+
+std::string DdsSink::Describe() const {
+  const std::string domain = "DDS domain " + std::to_string(domain_);
+  if (ns_.empty()) return domain;
+  return domain + " rt/" + ns_ +
+         (has_pose_ ? "/{pose,joint_states,timing,command}" : "/{joint_states,timing,command}");
+}
+
+}  // namespace
+
+std::shared_ptr<runtime::TelemetrySink> MakeDdsSink(const DdsEndpoint& endpoint) {
+  return std::make_shared<DdsSink>(endpoint.domain);
+}
+
+}  // namespace hiltwin::telemetry

@@ -1,0 +1,95 @@
+#pragma once
+// In-process DDS peers for the sink and monitor tests: a participant of the test's own with
+// typed readers and writers, over the shipped loopback configuration.
+#include <dds/dds.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <thread>
+
+#include "ros_types.h"
+
+namespace hiltwin::test {
+
+/// Every DDS test runs over config/cyclonedds-loopback.xml (set before the first participant).
+inline void UseLoopbackDds() { ::setenv("CYCLONEDDS_URI", "file://" HILTWIN_DDS_CONFIG, 1); }
+
+/// A namespace no other process on this machine uses (a second checkout's tests, say).
+inline std::string UniqueNamespace(const std::string& leaf) {
+  return "t" + std::to_string(::getpid()) + "/" + leaf;
+}
+
+/// Polls `done` every 5 ms until it holds or `timeout_ms` passes (generous on a loaded machine).
+inline bool WaitFor(const std::function<bool()>& done, int timeout_ms = 5000) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+/// The test's own participant on `domain`.
+class Peer {
+ public:
+  explicit Peer(std::uint32_t domain)
+      : participant_(
+            dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr)) {}
+  ~Peer() {
+    if (participant_ > 0) dds_delete(participant_);
+  }
+  Peer(const Peer&) = delete;
+  Peer& operator=(const Peer&) = delete;
+
+  [[nodiscard]] dds_entity_t participant() const { return participant_; }
+
+  /// A reliable reader (transient-local when `late_joiner`, to get a writer's last sample).
+  dds_entity_t Reader(const dds_topic_descriptor_t* desc, const std::string& topic,
+                      bool late_joiner = false) const {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 100);
+    if (late_joiner) dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+    const dds_entity_t t = dds_create_topic(participant_, desc, topic.c_str(), nullptr, nullptr);
+    const dds_entity_t r = dds_create_reader(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    return r;
+  }
+
+  dds_entity_t Writer(const dds_topic_descriptor_t* desc, const std::string& topic) const {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    const dds_entity_t t = dds_create_topic(participant_, desc, topic.c_str(), nullptr, nullptr);
+    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    return w;
+  }
+
+ private:
+  dds_entity_t participant_;
+};
+
+/// Takes one sample of `reader` into `out` (deep copy through `copy`); false when none.
+template <typename Sample, typename Copy>
+bool TakeOne(dds_entity_t reader, Copy&& copy) {
+  void* sample = nullptr;
+  dds_sample_info_t info{};
+  const dds_return_t n = dds_take(reader, &sample, &info, 1, 1);
+  if (n <= 0) return false;
+  const bool valid = info.valid_data;
+  if (valid) copy(*static_cast<const Sample*>(sample));
+  dds_return_loan(reader, &sample, n);
+  return valid;
+}
+
+/// True once `writer` has a matched reader.
+inline bool Matched(dds_entity_t writer) {
+  dds_publication_matched_status_t status{};
+  return dds_get_publication_matched_status(writer, &status) >= 0 && status.current_count > 0;
+}
+
+}  // namespace hiltwin::test
