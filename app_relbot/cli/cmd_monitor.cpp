@@ -89,11 +89,11 @@ std::string FormatTable(const std::vector<MonitorEntry>& entries) {
   for (const MonitorEntry& e : entries) {
     const std::string distance =
         e.distance_to_violation ? std::to_string(*e.distance_to_violation) : "-";
-    std::snprintf(line, sizeof line, "%-*s  %-10s  %8s  %15s  %7llu  %8s  %9s  %-8s  %-9s  %6s\n",
+    std::snprintf(line, sizeof line, "%-*s  %-10s  %8s  %15s  %7llu  %8s  %9s  %-8s  %-9s  %6s%s\n",
                   w, e.ns.c_str(), e.role.c_str(), Fixed(e.rate_hz, 0).c_str(),
                   CyclesText(e).c_str(), static_cast<unsigned long long>(e.deadline_misses),
                   Fixed(e.latency_p99_us, 1).c_str(), distance.c_str(), e.verdict.c_str(),
-                  e.state.c_str(), (Fixed(e.age_s, 1) + (e.final ? "*" : "")).c_str());
+                  e.state.c_str(), Fixed(e.age_s, 1).c_str(), e.final ? "*" : "");
     out += line;
   }
   return out;
