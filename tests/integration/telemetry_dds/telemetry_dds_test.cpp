@@ -1,0 +1,275 @@
+// DDS telemetry end to end: the real `hiltwin run --telemetry dds:N` publishes, a subscriber
+// in another process (dds_probe, as `ros2 topic echo` would be) reads, `hiltwin monitor` lists
+// and stops twins. Each test has its own DDS domain and namespaces that carry the test's pid,
+// over the shipped loopback configuration, so `ctest -j` (and a second checkout's tests) run
+// side by side without crosstalk. Twins run on the real clock at a modest rate; a loaded
+// machine may flag them (exit 3), which no assertion here depends on.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "fakes/process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using hiltwin::kernel_glue::Process;
+using Json = nlohmann::json;
+
+constexpr auto kProcessTimeout = std::chrono::seconds(20);
+
+class TelemetryDds : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // Inherited by every process the test starts (twins, probes, monitor).
+    ::setenv("CYCLONEDDS_URI", "file://" HILTWIN_DDS_CONFIG, 1);
+    dir_ = fs::temp_directory_path() /
+           ("hiltwin_dds_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  [[nodiscard]] std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+
+  static std::string Ns(const std::string& leaf) {
+    return "t" + std::to_string(getpid()) + "/" + leaf;
+  }
+
+  // `hiltwin run` publishing on `domain` under `ns`, with its log and report in the test dir.
+  [[nodiscard]] std::vector<std::string> Twin(std::uint32_t domain, const std::string& ns,
+                                              const std::string& duration_s,
+                                              const std::string& input = "openloop") const {
+    const std::string tag = ns.substr(ns.find('/') + 1);
+    return {HILTWIN_BINARY,
+            "run",
+            "--no-progress",
+            "--duration",
+            duration_s,
+            "--rate",
+            "200",
+            "--priority",
+            "0",
+            "--input",
+            input,
+            "--telemetry",
+            "dds:" + std::to_string(domain),
+            "--namespace",
+            ns,
+            "--log",
+            Path(tag + ".csv"),
+            "--report",
+            Path(tag + ".json")};
+  }
+
+  // A probe of `ns`, started and listening (its readers exist) before this returns.
+  [[nodiscard]] Process Probe(std::uint32_t domain, const std::string& ns,
+                              const std::string& out) const {
+    Process probe = hiltwin::test::Spawn(
+        {HILTWIN_DDS_PROBE, "--domain", std::to_string(domain), "--ns", ns, "--duration", "18"},
+        Path(out));
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (ReadText(Path(out)).find("\"ready\"") == std::string::npos) {
+      EXPECT_LT(std::chrono::steady_clock::now(), deadline) << "probe not ready";
+      if (std::chrono::steady_clock::now() >= deadline) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return probe;
+  }
+
+  static std::string ReadText(const std::string& path) {
+    std::ifstream in(path);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+  static std::vector<Json> ReadLines(const std::string& path) {
+    std::vector<Json> lines;
+    std::istringstream in(ReadText(path));
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty()) lines.push_back(Json::parse(line));
+    }
+    return lines;
+  }
+
+  // The last row of a CSV log, by column name, in the log's column order.
+  static nlohmann::ordered_json LastCsvRow(const std::string& path) {
+    std::istringstream in(ReadText(path));
+    std::string header, line, last;
+    std::getline(in, header);
+    while (std::getline(in, line)) {
+      if (!line.empty()) last = line;
+    }
+    nlohmann::ordered_json row = nlohmann::ordered_json::object();
+    std::istringstream names(header), values(last);
+    for (std::string name, value;
+         std::getline(names, name, ',') && std::getline(values, value, ',');) {
+      row[name] = std::stod(value);
+    }
+    return row;
+  }
+
+  static std::vector<Json> Samples(const std::vector<Json>& lines, const std::string& topic) {
+    std::vector<Json> samples;
+    for (const Json& j : lines) {
+      if (j.value("topic", "") == topic && !j.contains("event")) samples.push_back(j);
+    }
+    return samples;
+  }
+
+  // A twin ends with 0 (PASS) or 3 (FLAGGED on a loaded machine), never otherwise.
+  static void ExpectCleanExit(Process& twin, const std::string& what) {
+    const auto status = twin.WaitFor(kProcessTimeout);
+    ASSERT_TRUE(status.has_value()) << what << " still running";
+    EXPECT_TRUE(status->Success() || (status->exited && status->code == 3))
+        << what << ": " << status->Describe();
+  }
+
+  // The probe's last pose equals the twin's last logged pose: the final record is published
+  // after the loop ends, from the same cycle as the log's last row.
+  void ExpectLastPoseIsTheLogs(const std::vector<Json>& lines, const std::string& csv) const {
+    const std::vector<Json> poses = Samples(lines, "pose");
+    ASSERT_FALSE(poses.empty());
+    const auto row = LastCsvRow(Path(csv));
+    ASSERT_TRUE(row.contains("x_m")) << row.dump();
+    EXPECT_NEAR(poses.back()["x"].get<double>(), row["x_m"].get<double>(), 1e-12);
+    EXPECT_NEAR(poses.back()["y"].get<double>(), row["y_m"].get<double>(), 1e-12);
+    EXPECT_NEAR(poses.back()["theta"].get<double>(), row["theta_rad"].get<double>(), 1e-12);
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(TelemetryDds, AProbeInAnotherProcessReadsTheTwinsTopicsWithRosTypeNames) {
+  constexpr std::uint32_t kDomain = 220;
+  const std::string ns = Ns("twin");
+  Process probe = Probe(kDomain, ns, "probe.jsonl");
+  Process twin = hiltwin::test::Spawn(Twin(kDomain, ns, "2"), Path("twin.out"));
+  ExpectCleanExit(twin, "twin");
+  ASSERT_TRUE(probe.WaitFor(kProcessTimeout).has_value()) << "probe still running";
+  const std::vector<Json> lines = ReadLines(Path("probe.jsonl"));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines.back()["event"], "end");
+  EXPECT_TRUE(lines.back()["final"].get<bool>()) << "no final timing record arrived";
+
+  const std::vector<Json> poses = Samples(lines, "pose");
+  EXPECT_GE(poses.size(), 2u) << "2 s at 50 Hz should give about 100";
+  for (const Json& p : poses) EXPECT_EQ(p["type"], "geometry_msgs::msg::dds_::Pose2D_");
+  ExpectLastPoseIsTheLogs(lines, "twin.csv");
+
+  const std::vector<Json> joints = Samples(lines, "joint_states");
+  ASSERT_FALSE(joints.empty());
+  EXPECT_EQ(joints.back()["type"], "sensor_msgs::msg::dds_::JointState_");
+  EXPECT_EQ(joints.back()["name"].size(), 2u);
+  EXPECT_EQ(joints.back()["position"].size(), 2u);
+  const auto row = LastCsvRow(Path("twin.csv"));
+  const double stamp_s =
+      joints.back()["sec"].get<double>() + joints.back()["nanosec"].get<double>() * 1e-9;
+  // The log's first column is the task's time.
+  EXPECT_NEAR(stamp_s, row.begin().value().get<double>(), 1e-6) << row.begin().key();
+
+  const std::vector<Json> timing = Samples(lines, "timing");
+  ASSERT_FALSE(timing.empty());
+  EXPECT_EQ(timing.back()["type"], "hiltwin::msg::dds_::Timing_");
+  EXPECT_EQ(timing.back()["ns"], ns);
+  EXPECT_EQ(timing.back()["role"], "twin");
+  EXPECT_TRUE(timing.back()["final"].get<bool>());
+  const Json report = Json::parse(ReadText(Path("twin.json")));
+  EXPECT_EQ(timing.back()["verdict"], report["verdict"]);
+  EXPECT_EQ(timing.back()["cycle"], report["cycles_run"]);
+}
+
+TEST_F(TelemetryDds, TwoTwinsOnOneDomainDoNotMixAndTheMonitorListsBoth) {
+  constexpr std::uint32_t kDomain = 221;
+  const std::string ns_a = Ns("a");
+  const std::string ns_b = Ns("b");
+  // Twin b spins in place: its pose differs from the open-loop twin a's at every moment.
+  std::ofstream(Path("spin.csv")) << "time,left,right\n0,0.4,-0.4\n10,0.4,-0.4\n";
+  Process probe_a = Probe(kDomain, ns_a, "a.jsonl");
+  Process probe_b = Probe(kDomain, ns_b, "b.jsonl");
+  Process twin_a = hiltwin::test::Spawn(Twin(kDomain, ns_a, "4"), Path("a.out"));
+  Process twin_b = hiltwin::test::Spawn(Twin(kDomain, ns_b, "4", Path("spin.csv")), Path("b.out"));
+
+  const auto monitor = hiltwin::test::Run(
+      {HILTWIN_BINARY, "monitor", "--json", "--domain", std::to_string(kDomain), "--wait", "2.5"});
+  ASSERT_EQ(monitor.exit_code, 0) << monitor.out << monitor.err;
+  const Json listed = Json::parse(monitor.out);
+  EXPECT_EQ(listed["domain"], kDomain);
+  std::map<std::string, Json> tasks;
+  for (const Json& t : listed["tasks"]) tasks[t["ns"].get<std::string>()] = t;
+  ASSERT_TRUE(tasks.contains(ns_a) && tasks.contains(ns_b)) << monitor.out;
+  for (const std::string& ns : {ns_a, ns_b}) {
+    EXPECT_EQ(tasks[ns]["role"], "twin");
+    EXPECT_EQ(tasks[ns]["rate_hz"], 200.0);
+    EXPECT_EQ(tasks[ns]["cycles_planned"], 800);
+    EXPECT_LT(tasks[ns]["age_s"].get<double>(), 2.0) << "records keep arriving while it runs";
+  }
+
+  ExpectCleanExit(twin_a, "twin a");
+  ExpectCleanExit(twin_b, "twin b");
+  ASSERT_TRUE(probe_a.WaitFor(kProcessTimeout).has_value());
+  ASSERT_TRUE(probe_b.WaitFor(kProcessTimeout).has_value());
+  for (const auto& [ns, other, file] :
+       {std::tuple{ns_a, ns_b, std::string("a")}, std::tuple{ns_b, ns_a, std::string("b")}}) {
+    SCOPED_TRACE(ns);
+    const std::vector<Json> lines = ReadLines(Path(file + ".jsonl"));
+    bool saw_other_writer = false;  // proof that both twins were on this domain
+    for (const Json& j : lines) {
+      if (j.value("event", "") == "publication") {
+        saw_other_writer |= j["topic"] == "rt/" + other + "/pose";
+      }
+    }
+    EXPECT_TRUE(saw_other_writer);
+    const std::vector<Json> timing = Samples(lines, "timing");
+    ASSERT_FALSE(timing.empty());
+    for (const Json& t : timing) EXPECT_EQ(t["ns"], ns);
+    ExpectLastPoseIsTheLogs(lines, file + ".csv");
+  }
+}
+
+TEST_F(TelemetryDds, MonitorCommandStopStopsATwinAsSigtermWould) {
+  constexpr std::uint32_t kDomain = 222;
+  const std::string ns = Ns("twin");
+  Process twin = hiltwin::test::Spawn(Twin(kDomain, ns, "60"), Path("twin.out"));
+  const std::string domain = std::to_string(kDomain);
+
+  // A wrong namespace is a usage error that names the namespaces that are there.
+  const auto wrong = hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--domain", domain, "--command",
+                                         Ns("nothere"), "stop", "--wait", "4"});
+  EXPECT_EQ(wrong.exit_code, 2) << wrong.out << wrong.err;
+  EXPECT_NE(wrong.err.find("no task publishes rt/" + Ns("nothere") + "/timing"), std::string::npos)
+      << wrong.err;
+  EXPECT_NE(wrong.err.find(ns), std::string::npos) << "the twin is listed: " << wrong.err;
+
+  const auto stop = hiltwin::test::Run(
+      {HILTWIN_BINARY, "monitor", "--domain", domain, "--command", ns, "stop", "--wait", "10"});
+  EXPECT_EQ(stop.exit_code, 0) << stop.out << stop.err;
+  EXPECT_NE(stop.out.find("STOP sent to rt/" + ns + "/command"), std::string::npos) << stop.out;
+
+  const auto status = twin.WaitFor(kProcessTimeout);
+  ASSERT_TRUE(status.has_value()) << "twin still running after STOP";
+  ASSERT_TRUE(status->exited) << status->Describe();
+  const Json report = Json::parse(ReadText(Path("twin.json")));
+  EXPECT_EQ(report["stop_reason"], "stop_requested");
+  // Exit code and verdict agree as after SIGTERM: 0 PASS, 3 FLAGGED (a loaded machine).
+  EXPECT_EQ(status->code, report["verdict"] == "PASS" ? 0 : 3) << report["verdict"];
+  EXPECT_LT(report["cycles_run"].get<std::uint64_t>(), 12'000u);
+  EXPECT_EQ(report["log_rows_dropped"], 0);
+  EXPECT_EQ(report["log_rows_written"], report["cycles_run"]);
+  EXPECT_NE(ReadText(Path("twin.out.err")).find("STOP received on rt/" + ns + "/command"),
+            std::string::npos)
+      << ReadText(Path("twin.out.err"));
+}
+
+}  // namespace
