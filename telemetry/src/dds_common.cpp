@@ -18,7 +18,8 @@ Entity CreateParticipant(std::uint32_t domain, const std::string& flag) {
   const dds_entity_t participant =
       dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
   if (participant < 0) {
-    const char* uri = std::getenv("CYCLONEDDS_URI");
+    // Read once, on the control thread, before any helper thread of ours exists.
+    const char* uri = std::getenv("CYCLONEDDS_URI");  // NOLINT(concurrency-mt-unsafe)
     throw std::runtime_error(
         flag + ": Cyclone DDS could not join domain " + std::to_string(domain) + " (" +
         dds_strretcode(participant) + ") with CYCLONEDDS_URI " +

@@ -128,7 +128,9 @@ std::vector<MonitorEntry> DdsMonitor::Poll() {
   state_->Discover();
   const Clock::time_point now = Clock::now();
   std::vector<MonitorEntry> entries;
-  for (auto& [ns, task] : state_->tasks) {
+  for (auto& item : state_->tasks) {
+    const std::string& ns = item.first;
+    State::Task& task = item.second;
     TakeAll<hiltwin_msg_dds__Timing_>(task.reader, [&](const hiltwin_msg_dds__Timing_& t) {
       task.latest = EntryOf(ns, t);
       task.arrived = now;

@@ -210,7 +210,7 @@ void DdsSink::Handle(std::int32_t code, const runtime::CommandPort& port) const 
 }
 
 std::string DdsSink::Describe() const {
-  const std::string domain = "DDS domain " + std::to_string(domain_);
+  std::string domain = "DDS domain " + std::to_string(domain_);
   if (ns_.empty()) return domain;
   return domain + " rt/" + ns_ +
          (has_pose_ ? "/{pose,joint_states,timing,command}" : "/{joint_states,timing,command}");

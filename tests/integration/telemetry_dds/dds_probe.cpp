@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -45,7 +46,7 @@ Args Parse(int argc, char** argv) {
   }
   if (a.ns.empty()) {
     std::fprintf(stderr, "usage: dds_probe --domain N --ns NS [--duration S] [--after-final S]\n");
-    std::exit(2);
+    std::exit(2);  // NOLINT(concurrency-mt-unsafe): single-threaded tool
   }
   return a;
 }
@@ -67,7 +68,7 @@ dds_entity_t Reader(dds_entity_t pp, const dds_topic_descriptor_t* desc, const s
   if (topic < 0 || reader < 0) {
     std::fprintf(stderr, "dds_probe: cannot read %s: %s\n", name.c_str(),
                  dds_strretcode(reader < 0 ? reader : topic));
-    std::exit(1);
+    std::exit(1);  // NOLINT(concurrency-mt-unsafe): single-threaded tool
   }
   return reader;
 }
@@ -86,7 +87,7 @@ void TakeAll(dds_entity_t reader, Fn&& fn) {
 
 class Probe {
  public:
-  Probe(const Args& args, dds_entity_t pp) : args_(args), pp_(pp) {
+  Probe(const Args& args, dds_entity_t pp) : args_(args) {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wold-style-cast"  // Cyclone's pseudo-handle macro
     publications_ = dds_create_reader(pp, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
@@ -146,15 +147,12 @@ class Probe {
   }
 
   Args args_;
-  dds_entity_t pp_;
   dds_entity_t publications_ = 0, pose_ = 0, joints_ = 0, timing_ = 0;
   std::map<std::string, std::string> types_;  // topic -> type name, from DCPSPublication
   bool final_ = false;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int Main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   const dds_entity_t pp =
       dds_create_participant(static_cast<dds_domainid_t>(args.domain), nullptr, nullptr);
@@ -177,4 +175,14 @@ int main(int argc, char** argv) {
   Emit({{"event", "end"}, {"final", final_at.has_value()}});
   dds_delete(pp);
   return 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dds_probe: %s\n", e.what());
+    return 1;
+  }
 }

@@ -16,7 +16,10 @@
 namespace hiltwin::test {
 
 /// Every DDS test runs over config/cyclonedds-loopback.xml (set before the first participant).
-inline void UseLoopbackDds() { ::setenv("CYCLONEDDS_URI", "file://" HILTWIN_DDS_CONFIG, 1); }
+inline void UseLoopbackDds() {
+  // Before any participant exists: Cyclone reads the variable when a domain is created.
+  ::setenv("CYCLONEDDS_URI", "file://" HILTWIN_DDS_CONFIG, 1);  // NOLINT(concurrency-mt-unsafe)
+}
 
 /// A namespace no other process on this machine uses (a second checkout's tests, say).
 inline std::string UniqueNamespace(const std::string& leaf) {
