@@ -211,7 +211,8 @@ void DdsSink::Handle(std::int32_t code, const runtime::CommandPort& port) const 
 
 std::string DdsSink::Describe() const {
   std::string domain = "DDS domain " + std::to_string(domain_);
-  if (ns_.empty()) return domain;
+  // Before Open the namespace is not known yet; commands print the namespace next to this.
+  if (ns_.empty()) return domain + " rt/<namespace>/{pose,joint_states,timing,command}";
   return domain + " rt/" + ns_ +
          (has_pose_ ? "/{pose,joint_states,timing,command}" : "/{joint_states,timing,command}");
 }

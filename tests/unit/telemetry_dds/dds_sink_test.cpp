@@ -242,7 +242,7 @@ TEST_F(DdsSinkTest, ADomainAbove232IsABadFlag) {
 
 TEST_F(DdsSinkTest, PublishBeforeOpenDoesNothing) {
   const auto sink = MakeDdsSink({206});
-  EXPECT_EQ(sink->Describe(), "DDS domain 206");
+  EXPECT_EQ(sink->Describe(), "DDS domain 206 rt/<namespace>/{pose,joint_states,timing,command}");
   sink->Publish(TwinRecord("x"));
   sink->PollCommands([](RemoteCommand, std::string&) { return true; });
 }
