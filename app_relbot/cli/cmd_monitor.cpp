@@ -176,8 +176,12 @@ int RunCommand(const MonitorOptions& o) {
   const double left_s = std::max(1.0, Seconds(until - Clock::now()).count());
   const std::string why = monitor->SendCommand(ns, command, left_s);
   if (!why.empty()) throw Usage("--command " + ns + " " + o.command[1] + ": " + why);
-  std::printf("hiltwin monitor: %s sent to rt/%s/command on DDS domain %lld and acknowledged\n",
-              runtime::ToString(command), ns.c_str(), o.domain);
+  // The acknowledgement is DDS's: the task's reader has the command. Whether the task can
+  // act on it (a RESET while running, say) only the task knows; it prints that on its stderr.
+  std::printf(
+      "hiltwin monitor: %s delivered to rt/%s/command on DDS domain %lld (the task prints "
+      "whether it took it)\n",
+      runtime::ToString(command), ns.c_str(), o.domain);
   return static_cast<int>(ExitCode::kPass);
 }
 
@@ -257,10 +261,11 @@ Command AddMonitorCommand(CLI::App& parent) {
       "* marks a task's final record). Refreshed every 0.5 s: redrawn in place on a terminal,\n"
       "appended otherwise.\n"
       "Commands go to rt/NS/command (std_msgs/Int32, the seed ECS codes: INITIALISE 1, START 2,\n"
-      "STOP 3, RESET 4, PAUSE 5, QUIT 6); the task prints what it did with each.\n"
+      "STOP 3, RESET 4, PAUSE 5, QUIT 6). Exit 0 means the task's reader acknowledged it; the\n"
+      "task prints on its stderr whether it took it (a running task refuses RESET).\n"
       "Discovery uses Cyclone DDS's configuration (CYCLONEDDS_URI) on both sides; on one\n"
       "machine without multicast use config/cyclonedds-loopback.xml.\n"
-      "Exit: 0 done (a command sent and acknowledged); 2 bad usage, an unknown namespace or a\n"
+      "Exit: 0 done (a command delivered); 2 bad usage, an unknown namespace or a\n"
       "command nobody acknowledged; 1 internal error.");
   return Command{app, [o] { return RunMonitor(*o); }};
 }

@@ -255,7 +255,8 @@ TEST_F(TelemetryDds, MonitorCommandStopStopsATwinAsSigtermWould) {
   const auto stop = hiltwin::test::Run(
       {HILTWIN_BINARY, "monitor", "--domain", domain, "--command", ns, "stop", "--wait", "10"});
   EXPECT_EQ(stop.exit_code, 0) << stop.out << stop.err;
-  EXPECT_NE(stop.out.find("STOP sent to rt/" + ns + "/command"), std::string::npos) << stop.out;
+  EXPECT_NE(stop.out.find("STOP delivered to rt/" + ns + "/command"), std::string::npos)
+      << stop.out;
 
   const auto status = twin.WaitFor(kProcessTimeout);
   ASSERT_TRUE(status.has_value()) << "twin still running after STOP";
