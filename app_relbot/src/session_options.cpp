@@ -69,9 +69,8 @@ runtime::TelemetryConfig MakeTelemetry(telemetry::TelemetryOptions t, const Sess
   }
 }
 
-/// The start-up line that says where telemetry goes ("" when it is off).
+/// The start-up line that says where telemetry goes.
 std::string TelemetryLine(const runtime::TelemetryConfig& t) {
-  if (t.sinks.empty()) return "";
   std::string line = "telemetry: namespace " + t.ns + ", " + Num(t.rate_hz) + " Hz:";
   for (std::size_t i = 0; i < t.sinks.size(); ++i) {
     line += (i == 0 ? " " : "; ") + t.sinks[i]->Describe();
@@ -263,12 +262,13 @@ void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns) {
 }
 
 runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask& task) {
-  // Where telemetry goes, after the command's own start-up lines.
-  if (std::string line = TelemetryLine(config.telemetry); !line.empty()) {
+  // Where telemetry goes, after the command's own start-up lines: built when they print, after
+  // the session has opened the sinks, so each names its topics and address as opened.
+  if (!config.telemetry.sinks.empty()) {
     config.on_ready = [on_ready = std::move(config.on_ready),
-                       line = std::move(line)](const kernel_glue::RtSetupRecord* rt) {
+                       telemetry = config.telemetry](const kernel_glue::RtSetupRecord* rt) {
       if (on_ready) on_ready(rt);
-      std::fprintf(stdout, "%s\n", line.c_str());
+      std::fprintf(stdout, "%s\n", TelemetryLine(telemetry).c_str());
       std::fflush(stdout);
     };
   }
