@@ -15,11 +15,11 @@ void LatestRecord::Store(std::shared_ptr<const std::string> json) {
 
 LatestRecord::Next LatestRecord::WaitNewer(std::uint64_t seen, std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
-  const bool newer =
-      changed_.wait_for(lock, timeout, [&] { return stopped_ || (seq_ > seen && json_); });
-  if (stopped_) return {nullptr, seq_, true};
-  if (!newer) return {nullptr, seen, false};
-  return {json_, seq_, false};
+  const auto newer = [&] { return seq_ > seen && json_ != nullptr; };
+  changed_.wait_for(lock, timeout, [&] { return stopped_ || newer(); });
+  // A record not yet sent goes out even after Stop: it is often the run's final one.
+  if (newer()) return {json_, seq_, false};
+  return {nullptr, seen, stopped_};
 }
 
 LatestRecord::Next LatestRecord::Latest() const {

@@ -26,11 +26,12 @@ class LatestRecord {
   /// Replaces the newest record and wakes every waiting stream (the lock is held for a pointer
   /// swap only).
   void Store(std::shared_ptr<const std::string> json);
-  /// The newest record with a number above `seen`, waiting at most `timeout` for one.
+  /// The newest record with a number above `seen`, waiting at most `timeout` for one; once
+  /// stopped, that record if there is one, else `stopped` at once.
   [[nodiscard]] Next WaitNewer(std::uint64_t seen, std::chrono::milliseconds timeout);
   /// The newest record now (json null before the first).
   [[nodiscard]] Next Latest() const;
-  /// Wakes every stream for good: they end instead of waiting again.
+  /// Wakes every stream for good: each sends what it has not sent yet, then ends.
   void Stop();
 
  private:

@@ -37,6 +37,9 @@ constexpr int kMaxStreams = 6;
 // How long one idle or stuck connection may hold a worker, and so the longest the destructor
 // waits for a worker that is not inside a stream (streams end at once on Stop).
 constexpr time_t kSocketTimeoutS = 1;
+// How long the destructor lets open streams send their last record (a stream whose client
+// does not read is cut off after this).
+constexpr std::chrono::milliseconds kDrainTimeout{300};
 // httplib's stop() is a no-op until its listener marks itself running.
 constexpr std::chrono::seconds kStartTimeout{2};
 
@@ -90,7 +93,14 @@ WebSink::WebSink(const WebEndpoint& endpoint) : endpoint_(endpoint) {
 }
 
 WebSink::~WebSink() {
-  latest_.Stop();  // every stream ends its response now instead of waiting for a record
+  latest_.Stop();  // every stream sends what it has not sent yet and ends its response
+  // ... before the listener stops: httplib stops calling a stream's provider once its
+  // listening socket is closed, and the record a stream has not sent yet is usually the
+  // run's final one.
+  const auto give_up = std::chrono::steady_clock::now() + kDrainTimeout;
+  while (open_streams_ > 0 && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
   try {
     // httplib closes its bound socket only from a running listener: a sink that was never
     // opened starts one just to stop it, so the port is free when the sink is gone.

@@ -245,6 +245,32 @@ TEST(WebSinkTiming, DestructionWithAnOpenStreamIsQuick) {
       << std::chrono::duration_cast<milliseconds>(took).count() << " ms";
 }
 
+TEST(WebSinkTiming, TheFinalRecordReachesAnOpenStreamBeforeItEnds) {
+  auto served = std::make_unique<Served>();
+  served->sink->Publish(MakeRecord(0.1));
+  std::atomic<bool> streaming{false};
+  std::string received;
+  std::thread browser([&] {
+    httplib::Client client("127.0.0.1", served->port);
+    client.set_read_timeout(10, 0);
+    client.Get("/events", [&](const char* data, std::size_t length) {
+      received.append(data, length);
+      if (received.find("data: ") != std::string::npos) streaming = true;
+      return true;
+    });
+  });
+  const auto give_up = steady_clock::now() + std::chrono::seconds(5);
+  while (!streaming && steady_clock::now() < give_up) std::this_thread::sleep_for(milliseconds(5));
+  ASSERT_TRUE(streaming);
+
+  runtime::TelemetryRecord last = MakeRecord(9.0);
+  last.final = true;
+  served->sink->Publish(last);  // as RunSession does after the loop, just before the end
+  served.reset();
+  browser.join();
+  EXPECT_NE(received.find("data: " + ToJson(last).dump() + "\n\n"), std::string::npos);
+}
+
 TEST(WebSinkTiming, PublishDoesNotWaitForAClientThatDoesNotRead) {
   Served served;
   // A raw client that asks for the stream and never reads: its socket buffers fill up.
