@@ -118,7 +118,7 @@ int RunEcs(EcsOptions o) {
   if (!o.duration_given) o.session.duration_s = ecs->task->length_s();
   ValidateSessionOptions(o.session);
   const std::uint64_t planned = PlannedCycles(o.session);
-  const SessionRole role{"ecs", "twin", "hiltwin run", o.session.rate_hz};
+  const SessionRole role{"ecs", "twin", "hiltwin run", o.session.rate_hz, "controller"};
   runtime::SessionConfig config = MakeSessionConfig(o.session, role, *ecs->backend);
   config.task_name = "RELbot ECS";
   config.details = {{"mode", o.mode}, {"profile", ecs->profile_name}};

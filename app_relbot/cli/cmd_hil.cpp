@@ -39,6 +39,13 @@ constexpr double kTwinExtraS = 2.0;
 /// After one side ended, how long the other may take to notice before it is told to stop.
 constexpr auto kPeerGrace = std::chrono::seconds(3);
 
+/// hil's namespace without --namespace: the sides publish under hil/twin and hil/controller.
+telemetry::TelemetryOptions HilTelemetryDefaults() {
+  telemetry::TelemetryOptions t;
+  t.ns = "hil";
+  return t;
+}
+
 struct HilOptions {
   double twin_rate_hz = 4000.0;
   double ecs_rate_hz = 1000.0;
@@ -57,6 +64,8 @@ struct HilOptions {
   std::string wire;
   double wait_peer_s = 10.0;
   bool no_progress = false;
+  /// Passed on: each side publishes under NS/twin and NS/controller; the twin serves --web.
+  telemetry::TelemetryOptions telemetry = HilTelemetryDefaults();
 };
 
 [[noreturn]] void Usage(const std::string& message) {
@@ -64,8 +73,8 @@ struct HilOptions {
 }
 
 void Validate(HilOptions& o) {
-  for (const auto& [flag, rate] : {std::pair{"--twin-rate", o.twin_rate_hz},
-                                   std::pair{"--ecs-rate", o.ecs_rate_hz}}) {
+  for (const auto& [flag, rate] :
+       {std::pair{"--twin-rate", o.twin_rate_hz}, std::pair{"--ecs-rate", o.ecs_rate_hz}}) {
     try {
       scheduler::ValidateRateHz(rate);
     } catch (const std::invalid_argument& e) {
@@ -110,12 +119,33 @@ std::unique_ptr<WorkDir> MakeWorkDir(const HilOptions& o) {
   }
   std::string pattern = (fs::temp_directory_path() / "hiltwin-hil-XXXXXX").string();
   if (::mkdtemp(pattern.data()) == nullptr) {
-    throw CommandError(ExitCode::kIo, "cannot create a temporary folder in " +
-                                          fs::temp_directory_path().string());
+    throw CommandError(ExitCode::kIo,
+                       "cannot create a temporary folder in " + fs::temp_directory_path().string());
   }
   dir->path = pattern;
   dir->temporary = true;
   return dir;
+}
+
+/// Checks the telemetry flags here, so a mistake is the parent's exit 2, not a child's.
+void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
+  try {
+    static_cast<void>(telemetry::ParseDdsSpecs(t.specs));
+    static_cast<void>(telemetry::ParseUdpSpecs(t.specs));
+    if (!t.web.empty()) static_cast<void>(telemetry::ParseWebSpec(t.web));
+    telemetry::CheckNamespace(t.ns + "/controller");
+  } catch (const std::invalid_argument& e) {
+    Usage(e.what());
+  }
+}
+
+/// One side's telemetry flags: its own namespace under --namespace; the page on the twin only.
+void AddTelemetry(std::vector<std::string>& argv, const telemetry::TelemetryOptions& t,
+                  const char* side, bool serves_web) {
+  if (t.specs.empty() && (t.web.empty() || !serves_web)) return;
+  for (const std::string& spec : t.specs) argv.insert(argv.end(), {"--telemetry", spec});
+  argv.insert(argv.end(), {"--namespace", t.ns + "/" + side, "--telemetry-rate", Num(t.rate_hz)});
+  if (serves_web && !t.web.empty()) argv.insert(argv.end(), {"--web", t.web});
 }
 
 void AddRules(std::vector<std::string>& argv, const std::vector<std::string>& qos,
@@ -126,23 +156,46 @@ void AddRules(std::vector<std::string>& argv, const std::vector<std::string>& qo
   if (on_violation) argv.insert(argv.end(), {"--on-violation", *on_violation});
 }
 
-std::vector<std::string> TwinArgv(const HilOptions& o, const std::string& wire, const fs::path& dir) {
-  std::vector<std::string> argv = {"/proc/self/exe", "run", "--io", wire, "--rate",
-                                   Num(o.twin_rate_hz), "--duration", Num(o.duration_s + kTwinExtraS),
-                                   "--wait-peer", Num(o.wait_peer_s), "--no-progress", "--report",
+std::vector<std::string> TwinArgv(const HilOptions& o, const std::string& wire,
+                                  const fs::path& dir) {
+  std::vector<std::string> argv = {"/proc/self/exe",
+                                   "run",
+                                   "--io",
+                                   wire,
+                                   "--rate",
+                                   Num(o.twin_rate_hz),
+                                   "--duration",
+                                   Num(o.duration_s + kTwinExtraS),
+                                   "--wait-peer",
+                                   Num(o.wait_peer_s),
+                                   "--no-progress",
+                                   "--report",
                                    (dir / "twin.json").string()};
   if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", (dir / "twin.csv").string()});
   if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
   AddRules(argv, o.twin_qos, o.twin_max_miss_pct, o.on_violation);
+  AddTelemetry(argv, o.telemetry, "twin", true);
   argv.insert(argv.end(), o.twin_args.begin(), o.twin_args.end());
   return argv;
 }
 
-std::vector<std::string> EcsArgv(const HilOptions& o, const std::string& wire, const fs::path& dir) {
-  std::vector<std::string> argv = {"/proc/self/exe", "ecs", "--io", wire, "--rate",
-                                   Num(o.ecs_rate_hz), "--duration", Num(o.duration_s), "--mode",
-                                   o.mode, "--wait-peer", Num(o.wait_peer_s), "--no-progress",
-                                   "--report", (dir / "ecs.json").string()};
+std::vector<std::string> EcsArgv(const HilOptions& o, const std::string& wire,
+                                 const fs::path& dir) {
+  std::vector<std::string> argv = {"/proc/self/exe",
+                                   "ecs",
+                                   "--io",
+                                   wire,
+                                   "--rate",
+                                   Num(o.ecs_rate_hz),
+                                   "--duration",
+                                   Num(o.duration_s),
+                                   "--mode",
+                                   o.mode,
+                                   "--wait-peer",
+                                   Num(o.wait_peer_s),
+                                   "--no-progress",
+                                   "--report",
+                                   (dir / "ecs.json").string()};
   if (o.mode == "closedloop") {
     argv.insert(argv.end(), {"--setpoint", o.setpoint});
   } else {
@@ -152,6 +205,7 @@ std::vector<std::string> EcsArgv(const HilOptions& o, const std::string& wire, c
   if (!o.gains_path.empty()) argv.insert(argv.end(), {"--gains", o.gains_path});
   if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
   AddRules(argv, o.ecs_qos, o.ecs_max_miss_pct, o.on_violation);
+  AddTelemetry(argv, o.telemetry, "controller", false);
   argv.insert(argv.end(), o.ecs_args.begin(), o.ecs_args.end());
   return argv;
 }
@@ -239,6 +293,7 @@ void ShowOutputOf(const Child& child, const fs::path& dir) {
 
 int RunHil(HilOptions o) {
   Validate(o);
+  ValidateTelemetry(o.telemetry);
   const std::string name = o.wire.empty() ? "hil-" + std::to_string(::getpid()) : o.wire;
   const std::string wire = "wire:" + name;
   try {
@@ -250,8 +305,8 @@ int RunHil(HilOptions o) {
   std::ofstream report_file = OpenReport(o.report_path);
   kernel_glue::InstallStopSignalHandlers();
   std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s\n",
-              Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(),
-              wire.c_str(), Num(o.duration_s).c_str());
+              Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(), wire.c_str(),
+              Num(o.duration_s).c_str());
   std::fflush(stdout);
   Child twin = Start("twin", TwinArgv(o, wire, dir->path), dir->path);
   Child ecs = Start("ecs", EcsArgv(o, wire, dir->path), dir->path);
@@ -312,6 +367,7 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--wait-peer", o->wait_peer_s, "how long each side waits for the other, s")
       ->capture_default_str();
   app->add_flag("--no-progress", o->no_progress, "no progress line on the terminal");
+  AddTelemetryOptions(*app, o->telemetry);
   return {app, [o] { return RunHil(*o); }};
 }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "hiltwin/app_relbot/ecs_gains.h"
+#include "hiltwin/app_relbot/relbot_telemetry.h"
 
 namespace hiltwin::app {
 namespace {
@@ -207,6 +208,18 @@ TrackingStats EcsTask::tracking() const noexcept {
   stats.saturated_cycles = sums_.saturated_cycles;
   stats.max_abs_duty = sums_.max_abs_duty;
   return stats;
+}
+
+}  // namespace hiltwin::app
+
+namespace hiltwin::app {
+
+runtime::TelemetryShape EcsTask::TelemetryShapeOf() const {
+  return RelbotTelemetryShape("controller", false);
+}
+
+void EcsTask::FillTelemetry(runtime::TaskTelemetry& out) const noexcept {
+  FillWheelJoints(out, last_.measured.left_m, last_.measured.right_m, geometry_.wheel_radius_m);
 }
 
 }  // namespace hiltwin::app

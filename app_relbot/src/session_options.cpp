@@ -60,6 +60,25 @@ runtime::OverrunInjector MakeInjector(const SessionOptions& o, std::uint64_t pla
   return injector;
 }
 
+runtime::TelemetryConfig MakeTelemetry(telemetry::TelemetryOptions t, const SessionRole& role) {
+  if (t.ns.empty()) t.ns = role.default_namespace;
+  try {
+    return telemetry::MakeTelemetryConfig(t);
+  } catch (const std::exception& e) {
+    Usage(e.what());
+  }
+}
+
+/// The start-up line that says where telemetry goes ("" when it is off).
+std::string TelemetryLine(const runtime::TelemetryConfig& t) {
+  if (t.sinks.empty()) return "";
+  std::string line = "telemetry: namespace " + t.ns + ", " + Num(t.rate_hz) + " Hz:";
+  for (std::size_t i = 0; i < t.sinks.size(); ++i) {
+    line += (i == 0 ? " " : "; ") + t.sinks[i]->Describe();
+  }
+  return line;
+}
+
 }  // namespace
 
 std::string Num(double value) {
@@ -123,6 +142,25 @@ void AddSessionOptions(CLI::App& app, SessionOptions& o) {
                  "fault injection (mock and wire): the FPGA image the emulated board carries, "
                  "icoboard or icoboard_inverse; the wrong one stops at INIT with exit 5")
       ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}));
+  AddTelemetryOptions(app, o.telemetry);
+}
+
+void AddTelemetryOptions(CLI::App& app, telemetry::TelemetryOptions& t) {
+  app.add_option("--telemetry", t.specs,
+                 "live telemetry out of the loop (repeatable): dds[:DOMAIN] publishes ROS 2 "
+                 "topics rt/NS/{pose,joint_states,timing} and takes commands on rt/NS/command; "
+                 "udp[:HOST:PORT] streams JSON to PlotJuggler (default 127.0.0.1:9870)");
+  app.add_option("--namespace", t.ns,
+                 "telemetry namespace NS, one per task on a network (default: twin for run, "
+                 "controller for ecs; hil publishes its sides under NS/twin and NS/controller, "
+                 "default hil)");
+  app.add_option("--web", t.web,
+                 "serve a live page (pose, trail, wheels, timing) at ADDR:PORT (bare --web: "
+                 "127.0.0.1:8080)")
+      ->expected(0, 1)
+      ->default_str("127.0.0.1:8080");
+  app.add_option("--telemetry-rate", t.rate_hz, "telemetry records per second (0 < HZ <= 1000)")
+      ->capture_default_str();
 }
 
 void ValidateSessionOptions(const SessionOptions& o) {
@@ -205,12 +243,14 @@ runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionR
   config.progress = !o.no_progress && isatty(STDERR_FILENO) == 1;
   config.pause_signals = true;  // kill -USR1 pauses, -USR2 resumes (documented in --help)
   if (io::PeerLink* link = backend.peer_link(); link != nullptr) {
-    config.peer = runtime::PeerWait{link, o.wait_peer_s,
-                                    std::string(role.peer_command) + " --io " + o.io};
+    config.peer =
+        runtime::PeerWait{link, o.wait_peer_s, std::string(role.peer_command) + " --io " + o.io};
   } else if (o.wait_peer_s != SessionOptions{}.wait_peer_s && o.wait_peer_s != 0.0) {
-    Usage("--wait-peer only applies to --io wire:NAME; a mock board has no peer and a real "
-          "board's peer cannot be seen from here (drop --wait-peer)");
+    Usage(
+        "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a real "
+        "board's peer cannot be seen from here (drop --wait-peer)");
   }
+  config.telemetry = MakeTelemetry(o.telemetry, role);
   return config;
 }
 
@@ -223,6 +263,15 @@ void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns) {
 }
 
 runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask& task) {
+  // Where telemetry goes, after the command's own start-up lines.
+  if (std::string line = TelemetryLine(config.telemetry); !line.empty()) {
+    config.on_ready = [on_ready = std::move(config.on_ready),
+                       line = std::move(line)](const kernel_glue::RtSetupRecord* rt) {
+      if (on_ready) on_ready(rt);
+      std::fprintf(stdout, "%s\n", line.c_str());
+      std::fflush(stdout);
+    };
+  }
   std::optional<runtime::RunSession> session;
   // Only the two logs can fail to open; the message quotes the path of the one that did.
   const std::string timing_log_quoted = "'" + config.timing_log_path + "'";
@@ -230,6 +279,8 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
     session.emplace(std::move(config), task);
   } catch (const std::invalid_argument& e) {
     Usage(e.what());
+  } catch (const runtime::TelemetryError& e) {
+    Usage(std::string("telemetry: ") + e.what());
   } catch (const std::runtime_error& e) {
     const bool timing = timing_log_quoted != "''" &&
                         std::string(e.what()).find(timing_log_quoted) != std::string::npos;

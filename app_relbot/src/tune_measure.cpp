@@ -32,7 +32,7 @@ class IdleTask final : public runtime::RunTask {
 }  // namespace
 
 SessionRole TuneRole(double controller_rate_hz) {
-  return {"tune", "controller", "hiltwin ecs", controller_rate_hz};
+  return {"tune", "controller", "hiltwin ecs", controller_rate_hz, "twin"};
 }
 
 StepCost MeasureStepCost(const Twin& twin, double rate_hz) {

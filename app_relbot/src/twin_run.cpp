@@ -69,7 +69,7 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   std::ofstream report_file = OpenReport(o.session.report_path);
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(o, period_ns);
-  const SessionRole role{command, "controller", "hiltwin ecs", o.controller_rate_hz};
+  const SessionRole role{command, "controller", "hiltwin ecs", o.controller_rate_hz, "twin"};
   runtime::SessionConfig config = MakeSessionConfig(o.session, role, *twin->backend);
   config.task_name = "RELbot twin";
   config.details = {{"input", twin->input_name},

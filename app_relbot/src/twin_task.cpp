@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "hiltwin/app_relbot/relbot_telemetry.h"
+
 namespace hiltwin::app {
 
 ProfilePwmSource::ProfilePwmSource(const InputProfile& profile, double controller_rate_hz,
@@ -51,6 +53,19 @@ runtime::StepStatus TwinTask::Step(const scheduler::CycleContext& context) noexc
   last_.outputs = outputs;
   last_.encoder_counts = encoder_out_;
   return runtime::StepStatus::Ok();
+}
+
+runtime::TelemetryShape TwinTask::TelemetryShapeOf() const {
+  return RelbotTelemetryShape("twin", true);
+}
+
+void TwinTask::FillTelemetry(runtime::TaskTelemetry& out) const noexcept {
+  out.has_pose = true;
+  out.x_m = last_.outputs.x_m;
+  out.y_m = last_.outputs.y_m;
+  out.theta_rad = last_.outputs.theta_rad;
+  FillWheelJoints(out, last_.outputs.wheel_left_m, last_.outputs.wheel_right_m,
+                  geometry_.wheel_radius_m);
 }
 
 std::vector<std::string> TwinTask::LogColumns() const {

@@ -82,10 +82,10 @@ scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sampl
                 static_cast<std::uint8_t>(sample.missed),
                 static_cast<std::uint8_t>(rules_.records_qos));
   if (sample.missed) {
-    HILTWIN_TRACE(deadline_miss, sample.cycle,
-                  sample.end_ns - sample.release_ns - deadline_ns_);
+    HILTWIN_TRACE(deadline_miss, sample.cycle, sample.end_ns - sample.release_ns - deadline_ns_);
   }
   if (timing_log_ != nullptr) LogTiming(sample);
+  if (telemetry_.snapshot != nullptr) LeaveTelemetry(sample);
   qos_abort_ = false;
   if (rules_.records_qos) RecordQos(sample);
   if (stepped_ && logger_ != nullptr) Log(sample);
@@ -111,8 +111,8 @@ void CycleRunner::TraceViolations(std::uint64_t cycle) noexcept {
   for (std::size_t i = 0; i < rules.size() && i < violations_seen_.size(); ++i) {
     if (rules[i].violations == violations_seen_[i]) continue;
     violations_seen_[i] = rules[i].violations;
-    HILTWIN_TRACE(qos_violation, static_cast<std::uint32_t>(i), cycle,
-                  rules[i].distance_to_failure, rules[i].violations);
+    HILTWIN_TRACE(qos_violation, static_cast<std::uint32_t>(i), cycle, rules[i].distance_to_failure,
+                  rules[i].violations);
   }
 }
 
@@ -123,17 +123,35 @@ void CycleRunner::TraceIoError(std::uint64_t cycle, tracing::IoErrorKind kind) n
 void CycleRunner::LogTiming(const scheduler::TimingSample& sample) noexcept {
   // Nanoseconds since release 0, so the doubles stay exact (timing_log_format.h).
   if (!timing_base_set_) {
-    timing_base_ns_ = sample.release_ns -
-                      static_cast<kernel_glue::TimeNs>(sample.cycle) * period_ns_;
+    timing_base_ns_ =
+        sample.release_ns - static_cast<kernel_glue::TimeNs>(sample.cycle) * period_ns_;
     timing_base_set_ = true;
   }
-  const auto rel = [this](kernel_glue::TimeNs t) { return static_cast<double>(t - timing_base_ns_); };
+  const auto rel = [this](kernel_glue::TimeNs t) {
+    return static_cast<double>(t - timing_base_ns_);
+  };
   const std::array<double, tracing::kTimingLogFields.size()> row = {
-      static_cast<double>(sample.cycle), rel(sample.release_ns), rel(sample.wake_ns),
-      rel(sample.start_ns), rel(sample.end_ns), static_cast<double>(sample.io_ns),
-      static_cast<double>(sample.releases_skipped), sample.missed ? 1.0 : 0.0,
+      static_cast<double>(sample.cycle),
+      rel(sample.release_ns),
+      rel(sample.wake_ns),
+      rel(sample.start_ns),
+      rel(sample.end_ns),
+      static_cast<double>(sample.io_ns),
+      static_cast<double>(sample.releases_skipped),
+      sample.missed ? 1.0 : 0.0,
       rules_.records_qos ? 1.0 : 0.0};
   timing_log_->TryLog(rel(sample.release_ns) * 1e-9, row);
+}
+
+void CycleRunner::LeaveTelemetry(const scheduler::TimingSample& sample) noexcept {
+  LoopSnapshot& snapshot = telemetry_.snapshot->Back();
+  snapshot.cycle = sample.cycle;
+  snapshot.task_time_s = task_.LogTimeS();
+  task_.FillTelemetry(snapshot.task);
+  telemetry_.snapshot->Publish();
+  // A full ring (the telemetry thread stalled) drops the value and counts it: the recent
+  // latency figure then covers fewer cycles, which the record says (latency_samples).
+  static_cast<void>(telemetry_.latencies->TryPush(sample.wake_ns - sample.release_ns));
 }
 
 void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
@@ -152,16 +170,11 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
     const scheduler::TimingSample& sample) noexcept {
   const std::uint64_t next_release = sample.cycle + 1 + sample.releases_skipped;
   const bool plan_done = planned_releases_ != 0 && next_release >= planned_releases_;
-  // The common cycle: nothing happened and nothing was asked. A relaxed load first; the
-  // exchange (a locked instruction) only when a command is there.
+  // The common cycle: nothing happened and nothing was asked (relaxed loads only).
   const bool quiet = !io_fault_ && step_status_.code == StepStatus::Code::kOk && !qos_abort_ &&
-                     !plan_done && !peer_stop_seen_ &&
-                     commands_.load(std::memory_order_relaxed) == 0 && !kernel_glue::StopRequested();
+                     !plan_done && !peer_stop_seen_ && !commands_.MaybeNonEmpty() &&
+                     !kernel_glue::StopRequested();
   if (quiet) return false;
-  const std::uint8_t commands = commands_.exchange(0, std::memory_order_acq_rel);
-  const auto asked = [commands](CommandBit bit) {
-    return (commands & static_cast<std::uint8_t>(bit)) != 0;
-  };
   // Faults first: when several causes meet in one cycle the report names the one that makes
   // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
   const auto handle = [this, &sample](Event event) {
@@ -170,19 +183,33 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
   if (io_fault_) handle(Event::kIoFault);
   if (step_status_.code == StepStatus::Code::kModelFault) handle(Event::kModelFault);
   if (qos_abort_) handle(Event::kQosAbort);
-  if (kernel_glue::StopRequested() || asked(CommandBit::kStop)) handle(Event::kStopRequest);
+  if (kernel_glue::StopRequested()) handle(Event::kStopRequest);
   if (plan_done || step_status_.code == StepStatus::Code::kFinished) {
     handle(Event::kFinishReached);
   }
   if (peer_stop_seen_) handle(Event::kPeerStopped);
-  if (asked(CommandBit::kPause)) handle(Event::kPause);
-  if (asked(CommandBit::kResume)) handle(Event::kStart);
+  HandleCommands(sample.cycle);
   return true;
 }
 
-void CycleRunner::Post(CommandBit command) noexcept {
-  commands_.fetch_or(static_cast<std::uint8_t>(command), std::memory_order_acq_rel);
+void CycleRunner::HandleCommands(std::uint64_t cycle) noexcept {
+  SessionCommand command{};
+  while (commands_.TryPop(command)) {
+    switch (command) {
+      case SessionCommand::kStop:
+        HandleTraced(lifecycle_, Event::kStopRequest, cycle);
+        break;
+      case SessionCommand::kPause:
+        HandleTraced(lifecycle_, Event::kPause, cycle);
+        break;
+      case SessionCommand::kResume:
+        HandleTraced(lifecycle_, Event::kStart, cycle);
+        break;
+    }
+  }
 }
+
+bool CycleRunner::Post(SessionCommand command) noexcept { return commands_.TryPush(command); }
 
 bool CycleRunner::WriteSafeOutputs() noexcept {
   // Delivered to the board is what counts: a wire whose peer is gone still takes them.

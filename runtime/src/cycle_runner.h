@@ -14,18 +14,27 @@
 
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/qos/monitor.h"
+#include "hiltwin/runtime/command_queue.h"
+#include "hiltwin/runtime/latest_value.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_task.h"
 #include "hiltwin/scheduler/cycle.h"
 #include "hiltwin/statemachine/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
+#include "hiltwin/tracing/spsc_ring.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "hiltwin/tracing/trace_codes.h"
 
 namespace hiltwin::runtime {
 
-/// Commands from other threads (signals, telemetry, tests), one bit each.
-enum class CommandBit : std::uint8_t { kStop = 1, kPause = 2, kResume = 4 };
+/// Commands queued at once before the loop takes them (it takes all of them every cycle).
+inline constexpr std::size_t kCommandQueueCapacity = 16;
+
+/// Where the loop leaves telemetry for the telemetry thread (telemetry.h); none owned.
+struct TelemetryTaps {
+  LatestValue<LoopSnapshot>* snapshot = nullptr;          ///< written every cycle
+  tracing::SpscQueue<std::int64_t>* latencies = nullptr;  ///< every cycle's wake-up latency, ns
+};
 
 /// The first fault of a run, as the loop saw it (reason is static text).
 struct LoopFault {
@@ -69,8 +78,11 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   [[nodiscard]] kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
   scheduler::CycleAction OnCycle(const scheduler::TimingSample& sample) noexcept override;
 
-  /// Thread-safe and lock-free: the loop acts on it after the current cycle.
-  void Post(CommandBit command) noexcept;
+  /// Thread-safe and lock-free: the loop acts on it after the current cycle, in the order
+  /// posted. False when the queue is full (the command was not taken).
+  [[nodiscard]] bool Post(SessionCommand command) noexcept;
+  /// Before the loop starts: where to leave telemetry every cycle (off by default).
+  void AttachTelemetry(const TelemetryTaps& taps) noexcept { telemetry_ = taps; }
 
   /// One exchange with safe outputs, after the loop: true when the board took and answered it.
   [[nodiscard]] bool WriteSafeOutputs() noexcept;
@@ -84,6 +96,9 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   void RecordQos(const scheduler::TimingSample& sample) noexcept;
   void Log(const scheduler::TimingSample& sample) noexcept;
   void LogTiming(const scheduler::TimingSample& sample) noexcept;
+  void LeaveTelemetry(const scheduler::TimingSample& sample) noexcept;
+  /// Offers the queued commands to the lifecycle, in the order they were posted.
+  void HandleCommands(std::uint64_t cycle) noexcept;
   /// Fires hiltwin:qos_violation for every rule whose violation count rose at `cycle`.
   void TraceViolations(std::uint64_t cycle) noexcept;
   void TraceIoError(std::uint64_t cycle, tracing::IoErrorKind kind) noexcept;
@@ -106,7 +121,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   std::span<const kernel_glue::TimeNs> virtual_compute_ns_;
   std::array<double, tracing::kMaxLogColumns> row_{};
   std::vector<std::uint64_t> violations_seen_;  ///< per rule, as last traced
-  kernel_glue::TimeNs timing_base_ns_ = 0;       ///< release 0's time, for the timing log
+  kernel_glue::TimeNs timing_base_ns_ = 0;      ///< release 0's time, for the timing log
   bool timing_base_set_ = false;
 
   // This cycle, from Step to OnCycle. Only the loop thread changes the state while the loop
@@ -122,7 +137,8 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   LoopCounts counts_;
   std::optional<LoopFault> fault_;
   const char* peer_stopped_ = nullptr;
-  std::atomic<std::uint8_t> commands_{0};
+  CommandQueue<SessionCommand, kCommandQueueCapacity> commands_;
+  TelemetryTaps telemetry_;
 };
 
 }  // namespace hiltwin::runtime

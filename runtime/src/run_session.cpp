@@ -1,26 +1,25 @@
 #include "hiltwin/runtime/run_session.h"
 
+#include <sched.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
 
-#include <sched.h>
-
-#include <cmath>
-
 #include "costed_virtual_clock.h"
 #include "cycle_runner.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "hiltwin/tracing/trace.h"
 #include "hiltwin/tracing/trace_codes.h"
+#include "telemetry_publisher.h"
 #include "traced_lifecycle.h"
-#include "hiltwin/kernel_glue/stop_signal.h"
-#include "hiltwin/kernel_glue/thread.h"
 
 namespace hiltwin::runtime {
 namespace {
@@ -74,8 +73,7 @@ std::unique_ptr<tracing::CsvLogger> MakeTimingLog(const SessionConfig& config,
   tracing::CsvLoggerConfig log;
   log.path = config.timing_log_path;
   log.columns.assign(tracing::kTimingLogFields.begin(), tracing::kTimingLogFields.end());
-  log.preamble = {std::string(tracing::kTimingLogMagic),
-                  "period_ns=" + std::to_string(period_ns),
+  log.preamble = {std::string(tracing::kTimingLogMagic), "period_ns=" + std::to_string(period_ns),
                   "deadline_ns=" + std::to_string(deadline_ns),
                   "planned_cycles=" + std::to_string(config.executive.max_cycles)};
   for (const qos::RuleSpec& rule : config.qos.rules) {
@@ -96,26 +94,33 @@ void TraceLoopStart(const SessionConfig& config, const scheduler::Executive& exe
   const int policy = rt && rt->record().sched_fifo ? SCHED_FIFO : SCHED_OTHER;
   HILTWIN_TRACE(loop_start, static_cast<std::int32_t>(::gettid()),
                 static_cast<std::int32_t>(::sched_getcpu()), policy, priority,
-                executive.config().period_ns, executive.deadline_ns(),
-                config.executive.max_cycles, static_cast<std::uint32_t>(config.qos.rules.size()));
+                executive.config().period_ns, executive.deadline_ns(), config.executive.max_cycles,
+                static_cast<std::uint32_t>(config.qos.rules.size()));
   for (std::size_t i = 0; i < config.qos.rules.size(); ++i) {
     const qos::RuleSpec& rule = config.qos.rules[i];
-    HILTWIN_TRACE(qos_rule, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(rule.kind),
-                  rule.m, rule.k, rule.n,
-                  static_cast<std::uint32_t>(std::lround(rule.max_miss_pct * tracing::kPpmPerPercent)));
+    HILTWIN_TRACE(
+        qos_rule, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(rule.kind), rule.m,
+        rule.k, rule.n,
+        static_cast<std::uint32_t>(std::lround(rule.max_miss_pct * tracing::kPpmPerPercent)));
   }
 }
 
 io::StopCause StopCauseOf(statemachine::StopReason reason) noexcept {
   using statemachine::StopReason;
   switch (reason) {
-    case StopReason::kFinished: return io::StopCause::kFinished;
-    case StopReason::kStopRequested: return io::StopCause::kStopRequested;
-    case StopReason::kQosAbort: return io::StopCause::kQosAbort;
+    case StopReason::kFinished:
+      return io::StopCause::kFinished;
+    case StopReason::kStopRequested:
+      return io::StopCause::kStopRequested;
+    case StopReason::kQosAbort:
+      return io::StopCause::kQosAbort;
     case StopReason::kIoFault:
-    case StopReason::kModelFault: return io::StopCause::kFault;
-    case StopReason::kPeerStopped: return io::StopCause::kPeerStopped;
-    case StopReason::kNone: break;
+    case StopReason::kModelFault:
+      return io::StopCause::kFault;
+    case StopReason::kPeerStopped:
+      return io::StopCause::kPeerStopped;
+    case StopReason::kNone:
+      break;
   }
   return io::StopCause::kFault;  // the loop ended without a cause: say something is wrong
 }
@@ -190,27 +195,31 @@ RunSession::RunSession(SessionConfig config, RunTask& task)
   runner.period_ns = executive_.config().period_ns;
   runner.deadline_ns = executive_.deadline_ns();
   runner.virtual_compute_ns = config_.virtual_costs.compute_ns;
-  runner_ = std::make_unique<CycleRunner>(task_, *clock_, lifecycle_, monitor_, config_.injector,
-                                          runner);
+  runner_ =
+      std::make_unique<CycleRunner>(task_, *clock_, lifecycle_, monitor_, config_.injector, runner);
   executive_.AddObserver(*runner_);
+  if (!config_.telemetry.sinks.empty()) OpenTelemetry();
   HandleTraced(lifecycle_, statemachine::Event::kConfigured, 0);
 }
 
 RunSession::~RunSession() = default;
 
-void RunSession::Post(SessionCommand command) noexcept {
-  switch (command) {
-    case SessionCommand::kStop:
-      runner_->Post(CommandBit::kStop);
-      break;
-    case SessionCommand::kPause:
-      runner_->Post(CommandBit::kPause);
-      break;
-    case SessionCommand::kResume:
-      runner_->Post(CommandBit::kResume);
-      break;
+void RunSession::OpenTelemetry() {
+  TelemetryIdentity identity{config_.telemetry.ns, config_.rate_hz, config_.executive.max_cycles};
+  try {
+    telemetry_ = std::make_unique<TelemetryPublisher>(
+        config_.telemetry, task_.TelemetryShapeOf(), std::move(identity),
+        TelemetrySources{monitor_, executive_, lifecycle_},
+        [this](SessionCommand command) { return runner_->Post(command); });
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw TelemetryError(e.what());
   }
+  runner_->AttachTelemetry(telemetry_->taps());
 }
+
+bool RunSession::Post(SessionCommand command) noexcept { return runner_->Post(command); }
 
 void RunSession::LoopThreadMain(LoopResult& result) noexcept {
   {
@@ -261,6 +270,8 @@ RunReport RunSession::Run() {
     if (logger_) logger_->Start();  // after the RT set-up: see LoopThreadMain
     if (timing_log_) timing_log_->Start();
     if (config_.on_ready) config_.on_ready(result.rt ? &result.rt->record() : nullptr);
+    // Before the wait for a peer: a twin that waits already shows on the monitor (ready).
+    if (telemetry_) telemetry_->Start(kernel_glue::HelperCpus(allowed_cpus_, config_.rt.cpus));
   } catch (...) {
     // Release the waiting loop thread without running a cycle, then report the failure.
     CancelLoop(result, lock, loop);
@@ -272,6 +283,7 @@ RunReport RunSession::Run() {
     config_.peer->link->AnnounceStop(StopCauseOf(lifecycle_.stop_reason()));
     StopLoggers();
     HandleTraced(lifecycle_, statemachine::Event::kDrained, 0);
+    if (telemetry_) telemetry_->Stop();  // the final record: safe_stop or stopped
     return BuildReport(result, 0.0);
   }
   // The control thread is a helper too while the loop runs: off the loop's CPUs. Best effort:
@@ -301,6 +313,7 @@ RunReport RunSession::Run() {
   }
   StopLoggers();
   HandleTraced(lifecycle_, statemachine::Event::kDrained, executive_.stats().releases);
+  if (telemetry_) telemetry_->Stop();  // the final record, with the run's last state
   return BuildReport(result, wall_time_s);
 }
 
@@ -363,10 +376,10 @@ bool RunSession::WaitForPeer() {
 void RunSession::ForwardPauseSignal() noexcept {
   switch (kernel_glue::TakePauseRequest()) {
     case kernel_glue::PauseRequest::kPause:
-      Post(SessionCommand::kPause);
+      static_cast<void>(Post(SessionCommand::kPause));
       break;
     case kernel_glue::PauseRequest::kResume:
-      Post(SessionCommand::kResume);
+      static_cast<void>(Post(SessionCommand::kResume));
       break;
     case kernel_glue::PauseRequest::kNone:
       break;

@@ -39,7 +39,7 @@ RecordedRun RunRecorded(double seconds, runtime::VirtualCycleCosts costs, std::s
   const TwinRunOptions o = VirtualTwin(seconds);
   const std::unique_ptr<Twin> twin = BuildTwin(o, kPeriodNs);
   runtime::SessionConfig config =
-      MakeSessionConfig(o.session, {"test", "controller", "hiltwin ecs", 1000.0}, *twin->backend);
+      MakeSessionConfig(o.session, {"test", "controller", "hiltwin ecs", 1000.0, "twin"}, *twin->backend);
   config.virtual_costs = std::move(costs);
   TrajectoryRecorder recorder(*twin->task, kPeriodNs, capacity);
   runtime::RunSession session(std::move(config), recorder);

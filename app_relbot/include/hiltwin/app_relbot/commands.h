@@ -25,5 +25,6 @@ bool RegisterCommand(int order, CommandFactory factory);
 
 }  // namespace hiltwin::app
 
-#define HILTWIN_REGISTER_COMMAND(order, factory) \
-  [[maybe_unused]] static const bool kRegistered_##factory = ::hiltwin::app::RegisterCommand(order, &factory)
+#define HILTWIN_REGISTER_COMMAND(order, factory)             \
+  [[maybe_unused]] static const bool kRegistered_##factory = \
+      ::hiltwin::app::RegisterCommand(order, &factory)

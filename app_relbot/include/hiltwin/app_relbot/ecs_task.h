@@ -90,6 +90,10 @@ class EcsTask final : public runtime::RunTask {
   [[nodiscard]] std::vector<std::string> LogColumns() const override;
   [[nodiscard]] double LogTimeS() const noexcept override { return last_.time_s; }
   void FillLogRow(std::span<double> values) const noexcept override;
+  /// Both wheels as the encoders measured them at the last exchange (no pose: the controller
+  /// does not know it).
+  [[nodiscard]] runtime::TelemetryShape TelemetryShapeOf() const override;
+  void FillTelemetry(runtime::TaskTelemetry& out) const noexcept override;
 
   [[nodiscard]] EcsMode mode() const noexcept { return mode_; }
   [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
@@ -140,8 +144,8 @@ class EcsTask final : public runtime::RunTask {
   std::array<std::int32_t, io::kChannels> pwm_next_{};  ///< computed by the last step
   std::array<std::int32_t, io::kChannels> pwm_sent_{};  ///< on the wire since the last exchange
   std::array<std::int64_t, 2> origin_counts_{};         ///< left, right at the first step
-  bool have_inputs_ = false;  ///< an exchange has succeeded: the counts are a reading
-  bool started_ = false;      ///< the origin is taken
+  bool have_inputs_ = false;       ///< an exchange has succeeded: the counts are a reading
+  bool started_ = false;           ///< the origin is taken
   std::uint64_t held_cycles_ = 0;  ///< exchanges with safe outputs (paused): not profile time
   EcsCycleRecord last_{};
   TrackingSums sums_{};

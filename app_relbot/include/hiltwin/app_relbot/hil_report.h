@@ -15,8 +15,8 @@ namespace hiltwin::app {
 
 /// One process of the pair after it ended.
 struct HilSide {
-  std::string name;                 ///< "twin" or "ecs"
-  kernel_glue::ExitStatus status;   ///< how the process ended
+  std::string name;                              ///< "twin" or "ecs"
+  kernel_glue::ExitStatus status;                ///< how the process ended
   std::optional<nlohmann::ordered_json> report;  ///< its run report, when it wrote one
 };
 

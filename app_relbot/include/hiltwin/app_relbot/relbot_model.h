@@ -24,18 +24,18 @@ using RelbotState = Eigen::Matrix<double, kRelbotStateSize, 1>;
 
 /// Position of each quantity in RelbotState (body frame: X forward, Y left, origin at CoM).
 namespace relbot_state {
-inline constexpr int kWheelSpeedLeftRadPerS = 0;    ///< wheel angular velocity, left
-inline constexpr int kWheelSpeedRightRadPerS = 1;   ///< wheel angular velocity, right
-inline constexpr int kWheelPositionLeftM = 2;       ///< wheel travel r*phi, left (output)
-inline constexpr int kWheelPositionRightM = 3;      ///< wheel travel r*phi, right (output)
-inline constexpr int kSpringDeflectionLeftM = 4;    ///< wheel-to-body spring, left
-inline constexpr int kSpringDeflectionRightM = 5;   ///< wheel-to-body spring, right
-inline constexpr int kBodyVelocityXMPerS = 6;       ///< body velocity along body X
-inline constexpr int kBodyVelocityYMPerS = 7;       ///< body velocity along body Y (side slip)
-inline constexpr int kYawRateRadPerS = 8;           ///< body rotation rate about Z
-inline constexpr int kWorldXM = 9;                  ///< CoM x in the world frame
-inline constexpr int kWorldYM = 10;                 ///< CoM y in the world frame
-inline constexpr int kHeadingRad = 11;              ///< heading theta (0 = world X), CCW +
+inline constexpr int kWheelSpeedLeftRadPerS = 0;   ///< wheel angular velocity, left
+inline constexpr int kWheelSpeedRightRadPerS = 1;  ///< wheel angular velocity, right
+inline constexpr int kWheelPositionLeftM = 2;      ///< wheel travel r*phi, left (output)
+inline constexpr int kWheelPositionRightM = 3;     ///< wheel travel r*phi, right (output)
+inline constexpr int kSpringDeflectionLeftM = 4;   ///< wheel-to-body spring, left
+inline constexpr int kSpringDeflectionRightM = 5;  ///< wheel-to-body spring, right
+inline constexpr int kBodyVelocityXMPerS = 6;      ///< body velocity along body X
+inline constexpr int kBodyVelocityYMPerS = 7;      ///< body velocity along body Y (side slip)
+inline constexpr int kYawRateRadPerS = 8;          ///< body rotation rate about Z
+inline constexpr int kWorldXM = 9;                 ///< CoM x in the world frame
+inline constexpr int kWorldYM = 10;                ///< CoM y in the world frame
+inline constexpr int kHeadingRad = 11;             ///< heading theta (0 = world X), CCW +
 }  // namespace relbot_state
 
 /// Model outputs.
@@ -51,9 +51,9 @@ struct RelbotOutputs {
 /// divisions by parameters.
 struct RelbotCoefficients {
   double supply_voltage_v = 0.0;
-  double drive_per_volt = 0.0;         ///< N k_t / (R J_eq)            [rad/s^2/V]
-  double drive_damping_per_s = 0.0;    ///< N^2 (k_t k_e / R + b_m) / J_eq [1/s]
-  double force_to_wheel_accel = 0.0;   ///< r / J_eq                    [rad/s^2/N]
+  double drive_per_volt = 0.0;        ///< N k_t / (R J_eq)            [rad/s^2/V]
+  double drive_damping_per_s = 0.0;   ///< N^2 (k_t k_e / R + b_m) / J_eq [1/s]
+  double force_to_wheel_accel = 0.0;  ///< r / J_eq                    [rad/s^2/N]
   double wheel_radius_m = 0.0;
   double half_track_m = 0.0;
   double stiffness_n_per_m = 0.0;

@@ -17,11 +17,11 @@ namespace hiltwin::app {
 
 /// RELbot parameters in SI units; the member name carries the unit.
 struct RelbotParams {
-  double supply_voltage_v = 12.0;                    ///< motor driver supply (duty 1 = this)
-  double motor_resistance_ohm = 4.0;                 ///< armature resistance
-  double motor_torque_constant_n_m_per_a = 0.01;     ///< k_t
-  double motor_back_emf_constant_v_s_per_rad = 0.01; ///< k_e (= k_t in SI for an ideal motor)
-  double motor_rotor_inertia_kg_m2 = 1.0e-6;         ///< rotor (and encoder disc)
+  double supply_voltage_v = 12.0;                        ///< motor driver supply (duty 1 = this)
+  double motor_resistance_ohm = 4.0;                     ///< armature resistance
+  double motor_torque_constant_n_m_per_a = 0.01;         ///< k_t
+  double motor_back_emf_constant_v_s_per_rad = 0.01;     ///< k_e (= k_t in SI for an ideal motor)
+  double motor_rotor_inertia_kg_m2 = 1.0e-6;             ///< rotor (and encoder disc)
   double motor_viscous_friction_n_m_s_per_rad = 2.0e-6;  ///< motor + gearbox, at the motor shaft
   double gear_ratio_motor_rev_per_wheel_rev = 50.0;  ///< reduction N (motor turns per wheel turn)
   double encoder_counts_per_motor_rev = 64.0;        ///< quadrature counts (4 x lines)
@@ -36,8 +36,8 @@ struct RelbotParams {
   double contact_lateral_damping_n_s_per_m = 200.0;  ///< both wheels' resistance to side slip (Y)
   double castor_offset_m = 0.10;                     ///< castor behind the CoM along -X
   double castor_viscous_friction_n_s_per_m = 0.2;
-  double castor_coulomb_friction_n = 0.12;           ///< rolling resistance
-  double castor_smoothing_speed_m_per_s = 0.01;      ///< below this the Coulomb term fades out
+  double castor_coulomb_friction_n = 0.12;       ///< rolling resistance
+  double castor_smoothing_speed_m_per_s = 0.01;  ///< below this the Coulomb term fades out
 };
 
 /// How one parameter appears in the TOML file and which values it accepts.

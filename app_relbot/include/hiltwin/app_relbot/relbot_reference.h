@@ -23,8 +23,7 @@ struct ReferenceOptions {
 /// input_hold_s must be a whole multiple of sample_step_s. Throws std::invalid_argument.
 [[nodiscard]] std::vector<RelbotOutputs> SimulateReference(const RelbotParams& params,
                                                            const InputProfile& profile,
-                                                           double duration_s,
-                                                           double sample_step_s,
+                                                           double duration_s, double sample_step_s,
                                                            const ReferenceOptions& options = {});
 
 /// The same experiment with RelbotModel (its integrator and step_s): outputs after each step.

@@ -19,6 +19,7 @@
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/run_report.h"
 #include "hiltwin/runtime/run_session.h"
+#include "hiltwin/telemetry/sinks.h"
 
 namespace hiltwin::app {
 
@@ -45,19 +46,26 @@ struct SessionOptions {
   bool no_progress = false;
   double wait_peer_s = 30.0;
   std::string board_image;  ///< fault injection: the image the emulated board carries
+  /// --telemetry, --namespace (empty: the role's default), --web, --telemetry-rate.
+  telemetry::TelemetryOptions telemetry;
 };
 
 /// What the command that uses the options is, for messages and help texts.
 struct SessionRole {
-  const char* command;        ///< "run" or "ecs"
-  const char* peer_name;      ///< who is on the other side: "controller" or "twin"
-  const char* peer_command;   ///< how the other side starts: "hiltwin ecs" or "hiltwin run"
-  double other_rate_hz;       ///< the other side's rate, for the default (m,k) rule
+  const char* command;            ///< "run" or "ecs"
+  const char* peer_name;          ///< who is on the other side: "controller" or "twin"
+  const char* peer_command;       ///< how the other side starts: "hiltwin ecs" or "hiltwin run"
+  double other_rate_hz;           ///< the other side's rate, for the default (m,k) rule
+  const char* default_namespace;  ///< telemetry namespace without --namespace: "twin", ...
 };
 
 /// Adds the shared flags (with their help texts) to `app`. `--rate` and `--duration` take
 /// their defaults from `o` as it is when called.
 void AddSessionOptions(CLI::App& app, SessionOptions& o);
+
+/// Adds --telemetry, --namespace, --web and --telemetry-rate (part of AddSessionOptions; `hil`
+/// adds them alone and passes them on to its two processes).
+void AddTelemetryOptions(CLI::App& app, telemetry::TelemetryOptions& t);
 
 /// Checks the shared flags; throws CommandError(kUsage) naming the flag and the fix.
 void ValidateSessionOptions(const SessionOptions& o);
@@ -74,8 +82,9 @@ void ValidateSessionOptions(const SessionOptions& o);
 
 /// The session configuration of the shared flags: clock, executive, QoS (the documented
 /// default (m,k) rule for this rate pair unless --qos is given), RT set-up, injection, log,
-/// progress, pause signals and, on a wire, the wait for the peer. The command adds its task's
-/// name, details and on_ready.
+/// progress, pause signals, telemetry (its sinks opened now: a port in use is exit 2 before the
+/// board is touched) and, on a wire, the wait for the peer. The command adds its task's name,
+/// details and on_ready.
 [[nodiscard]] runtime::SessionConfig MakeSessionConfig(const SessionOptions& o,
                                                        const SessionRole& role,
                                                        io::IoBackend& backend);

@@ -62,6 +62,9 @@ class TwinTask final : public runtime::RunTask {
   [[nodiscard]] std::vector<std::string> LogColumns() const override;
   [[nodiscard]] double LogTimeS() const noexcept override { return last_.model_time_s; }
   void FillLogRow(std::span<double> values) const noexcept override;
+  /// The pose (x, y, heading) and both wheels as the model moved them in the last step.
+  [[nodiscard]] runtime::TelemetryShape TelemetryShapeOf() const override;
+  void FillTelemetry(runtime::TaskTelemetry& out) const noexcept override;
 
   [[nodiscard]] const TwinCycleRecord& last() const noexcept { return last_; }
   /// The absolute counts of the last exchange (live or safe).

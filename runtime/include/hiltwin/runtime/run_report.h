@@ -116,8 +116,8 @@ struct RunReport {
 /// What went wrong or needs attention, one line each, for stderr (empty when nothing did).
 [[nodiscard]] std::vector<std::string> Problems(const RunReport& report);
 
-/// The process exit code: an I/O fault or an incomplete log (data or timing) 5, a model fault 1, otherwise the
-/// verdict (PASS 0, FLAGGED 3, ABORTED 4).
+/// The process exit code: an I/O fault or an incomplete log (data or timing) 5, a model fault 1,
+/// otherwise the verdict (PASS 0, FLAGGED 3, ABORTED 4).
 [[nodiscard]] ExitCode ExitCodeFor(const RunReport& report) noexcept;
 
 }  // namespace hiltwin::runtime

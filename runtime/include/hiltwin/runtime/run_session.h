@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,9 +24,11 @@
 #include "hiltwin/kernel_glue/rt_setup.h"
 #include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/qos/monitor.h"
+#include "hiltwin/runtime/command_queue.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_report.h"
 #include "hiltwin/runtime/run_task.h"
+#include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/runtime/virtual_costs.h"
 #include "hiltwin/scheduler/executive.h"
 #include "hiltwin/statemachine/lifecycle.h"
@@ -34,6 +37,7 @@
 namespace hiltwin::runtime {
 
 class CycleRunner;
+class TelemetryPublisher;
 
 /// Where and how often to log.
 struct LogConfig {
@@ -74,6 +78,8 @@ struct SessionConfig {
   /// SIGUSR1 pauses and SIGUSR2 resumes the run (forwarded by the control thread within
   /// 100 ms). Off by default: the handlers are process-wide, the command decides.
   bool pause_signals = false;
+  /// Live telemetry (telemetry.h): no sinks, no telemetry thread and no per-cycle cost.
+  TelemetryConfig telemetry;
   /// Set when the link has a process on its other end (wire); empty otherwise.
   std::optional<PeerWait> peer;
   /// Called on the control thread once the loop thread is set up, before the first cycle:
@@ -90,14 +96,18 @@ class LoopThreadHooks {
   virtual void AfterLoop() noexcept {}
 };
 
-/// Commands another thread may send to a running session.
-enum class SessionCommand : std::uint8_t { kStop, kPause, kResume };
+/// A telemetry sink could not be opened for this task (the message says which and why).
+class TelemetryError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class RunSession {
  public:
-  /// Builds everything and opens the log (truncating it). Throws std::invalid_argument for a
-  /// bad configuration and std::runtime_error when the log cannot be created; the messages
-  /// name domain values, not flags. `task` must outlive the session.
+  /// Builds everything, opens the log (truncating it) and the telemetry sinks. Throws
+  /// std::invalid_argument for a bad configuration, TelemetryError when a sink cannot be
+  /// opened and std::runtime_error when the log cannot be created; the messages name domain
+  /// values, not flags. `task` must outlive the session.
   RunSession(SessionConfig config, RunTask& task);
   ~RunSession();
   RunSession(const RunSession&) = delete;
@@ -107,13 +117,16 @@ class RunSession {
   /// Throws std::runtime_error when a thread cannot be started.
   [[nodiscard]] RunReport Run();
 
-  /// Thread-safe and lock-free; acted on by the loop after its current cycle.
-  void Post(SessionCommand command) noexcept;
+  /// Thread-safe and lock-free; acted on by the loop after its current cycle, in the order
+  /// posted. False when the loop has not yet taken the commands before it (queue full).
+  bool Post(SessionCommand command) noexcept;
   void SetLoopThreadHooks(LoopThreadHooks* hooks) noexcept { hooks_ = hooks; }
 
  private:
   struct LoopResult;
   void LoopThreadMain(LoopResult& result) noexcept;
+  /// The constructor's last step when telemetry is asked for: opens the sinks for this task.
+  void OpenTelemetry();
   void PrintProgress() const;
   /// Control thread, in `ready`: polls the peer until it is up (true), the wait times out
   /// (io_fault) or a stop signal arrives (stop_requested).
@@ -139,6 +152,8 @@ class RunSession {
   LoopThreadHooks* hooks_ = nullptr;
   std::optional<RunFault> wait_fault_;  ///< the peer never came
   bool ran_ = false;
+  /// Last: destroyed first, so its thread has stopped before what it reads goes away.
+  std::unique_ptr<TelemetryPublisher> telemetry_;
 };
 
 }  // namespace hiltwin::runtime

@@ -28,9 +28,9 @@ inline constexpr std::size_t kMaxTelemetryJoints = 4;
 /// fixed size, trivially copyable, so the mailbox copies it without allocating.
 struct TaskTelemetry {
   bool has_pose = false;
-  double x_m = 0.0;          ///< planar pose, world frame
+  double x_m = 0.0;  ///< planar pose, world frame
   double y_m = 0.0;
-  double theta_rad = 0.0;    ///< heading, unwrapped
+  double theta_rad = 0.0;  ///< heading, unwrapped
   std::uint8_t joint_count = 0;
   std::array<double, kMaxTelemetryJoints> joint_position_rad{};  ///< wheel angles
   std::array<double, kMaxTelemetryJoints> joint_position_m{};    ///< wheel travel (r·angle)
@@ -38,15 +38,15 @@ struct TaskTelemetry {
 
 /// What a task's telemetry looks like, fixed for a run (RunTask::TelemetryShapeOf).
 struct TelemetryShape {
-  std::string role = "task";              ///< "twin" or "controller": for the monitor
+  std::string role = "task";  ///< "twin" or "controller": for the monitor
   bool has_pose = false;
-  std::vector<std::string> joint_names;   ///< ROS joint names, one per joint (≤ 4)
+  std::vector<std::string> joint_names;  ///< ROS joint names, one per joint (≤ 4)
 };
 
 /// The loop's part of a telemetry record: written every cycle, read at the telemetry rate.
 struct LoopSnapshot {
-  std::uint64_t cycle = 0;     ///< release index of the last completed cycle
-  double task_time_s = 0.0;    ///< the task's time after its last step (the log's time_s)
+  std::uint64_t cycle = 0;   ///< release index of the last completed cycle
+  double task_time_s = 0.0;  ///< the task's time after its last step (the log's time_s)
   TaskTelemetry task;
 };
 
@@ -54,15 +54,15 @@ struct LoopSnapshot {
 /// derives from this record.
 struct TelemetryRecord {
   // Who.
-  std::string ns;     ///< ROS namespace without leading slash, e.g. "bench1/twin"
-  std::string role;   ///< TelemetryShape::role
+  std::string ns;    ///< ROS namespace without leading slash, e.g. "bench1/twin"
+  std::string role;  ///< TelemetryShape::role
   double rate_hz = 0.0;
   // When.
   double time_s = 0.0;               ///< the task's time (the CSV log's first column)
   std::uint64_t cycle = 0;           ///< cycles run so far
   std::uint64_t cycles_planned = 0;  ///< 0: until stopped
   statemachine::State state = statemachine::State::kInit;
-  bool final = false;                ///< the last record of the run (published after the loop)
+  bool final = false;  ///< the last record of the run (published after the loop)
   // Timing, as the QoS monitor and the loop saw it.
   std::uint64_t deadline_misses = 0;  ///< every miss so far, grace period included
   /// Wake-up latency over the last second of cycles (or fewer at the start); 0 before the

@@ -1,0 +1,85 @@
+// `hiltwin run --telemetry udp:127.0.0.1:PORT` received by a real UDP socket, as PlotJuggler's
+// UDP server would: every datagram one JSON object below 2 KB with a timestamp in seconds,
+// about --telemetry-rate of them per second, and a final record that agrees with the CSV log.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fakes/csv_table.h"
+#include "fakes/process.h"
+#include "fakes/udp_listener.h"
+
+namespace hiltwin {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir(const char* name) {
+  const fs::path dir = fs::temp_directory_path() /
+                       ("hiltwin-udp-" + std::string(name) + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// Every datagram until the final record (or 20 s of silence).
+std::vector<nlohmann::json> ReceiveUntilFinal(const test::UdpListener& listener,
+                                              const std::string& ns) {
+  std::vector<nlohmann::json> received;
+  for (;;) {
+    const std::string datagram = listener.Receive(20'000);
+    if (datagram.empty()) break;
+    EXPECT_LT(datagram.size(), 2048U);
+    received.push_back(nlohmann::json::parse(datagram));
+    if (received.back()[ns]["final"].get<bool>()) break;
+  }
+  return received;
+}
+
+TEST(TelemetryUdp, AtTheConfiguredRateEveryDatagramIsJsonAndTheLastAgreesWithTheLog) {
+  const fs::path dir = TempDir("rate");
+  const test::UdpListener listener;
+  constexpr double kSeconds = 3.0, kRateHz = 20.0;
+  auto twin = test::Spawn(
+      {HILTWIN_BINARY, "run", "--rate", "1000", "--duration", "3", "--telemetry",
+       "udp:127.0.0.1:" + std::to_string(listener.port()), "--telemetry-rate", "20", "--namespace",
+       "bench7/twin", "--log", (dir / "twin.csv").string(), "--no-progress"},
+      (dir / "out.txt").string());
+  const std::vector<nlohmann::json> got = ReceiveUntilFinal(listener, "bench7/twin");
+  EXPECT_EQ(twin.Wait().code, 0);
+  ASSERT_GE(got.size(), 2U);
+  // One record per tick from before the first cycle to the end, plus the final one. A loaded
+  // machine may skip ticks (they are not made up), never add any.
+  const double expected = kSeconds * kRateHz;
+  EXPECT_GE(static_cast<double>(got.size()), 0.6 * expected);
+  EXPECT_LE(static_cast<double>(got.size()), expected + 3.0);
+  for (std::size_t i = 1; i < got.size(); ++i) {
+    EXPECT_GE(got[i]["timestamp"].get<double>(), got[i - 1]["timestamp"].get<double>()) << i;
+  }
+  const nlohmann::json& last = got.back()["bench7/twin"];
+  EXPECT_TRUE(last["final"].get<bool>());
+  EXPECT_EQ(last["state"], "stopped");
+  EXPECT_EQ(last["cycle"], 3000);
+  EXPECT_EQ(last["timing"]["verdict"], "PASS");
+  const auto row = test::ReadCsvTable((dir / "twin.csv").string()).LastRow();
+  EXPECT_DOUBLE_EQ(got.back()["timestamp"].get<double>(), row.at("time_s"));
+  EXPECT_NEAR(last["pose"]["x"].get<double>(), row.at("x_m"), 1e-9);
+  EXPECT_NEAR(last["pose"]["theta"].get<double>(), row.at("theta_rad"), 1e-9);
+  EXPECT_NEAR(last["wheels"]["wheel_left_joint"]["m"].get<double>(), row.at("wheel_left_m"), 1e-9);
+  EXPECT_GT(last["pose"]["x"].get<double>(), 0.1);  // the openloop input moved the robot
+  fs::remove_all(dir);
+}
+
+TEST(TelemetryUdp, ABadSpecIsExitTwoNamingTheFlag) {
+  const test::RunResult r = test::Run(
+      {HILTWIN_BINARY, "run", "--clock", "virtual", "--duration", "1", "--telemetry", "udp:host"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--telemetry udp:"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace hiltwin
