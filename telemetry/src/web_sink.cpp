@@ -40,8 +40,6 @@ constexpr time_t kSocketTimeoutS = 1;
 // How long the destructor lets open streams send their last record (a stream whose client
 // does not read is cut off after this).
 constexpr std::chrono::milliseconds kDrainTimeout{300};
-// httplib's stop() is a no-op until its listener marks itself running.
-constexpr std::chrono::seconds kStartTimeout{2};
 
 // One open /events stream: what it sent last, and its place in the stream count (released
 // when httplib drops the response, however the stream ended).
@@ -108,7 +106,13 @@ WebSink::~WebSink() {
   } catch (...) {
     return;  // no thread could be made: nothing to stop either
   }
-  if (server_.is_running()) server_.stop();
+  // httplib's stop() is a no-op until listen_after_bind has marked the server running (its
+  // first statement), so a sink destroyed right after Open waits for that, or the listener
+  // would accept forever.
+  while (!server_.is_running() && !listen_returned_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  if (!listen_returned_) server_.stop();
   listener_.Join();
 }
 
@@ -167,10 +171,6 @@ void WebSink::StartServing() {
     }
     listen_returned_ = true;
   });
-  const auto give_up = std::chrono::steady_clock::now() + kStartTimeout;
-  while (!server_.is_running() && !listen_returned_ && std::chrono::steady_clock::now() < give_up) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
 }
 
 void WebSink::ServeRecord(httplib::Response& res) const {

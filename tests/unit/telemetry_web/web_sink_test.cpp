@@ -215,6 +215,14 @@ TEST(WebSink, ASinkNeverOpenedFreesItsPort) {
   EXPECT_NO_THROW(auto again = MakeWebSink({"127.0.0.1", static_cast<std::uint16_t>(port)}));
 }
 
+TEST(WebSink, ASinkDestroyedRightAfterOpenEnds) {
+  // httplib's stop() does nothing until its listener runs: the destructor must not miss it.
+  for (int i = 0; i < 20; ++i) {
+    auto sink = MakeWebSink({"127.0.0.1", 0});
+    sink->Open(runtime::TelemetryShape{}, "twin");
+  }
+}
+
 TEST(WebSink, DescribeGivesTheUrl) {
   Served served;
   EXPECT_EQ(served.sink->Describe(),
