@@ -43,8 +43,8 @@ namespace fs = std::filesystem;
 constexpr const char* kChromium = "/usr/bin/chromium";
 
 fs::path TempDir(const char* name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("hiltwin-web-" + std::string(name) + "-" + std::to_string(::getpid()));
+  fs::path dir = fs::temp_directory_path() /
+                 ("hiltwin-web-" + std::string(name) + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
