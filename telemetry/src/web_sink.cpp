@@ -1,0 +1,245 @@
+// The live web page (`--web ADDR:PORT`): the page itself, a Server-Sent Events stream of the
+// telemetry records and the latest record as JSON, served by cpp-httplib on threads of our
+// own. The telemetry thread only swaps a pointer and notifies; every browser is served from
+// its own worker, so a slow one delays nobody but itself.
+
+#include <httplib.h>
+#include <sys/socket.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "hiltwin/kernel_glue/thread.h"
+#include "hiltwin/telemetry/record_json.h"
+#include "hiltwin/telemetry/sinks.h"
+#include "web_bind.h"
+#include "web_latest.h"
+#include "web_page.h"
+#include "web_workers.h"
+
+namespace hiltwin::telemetry {
+namespace {
+
+// A comment on an idle stream (a paused run, a slow rate) keeps the connection from looking
+// dead to the browser, and a closed browser shows up as a failed write within this time.
+constexpr std::chrono::milliseconds kKeepAlive{2000};
+// How long an EventSource waits before it reconnects (e.g. to the next run on the same port).
+constexpr const char* kRetryHint = "retry: 1000\n\n";
+// Each /events stream holds a worker for its whole life: six pages may watch and two workers
+// stay free for the page itself and /record.
+constexpr std::size_t kWorkers = 8;
+constexpr int kMaxStreams = 6;
+// How long one idle or stuck connection may hold a worker, and so the longest the destructor
+// waits for a worker that is not inside a stream (streams end at once on Stop).
+constexpr time_t kSocketTimeoutS = 1;
+// How long the destructor lets open streams send their last record (a stream whose client
+// does not read is cut off after this).
+constexpr std::chrono::milliseconds kDrainTimeout{300};
+
+// One open /events stream: what it sent last, and its place in the stream count (released
+// when httplib drops the response, however the stream ended).
+struct Stream {
+  explicit Stream(std::atomic<int>& open) noexcept : open_count(open) {}
+  ~Stream() { open_count.fetch_sub(1); }
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+
+  std::atomic<int>& open_count;
+  std::uint64_t seen = 0;
+  bool greeted = false;
+};
+
+bool Write(httplib::DataSink& sink, const std::string& text) {
+  return sink.write(text.data(), text.size());
+}
+
+class WebSink final : public runtime::TelemetrySink {
+ public:
+  explicit WebSink(const WebEndpoint& endpoint);
+  ~WebSink() override;
+  WebSink(const WebSink&) = delete;
+  WebSink& operator=(const WebSink&) = delete;
+
+  void Open(const runtime::TelemetryShape& shape, const std::string& ns) override;
+  void Publish(const runtime::TelemetryRecord& record) noexcept override;
+  [[nodiscard]] std::string Describe() const override;
+
+ private:
+  void Configure();
+  void Bind();
+  void StartServing();
+  void ServeRecord(httplib::Response& res) const;
+  void ServeEvents(httplib::Response& res);
+  bool StreamStep(Stream& stream, httplib::DataSink& sink);
+
+  WebEndpoint endpoint_;
+  web::LatestRecord latest_;
+  std::atomic<int> open_streams_{0};
+  httplib::Server server_;
+  std::atomic<bool> listen_returned_{false};
+  kernel_glue::NamedThread listener_;
+};
+
+WebSink::WebSink(const WebEndpoint& endpoint) : endpoint_(endpoint) {
+  Configure();
+  Bind();
+}
+
+WebSink::~WebSink() {
+  latest_.Stop();  // every stream sends what it has not sent yet and ends its response
+  // ... before the listener stops: httplib stops calling a stream's provider once its
+  // listening socket is closed, and the record a stream has not sent yet is usually the
+  // run's final one.
+  const auto give_up = std::chrono::steady_clock::now() + kDrainTimeout;
+  while (open_streams_ > 0 && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  try {
+    // httplib closes its bound socket only from a running listener: a sink that was never
+    // opened starts one just to stop it, so the port is free when the sink is gone.
+    if (!listener_.joinable()) StartServing();
+  } catch (...) {
+    return;  // no thread could be made: nothing to stop either
+  }
+  // httplib's stop() is a no-op until listen_after_bind has marked the server running (its
+  // first statement), so a sink destroyed right after Open waits for that, or the listener
+  // would accept forever.
+  while (!server_.is_running() && !listen_returned_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  if (!listen_returned_) server_.stop();
+  listener_.Join();
+}
+
+void WebSink::Configure() {
+  // httplib's default sets SO_REUSEPORT, which lets a second server bind a port that is in
+  // use (and share its connections). SO_REUSEADDR alone still allows a restart right after
+  // a run, while the last connections sit in TIME_WAIT.
+  server_.set_socket_options([](socket_t sock) {
+    const int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
+  // One request per connection: an idle keep-alive connection would hold a worker, and
+  // httplib does not look at stop() while it waits for the next request.
+  server_.set_keep_alive_max_count(1);
+  server_.set_keep_alive_timeout(kSocketTimeoutS);
+  server_.set_read_timeout(kSocketTimeoutS, 0);
+  server_.set_write_timeout(kSocketTimeoutS, 0);
+  server_.new_task_queue = [] { return new web::Workers(kWorkers, "hiltwin-web"); };
+
+  server_.Get("/", [](const httplib::Request&, httplib::Response& res) {
+    const std::string_view page = web::PageHtml();
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(page.data(), page.size(), "text/html; charset=utf-8");
+  });
+  server_.Get("/record",
+              [this](const httplib::Request&, httplib::Response& res) { ServeRecord(res); });
+  server_.Get("/events",
+              [this](const httplib::Request&, httplib::Response& res) { ServeEvents(res); });
+}
+
+void WebSink::Bind() {
+  bool bound = false;
+  if (endpoint_.port == 0) {  // any free port: Describe() then names the one chosen
+    const int port = server_.bind_to_any_port(endpoint_.address);
+    bound = port > 0;
+    if (bound) endpoint_.port = static_cast<std::uint16_t>(port);
+  } else {
+    bound = server_.bind_to_port(endpoint_.address, endpoint_.port);
+  }
+  if (!bound) {
+    throw std::invalid_argument(web::BindFailureMessage(endpoint_, web::ProbeBind(endpoint_)));
+  }
+}
+
+void WebSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) {
+  static_cast<void>(shape);  // every record names its namespace, role and joints itself
+  static_cast<void>(ns);
+  if (!listener_.joinable()) StartServing();
+}
+
+void WebSink::StartServing() {
+  listener_ = kernel_glue::NamedThread({"hiltwin-web-lsn", {}}, [this] {
+    try {
+      server_.listen_after_bind();
+    } catch (...) {  // workers could not start: the page is gone, the run goes on
+    }
+    listen_returned_ = true;
+  });
+}
+
+void WebSink::ServeRecord(httplib::Response& res) const {
+  const web::LatestRecord::Next latest = latest_.Latest();
+  res.set_header("Cache-Control", "no-store");
+  if (!latest.json) {
+    res.status = 503;
+    res.set_header("Retry-After", "1");
+    res.set_content(R"({"error": "no record yet: the run has not published one"})",
+                    "application/json");
+    return;
+  }
+  res.set_content(*latest.json, "application/json");
+}
+
+void WebSink::ServeEvents(httplib::Response& res) {
+  if (open_streams_.fetch_add(1) >= kMaxStreams) {
+    open_streams_.fetch_sub(1);
+    res.status = 503;
+    res.set_content(
+        "too many open pages (at most " + std::to_string(kMaxStreams) + "): close one and reload",
+        "text/plain");
+    return;
+  }
+  res.set_header("Cache-Control", "no-store");
+  auto stream = std::make_shared<Stream>(open_streams_);
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [this, stream](std::size_t, httplib::DataSink& sink) { return StreamStep(*stream, sink); });
+}
+
+// httplib calls this again for as long as it returns true and the server runs; each call
+// sends one event (the newest record), a keep-alive comment, or the end of the stream.
+bool WebSink::StreamStep(Stream& stream, httplib::DataSink& sink) {
+  if (!stream.greeted) {
+    stream.greeted = true;
+    if (!Write(sink, kRetryHint)) return false;
+  }
+  const web::LatestRecord::Next next = latest_.WaitNewer(stream.seen, kKeepAlive);
+  if (next.stopped) {
+    sink.done();
+    return true;
+  }
+  if (!next.json) return Write(sink, ": keep-alive\n\n");
+  stream.seen = next.seq;
+  std::string event;
+  event.reserve(next.json->size() + 8);
+  event.append("data: ").append(*next.json).append("\n\n");
+  return Write(sink, event);
+}
+
+void WebSink::Publish(const runtime::TelemetryRecord& record) noexcept {
+  try {
+    // replace, not throw, on a bad byte: a namespace typo must not cost the stream
+    std::string json =
+        ToJson(record).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    latest_.Store(std::make_shared<const std::string>(std::move(json)));
+  } catch (...) {  // out of memory: this record is lost, the next one replaces it
+  }
+}
+
+std::string WebSink::Describe() const {
+  return "web page http://" + endpoint_.address + ":" + std::to_string(endpoint_.port) + "/";
+}
+
+}  // namespace
+
+std::shared_ptr<runtime::TelemetrySink> MakeWebSink(const WebEndpoint& endpoint) {
+  return std::make_shared<WebSink>(endpoint);
+}
+
+}  // namespace hiltwin::telemetry

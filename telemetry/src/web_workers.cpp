@@ -1,0 +1,51 @@
+#include "web_workers.h"
+
+#include <utility>
+
+namespace hiltwin::telemetry::web {
+
+Workers::Workers(std::size_t count, const std::string& name) {
+  threads_.reserve(count);
+  try {
+    for (std::size_t i = 0; i < count; ++i)
+      threads_.emplace_back(kernel_glue::ThreadSpec{name, {}}, [this] { Work(); });
+  } catch (...) {
+    shutdown();  // the started ones wait on queued_: release them before unwinding
+    throw;
+  }
+}
+
+Workers::~Workers() { shutdown(); }
+
+void Workers::enqueue(std::function<void()> fn) {
+  {
+    const std::lock_guard lock(mutex_);
+    jobs_.push_back(std::move(fn));
+  }
+  queued_.notify_one();
+}
+
+void Workers::shutdown() {
+  {
+    const std::lock_guard lock(mutex_);
+    shutting_down_ = true;
+  }
+  queued_.notify_all();
+  for (kernel_glue::NamedThread& thread : threads_) thread.Join();
+}
+
+void Workers::Work() {
+  for (;;) {
+    std::function<void()> job;
+    {
+      std::unique_lock lock(mutex_);
+      queued_.wait(lock, [this] { return shutting_down_ || !jobs_.empty(); });
+      if (jobs_.empty()) return;  // shutting down with nothing left to serve
+      job = std::move(jobs_.front());
+      jobs_.pop_front();
+    }
+    job();
+  }
+}
+
+}  // namespace hiltwin::telemetry::web
