@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -71,6 +72,39 @@ TEST(TelemetryUdp, AtTheConfiguredRateEveryDatagramIsJsonAndTheLastAgreesWithThe
   EXPECT_NEAR(last["pose"]["theta"].get<double>(), row.at("theta_rad"), 1e-9);
   EXPECT_NEAR(last["wheels"]["wheel_left_joint"]["m"].get<double>(), row.at("wheel_left_m"), 1e-9);
   EXPECT_GT(last["pose"]["x"].get<double>(), 0.1);  // the openloop input moved the robot
+  fs::remove_all(dir);
+}
+
+TEST(TelemetryUdp, HilPublishesBothSidesUnderItsNamespace) {
+  const fs::path dir = TempDir("hil");
+  const test::UdpListener listener;
+  const test::RunResult r =
+      test::Run({HILTWIN_BINARY, "hil", "--duration", "1", "--telemetry",
+                 "udp:127.0.0.1:" + std::to_string(listener.port()), "--namespace", "lab/bench3",
+                 "--no-progress", "--log-dir", dir.string()},
+                60'000);
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;  // 3: a loaded machine
+  std::map<std::string, nlohmann::json> last;  // namespace -> its last record
+  for (std::string d = listener.Receive(1000); !d.empty(); d = listener.Receive(200)) {
+    const nlohmann::json datagram = nlohmann::json::parse(d);
+    for (const auto& [key, value] : datagram.items()) {
+      if (key != "timestamp") last[key] = value;
+    }
+  }
+  ASSERT_EQ(last.size(), 2U);
+  const nlohmann::json& twin = last["lab/bench3/twin"];
+  const nlohmann::json& controller = last["lab/bench3/controller"];
+  EXPECT_EQ(twin["role"], "twin");
+  EXPECT_TRUE(twin["final"].get<bool>());
+  EXPECT_TRUE(twin.contains("pose"));
+  EXPECT_EQ(controller["role"], "controller");
+  EXPECT_TRUE(controller["final"].get<bool>());
+  EXPECT_FALSE(controller.contains("pose"));  // the controller does not know it
+  // The controller's wheels are what its encoders read from the twin's: the same travel
+  // within a few counts once both have stopped.
+  const auto ecs_log = test::ReadCsvTable((dir / "ecs.csv").string()).LastRow();
+  EXPECT_NEAR(controller["wheels"]["wheel_left_joint"]["m"].get<double>(),
+              ecs_log.at("wheel_left_m"), 1e-9);
   fs::remove_all(dir);
 }
 
