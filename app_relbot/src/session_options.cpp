@@ -1,5 +1,7 @@
 #include "hiltwin/app_relbot/session_options.h"
 
+#include "hiltwin/kernel_glue/thread.h"
+
 #include <unistd.h>
 
 #include <cerrno>
@@ -60,8 +62,12 @@ runtime::OverrunInjector MakeInjector(const SessionOptions& o, std::uint64_t pla
   return injector;
 }
 
-runtime::TelemetryConfig MakeTelemetry(telemetry::TelemetryOptions t, const SessionRole& role) {
+runtime::TelemetryConfig MakeTelemetry(telemetry::TelemetryOptions t, const SessionRole& role,
+                                      const std::vector<int>& loop_cpus) {
   if (t.ns.empty()) t.ns = role.default_namespace;
+  // Cyclone DDS starts its threads with the participant: on the helper CPUs, off the loop's.
+  const kernel_glue::ScopedThreadCpus on_helpers(
+      kernel_glue::HelperCpus(kernel_glue::AllowedCpus(), loop_cpus));
   try {
     return telemetry::MakeTelemetryConfig(t);
   } catch (const std::exception& e) {
@@ -249,7 +255,7 @@ runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionR
         "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a real "
         "board's peer cannot be seen from here (drop --wait-peer)");
   }
-  config.telemetry = MakeTelemetry(o.telemetry, role);
+  config.telemetry = MakeTelemetry(o.telemetry, role, o.cpus);
   return config;
 }
 

@@ -2,12 +2,15 @@
 # The miss ratio of `hiltwin run` at 4 kHz on the real clock with DDS telemetry publishing at
 # 50 Hz (and a monitor subscribed to it) against the same run without telemetry, alternating
 # off/on for several rounds so a noisy minute hits both. Usage:
-#   bash bench/telemetry/dds_miss_ratio.sh [BUILD_DIR] [SECONDS_PER_RUN] [ROUNDS]
-# Uses the loopback Cyclone configuration shipped in config/ and DDS domain 77.
+#   bash bench/telemetry/dds_miss_ratio.sh [BUILD_DIR] [SECONDS_PER_RUN] [ROUNDS] [LOOP_CPU]
+# Uses the loopback Cyclone configuration shipped in config/ and DDS domain 77. Both runs pin
+# the loop to LOOP_CPU (default: the last CPU), as a real-time set-up would: the telemetry
+# thread and Cyclone's threads then run on the other CPUs (docs/architecture.md).
 set -euo pipefail
 build=${1:-build}
 seconds=${2:-20}
 rounds=${3:-3}
+loop_cpu=${4:-$(($(nproc) - 1))}
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 repo=$(cd "$here/../.." && pwd)
 hiltwin="$build/hiltwin"
@@ -24,11 +27,11 @@ p99() {
 
 declare -a off_pct on_pct
 for ((r = 1; r <= rounds; ++r)); do
-  "$hiltwin" run --rate 4000 --duration "$seconds" --no-progress --report "$work/off.json" \
+  "$hiltwin" run --rate 4000 --duration "$seconds" --cpu "$loop_cpu" --no-progress --report "$work/off.json" \
     >/dev/null || true
   "$hiltwin" monitor --domain 77 --duration $((seconds + 5)) >/dev/null 2>&1 &
   monitor=$!
-  "$hiltwin" run --rate 4000 --duration "$seconds" --no-progress --report "$work/on.json" \
+  "$hiltwin" run --rate 4000 --duration "$seconds" --cpu "$loop_cpu" --no-progress --report "$work/on.json" \
     --telemetry dds:77 --namespace bench --telemetry-rate 50 >/dev/null || true
   kill "$monitor" 2>/dev/null || true
   wait "$monitor" 2>/dev/null || true

@@ -141,4 +141,14 @@ std::vector<int> HelperCpus(std::span<const int> allowed, std::span<const int> l
   return helpers;
 }
 
+ScopedThreadCpus::ScopedThreadCpus(std::span<const int> cpus) {
+  if (cpus.empty()) return;
+  previous_ = AllowedCpus();
+  static_cast<void>(SetCallingThreadCpus(cpus));
+}
+
+ScopedThreadCpus::~ScopedThreadCpus() {
+  if (!previous_.empty()) static_cast<void>(SetCallingThreadCpus(previous_));
+}
+
 }  // namespace hiltwin::kernel_glue

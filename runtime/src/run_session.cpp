@@ -206,6 +206,9 @@ RunSession::~RunSession() = default;
 
 void RunSession::OpenTelemetry() {
   TelemetryIdentity identity{config_.telemetry.ns, config_.rate_hz, config_.executive.max_cycles};
+  // Threads the sinks start as they open (HTTP workers) belong on the helper CPUs.
+  const kernel_glue::ScopedThreadCpus on_helpers(
+      kernel_glue::HelperCpus(allowed_cpus_, config_.rt.cpus));
   try {
     telemetry_ = std::make_unique<TelemetryPublisher>(
         config_.telemetry, task_.TelemetryShapeOf(), std::move(identity),

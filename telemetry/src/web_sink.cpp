@@ -164,7 +164,7 @@ void WebSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
 }
 
 void WebSink::StartServing() {
-  listener_ = kernel_glue::NamedThread({"hiltwin-web-lsn", {}}, [this] {
+  listener_ = kernel_glue::NamedThread({"hiltwin-web-lsn", kernel_glue::AllowedCpus()}, [this] {
     try {
       server_.listen_after_bind();
     } catch (...) {  // workers could not start: the page is gone, the run goes on

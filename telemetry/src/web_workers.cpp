@@ -8,7 +8,7 @@ Workers::Workers(std::size_t count, const std::string& name) {
   threads_.reserve(count);
   try {
     for (std::size_t i = 0; i < count; ++i)
-      threads_.emplace_back(kernel_glue::ThreadSpec{name, {}}, [this] { Work(); });
+      threads_.emplace_back(kernel_glue::ThreadSpec{name, kernel_glue::AllowedCpus()}, [this] { Work(); });
   } catch (...) {
     shutdown();  // the started ones wait on queued_: release them before unwinding
     throw;

@@ -50,6 +50,20 @@ class NamedThread {
 /// Pins the calling thread to `cpus`; 0 or an errno value (EINVAL for a bad CPU number).
 [[nodiscard]] int SetCallingThreadCpus(std::span<const int> cpus) noexcept;
 
+/// Moves the calling thread to `cpus` for a scope and back to the CPUs it had: threads that
+/// libraries start meanwhile (Cyclone DDS, an HTTP server) inherit the scope's CPUs, so they
+/// stay off the loop's. Best effort, like SetCallingThreadCpus; empty `cpus`: no change.
+class ScopedThreadCpus {
+ public:
+  explicit ScopedThreadCpus(std::span<const int> cpus);
+  ~ScopedThreadCpus();
+  ScopedThreadCpus(const ScopedThreadCpus&) = delete;
+  ScopedThreadCpus& operator=(const ScopedThreadCpus&) = delete;
+
+ private:
+  std::vector<int> previous_;
+};
+
 /// CPUs for helper threads: `allowed` minus `loop_cpus`; all of `allowed` when the loop is not
 /// pinned or takes every allowed CPU (a helper must run somewhere).
 [[nodiscard]] std::vector<int> HelperCpus(std::span<const int> allowed,
