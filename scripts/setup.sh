@@ -20,6 +20,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools               # telemetry over DDS (idlc generates the types)
   libcpp-httplib-dev                            # the live web page (--web)
   chromium                                      # the web page test (headless)
+  libzip-dev libxml2-dev                        # FMI 2.0 FMUs: unpacking, modelDescription.xml
 )
 
 # One dpkg-query for all: names it does not know at all are missing too.
