@@ -1,8 +1,10 @@
 #include "hiltwin/app_relbot/trajectory_recorder.h"
 
+#include "hiltwin/app_relbot/relbot_plant.h"
+
 namespace hiltwin::app {
 
-TrajectoryRecorder::TrajectoryRecorder(TwinTask& twin, kernel_glue::TimeNs period_ns,
+TrajectoryRecorder::TrajectoryRecorder(plant::PlantTwinTask& twin, kernel_glue::TimeNs period_ns,
                                        std::size_t capacity_cycles)
     : twin_(twin), capacity_(capacity_cycles) {
   record_.period_s = static_cast<double>(period_ns) * 1e-9;
@@ -22,8 +24,8 @@ runtime::StepStatus TrajectoryRecorder::Step(const scheduler::CycleContext& cont
   const kernel_glue::TimeNs release0_ns =
       context.release_ns - static_cast<kernel_glue::TimeNs>(context.cycle) * context.period_ns;
   record_.exchange_time_s.push_back(static_cast<double>(context.start_ns - release0_ns) * 1e-9);
-  record_.wheel_left_m.push_back(twin_.last().outputs.wheel_left_m);
-  record_.wheel_right_m.push_back(twin_.last().outputs.wheel_right_m);
+  record_.wheel_left_m.push_back(twin_.outputs()[relbot_port::kWheelLeftM]);
+  record_.wheel_right_m.push_back(twin_.outputs()[relbot_port::kWheelRightM]);
   return status;
 }
 

@@ -1,10 +1,13 @@
-// The RELbot twin built from `run`'s flags (twin_build.h).
+// A twin built from `run`'s flags (twin_build.h).
 #include "hiltwin/app_relbot/twin_build.h"
 
 #include <stdexcept>
+#include <vector>
 
 #include "hiltwin/app_relbot/command.h"
+#include "hiltwin/app_relbot/relbot_plant.h"
 #include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/plant/plant_registry.h"
 
 namespace hiltwin::app {
 namespace {
@@ -13,12 +16,38 @@ namespace {
   throw CommandError(ExitCode::kUsage, message);
 }
 
+constexpr std::string_view kFmuPrefix = "fmu:";
+
+std::string KnownPlants() {
+  std::string list;
+  for (const plant::PlantEntry* entry : plant::RegisteredPlants()) {
+    list += "\n  " + entry->name + ": " + entry->description;
+  }
+  return list + "\n  fmu:PATH.fmu: an FMI 2.0 co-simulation FMU";
+}
+
+std::unique_ptr<plant::Plant> OpenPlant(const TwinRunOptions& o,
+                                        const plant::PlantEntry** entry_out) {
+  const plant::PlantOptions options{o.config_path, o.integrator};
+  if (o.plant.starts_with(kFmuPrefix)) {
+    Usage("TODO-FMU");  // replaced by fmi::OpenFmuPlant when the fmi module lands
+  }
+  const plant::PlantEntry* entry = plant::FindPlant(o.plant);
+  if (entry == nullptr) {
+    Usage("--plant " + o.plant + ": no such plant; the plants are:" + KnownPlants());
+  }
+  *entry_out = entry;
+  return entry->make(options);
+}
+
 }  // namespace
 
 void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin) {
   try {
-    if (!o.config_path.empty()) twin.params = LoadRelbotParams(o.config_path);
-    twin.integrator = ParseIntegrator(o.integrator);
+    if (o.plant == kRelbotPlantName) {
+      if (!o.config_path.empty()) twin.params = LoadRelbotParams(o.config_path);
+      twin.integrator = ParseIntegrator(o.integrator.empty() ? "rk4" : o.integrator);
+    }
     twin.profile.emplace(LoadInputProfile(o.input));
   } catch (const ConfigError& e) {
     Usage(e.what());
@@ -29,12 +58,40 @@ void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin) {
   }
 }
 
+TwinPlant MakeTwinPlant(const TwinRunOptions& o) {
+  RegisterRelbotPlant();
+  try {
+    const plant::PlantEntry* entry = nullptr;
+    TwinPlant out;
+    out.plant = OpenPlant(o, &entry);
+    if (!o.plant_map_path.empty()) {
+      out.map = plant::LoadPlantMap(o.plant_map_path);
+    } else if (entry != nullptr && entry->default_map) {
+      out.map = entry->default_map(*out.plant);
+    } else {
+      Usage("--plant " + o.plant + " needs --plant-map FILE.toml: which PWM channel drives which "
+            "of its inputs and which output each encoder follows (docs/plants.md)");
+    }
+    static_cast<void>(plant::BindPlantMap(out.map, *out.plant));  // refused now, not mid-build
+    return out;
+  } catch (const plant::PlantError& e) {
+    Usage("--plant " + o.plant + ": " + e.what());
+  } catch (const plant::PlantMapError& e) {
+    Usage("--plant-map: " + std::string(e.what()));
+  }
+}
+
 std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs period_ns) {
   auto twin = std::make_unique<Twin>();
   LoadTwinConfiguration(o, *twin);
+  TwinPlant made = MakeTwinPlant(o);
+  twin->plant = std::move(made.plant);
+  twin->map_source = made.map.source;
+  const double step_s = static_cast<double>(period_ns) * 1e-9;
+  std::vector<double> y0(twin->plant->Info().outputs.size(), 0.0);
   try {
-    twin->model.emplace(twin->params, twin->integrator, static_cast<double>(period_ns) * 1e-9);
-  } catch (const ConfigError& e) {
+    twin->plant->Start(step_s, y0);
+  } catch (const plant::PlantError& e) {
     Usage("--rate " + Num(o.session.rate_hz) + ": " + e.what());
   }
   twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
@@ -49,8 +106,8 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   twin->input_name = profile_drives ? twin->profile->name() : "the controller on " + o.session.io;
   twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
   InitBoard(*twin->driver, period_ns);
-  twin->geometry = WheelGeometryOf(twin->params);
-  twin->task.emplace(*twin->driver, *twin->model, twin->geometry);
+  twin->task.emplace(*twin->driver, *twin->plant, plant::BindPlantMap(made.map, *twin->plant),
+                     step_s, y0);
   return twin;
 }
 

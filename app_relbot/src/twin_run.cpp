@@ -12,10 +12,9 @@
 
 #include "hiltwin/app_relbot/command.h"
 #include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_params.h"
 #include "hiltwin/app_relbot/twin_build.h"
-#include "hiltwin/app_relbot/twin_task.h"
+#include "hiltwin/app_relbot/relbot_plant.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
@@ -38,15 +37,34 @@ void Validate(const TwinRunOptions& o) {
 }
 
 void PrintStartLines(const char* command, const SessionOptions& o, std::uint64_t planned,
-                     const std::string& input, const kernel_glue::RtSetupRecord* rt) {
+                     const std::string& plant, const std::string& input,
+                     const kernel_glue::RtSetupRecord* rt) {
   std::fprintf(
       stdout,
-      "hiltwin %s: RELbot twin at %.0f Hz for %.3f s (%llu cycles), io %s, input %s, %s clock\n",
-      command, o.rate_hz, o.duration_s, static_cast<unsigned long long>(planned), o.io.c_str(),
-      input.c_str(), o.clock.c_str());
+      "hiltwin %s: %s twin at %.0f Hz for %.3f s (%llu cycles), io %s, input %s, %s clock\n",
+      command, plant.c_str(), o.rate_hz, o.duration_s, static_cast<unsigned long long>(planned),
+      o.io.c_str(), input.c_str(), o.clock.c_str());
   if (rt != nullptr)
     std::fprintf(stdout, "real-time set-up: %s\n", kernel_glue::Summary(*rt).c_str());
   std::fflush(stdout);
+}
+
+/// How the start line and the report name the task: "RELbot" for the built-in plant (as
+/// before plants were pluggable), "plant NAME" otherwise.
+std::string TaskNameOf(const plant::PlantInfo& info) {
+  return info.name == kRelbotPlantName ? std::string("RELbot") : "plant " + info.name;
+}
+
+/// The report's facts about the plant: which, what kind, wired by which map, and its own.
+std::vector<std::pair<std::string, std::string>> PlantDetails(const Twin& twin) {
+  const plant::PlantInfo& info = twin.plant->Info();
+  std::vector<std::pair<std::string, std::string>> details = {
+      {"input", twin.input_name},
+      {"plant", info.name},
+      {"plant kind", info.kind},
+      {"plant map", twin.map_source}};
+  details.insert(details.end(), info.details.begin(), info.details.end());
+  return details;
 }
 
 /// --input-rate, or its documented default.
@@ -71,21 +89,23 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   const std::unique_ptr<Twin> twin = BuildTwin(o, period_ns);
   const SessionRole role{command, "controller", "hiltwin ecs", o.controller_rate_hz, "twin"};
   runtime::SessionConfig config = MakeSessionConfig(o.session, role, *twin->backend);
-  config.task_name = "RELbot twin";
-  config.details = {{"input", twin->input_name},
-                    {"integrator", std::string(IntegratorName(twin->integrator))}};
-  config.on_ready = [command, s = o.session, planned,
+  const std::string task_name = TaskNameOf(twin->plant->Info());
+  config.task_name = task_name + " twin";
+  config.details = PlantDetails(*twin);
+  config.on_ready = [command, s = o.session, planned, task_name,
                      input = twin->input_name](const kernel_glue::RtSetupRecord* rt) {
-    PrintStartLines(command, s, planned, input, rt);
+    PrintStartLines(command, s, planned, task_name, input, rt);
   };
   const runtime::RunReport report = RunSessionOf(std::move(config), *twin->task);
   PrintOutcome(o.session, role, report, runtime::ToJson(report), "", report_file);
-  if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault) {
+  if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault &&
+      o.plant == kRelbotPlantName) {
     std::fprintf(
         stderr,
         "hiltwin %s: try a higher --rate, --integrator rk4 or check the parameters in --config\n",
         command);
   }
+  twin->plant->Finish();
   const int exit_code = static_cast<int>(runtime::ExitCodeFor(report));
   return {report, exit_code};
 }
@@ -98,9 +118,16 @@ void AddTwinRunOptions(CLI::App& app, TwinRunOptions& o) {
   app.add_option("--input-rate", o.controller_rate_hz,
                  "rate in Hz at which the input is played into the PWM reader (the ECS's rate; "
                  "default 1000, or --rate if lower)");
+  app.add_option("--plant", o.plant,
+                 "the plant: a built-in or 20-sim plant's name, or fmu:PATH.fmu for an FMI 2.0 "
+                 "co-simulation FMU (docs/plants.md)")
+      ->capture_default_str();
+  app.add_option("--plant-map", o.plant_map_path,
+                 "plant map (TOML): which PWM channel drives which plant input and which output "
+                 "each encoder follows, with scales (default: the plant's own; docs/plants.md)");
   app.add_option("--config", o.config_path,
                  "RELbot parameter file (TOML, see app_relbot/relbot.toml)");
-  app.add_option("--integrator", o.integrator, "euler | rk2 | rk4")->capture_default_str();
+  app.add_option("--integrator", o.integrator, "RELbot integrator: euler | rk2 | rk4 (default rk4)");
 }
 
 }  // namespace hiltwin::app

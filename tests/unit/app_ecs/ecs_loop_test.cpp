@@ -87,18 +87,17 @@ TEST(EcsLoop, ClosedLoopRunsInARunSessionWithoutAllocating) {
 struct ReferenceTwin {
   explicit ReferenceTwin(const InputProfile& profile)
       : source(profile, 1000.0, 4000.0),
-        model(params, Integrator::kRk4, 2.5e-4),
-        task(driver, model, geometry) {
+        twin(driver, params, Integrator::kRk4, 2.5e-4) {
     board.SetPwmSource(&source);
     EXPECT_TRUE(driver.Init(250'000).ok);
   }
   void Run(std::uint64_t cycles) {
     for (std::uint64_t j = 0; j < cycles; ++j) {
-      ASSERT_TRUE(task.Exchange(true).ok());
+      ASSERT_TRUE(twin.task().Exchange(true).ok());
       scheduler::CycleContext context;
       context.cycle = j;
       context.period_ns = 250'000;
-      ASSERT_EQ(task.Step(context).code, runtime::StepStatus::Code::kOk);
+      ASSERT_EQ(twin.task().Step(context).code, runtime::StepStatus::Code::kOk);
     }
   }
   ProfilePwmSource source;
@@ -107,8 +106,7 @@ struct ReferenceTwin {
   io::EmulatedFpga board{io::Image::kIcoboardInverse};
   io::EmulatedSpiBus bus{board};
   io::IcoBoardInverse driver{bus};
-  RelbotModel model;
-  TwinTask task;
+  RelbotTwin twin;
 };
 
 TEST(EcsLoop, OpenLoopLogReplaysIntoAReferenceRunThatReproducesTheTwin) {
@@ -131,7 +129,7 @@ TEST(EcsLoop, OpenLoopLogReplaysIntoAReferenceRunThatReproducesTheTwin) {
   ReferenceTwin reference(logged);
   reference.Run(rig.observations().twin_cycles);
   const RelbotOutputs twin = rig.model().Outputs();
-  const RelbotOutputs ref = reference.model.Outputs();
+  const RelbotOutputs ref = reference.twin.outputs();
   EXPECT_GT(std::abs(twin.wheel_right_m), 0.1);  // the profile really drove the robot
   EXPECT_EQ(ref.wheel_left_m, twin.wheel_left_m);
   EXPECT_EQ(ref.wheel_right_m, twin.wheel_right_m);

@@ -38,8 +38,7 @@ InProcessHil::InProcessHil(const HilConfig& config)
       params_(DefaultRelbotParams()),
       geometry_(WheelGeometryOf(params_)),
       count_m_(1.0 / io::CountsPerMetre(geometry_)),
-      model_(params_, Integrator::kRk4, 1.0 / config.twin_rate_hz),
-      twin_(twin_driver_, model_, geometry_),
+      twin_(twin_driver_, params_, Integrator::kRk4, 1.0 / config.twin_rate_hz),
       ecs_(config.setpoints != nullptr
                ? EcsTask(ecs_driver_, *config.setpoints, config.gains, geometry_, ecs_period_ns_)
                : EcsTask(ecs_driver_, *config.duty_profile, geometry_, ecs_period_ns_)) {
@@ -61,14 +60,14 @@ runtime::StepStatus InProcessHil::Step(const scheduler::CycleContext& context) n
   if (ecs_status.code != runtime::StepStatus::Code::kOk) return ecs_status;
   Observe(context.cycle);
   for (std::uint64_t i = 0; i < twin_per_ecs_; ++i, ++twin_cycle_) {
-    if (!twin_.Exchange(true).ok()) ++seen_.link_errors;
+    if (!twin_.task().Exchange(true).ok()) ++seen_.link_errors;
     scheduler::CycleContext twin_context;
     twin_context.cycle = twin_cycle_;
     twin_context.period_ns = twin_period_ns_;
     twin_context.release_ns = static_cast<std::int64_t>(twin_cycle_) * twin_period_ns_;
     twin_context.model_time_ns = twin_context.release_ns;
     if (twin_board_.time_ns() != twin_context.release_ns) ++seen_.board_time_mismatches;
-    const runtime::StepStatus twin_status = twin_.Step(twin_context);
+    const runtime::StepStatus twin_status = twin_.task().Step(twin_context);
     if (twin_status.code != runtime::StepStatus::Code::kOk) return twin_status;
   }
   return runtime::StepStatus::Ok();
@@ -82,7 +81,7 @@ void InProcessHil::Observe(std::uint64_t ecs_cycle) noexcept {
   }
   const EcsCycleRecord& r = ecs_.last();
   // The model has integrated up to t_k exactly when the ECS samples (twin cycles 0 .. r·k - 1).
-  const RelbotOutputs truth = model_.Outputs();
+  const RelbotOutputs truth = twin_.outputs();
   if (ecs_.mode() == EcsMode::kClosedLoop) {
     seen_.final_true_error_left_m = r.setpoint.left_m - truth.wheel_left_m;
     seen_.final_true_error_right_m = r.setpoint.right_m - truth.wheel_right_m;

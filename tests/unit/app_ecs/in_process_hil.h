@@ -1,5 +1,5 @@
 #pragma once
-// The whole HiL loop in one process, on one virtual timeline: the RELbot twin (TwinTask on an
+// The whole HiL loop in one process, on one virtual timeline: the RELbot twin (the RELbot plant behind a PlantTwinTask on an
 // emulated icoboard_inverse board, IcoBoardInverse driver, RelbotModel RK4) and the ECS
 // (EcsTask on an emulated icoboard board, IcoBoard driver), joined by the encoder lines
 // (EmulatorToReaderLink: the ECS board's quadrature readers decode the twin's A/B edges) and the
@@ -21,7 +21,8 @@
 #include "hiltwin/app_relbot/ecs_task.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/twin_task.h"
+#include "hiltwin/app_relbot/profile_pwm_source.h"
+#include "hiltwin/app_relbot/relbot_twin.h"
 #include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app::test {
@@ -74,8 +75,8 @@ class InProcessHil final : public runtime::RunTask {
   /// ECS cycles of the configured duration.
   [[nodiscard]] std::uint64_t planned_cycles() const noexcept { return planned_cycles_; }
   [[nodiscard]] const EcsTask& ecs() const noexcept { return ecs_; }
-  [[nodiscard]] const TwinTask& twin() const noexcept { return twin_; }
-  [[nodiscard]] const RelbotModel& model() const noexcept { return model_; }
+  [[nodiscard]] const RelbotTwin& twin() const noexcept { return twin_; }
+  [[nodiscard]] const RelbotModel& model() const noexcept { return twin_.model(); }
   [[nodiscard]] HilObservations observations() const noexcept;
 
  private:
@@ -90,7 +91,6 @@ class InProcessHil final : public runtime::RunTask {
   RelbotParams params_;
   io::WheelGeometry geometry_;
   double count_m_;  ///< one encoder count in metres
-  RelbotModel model_;
   io::EmulatedFpga twin_board_{io::Image::kIcoboardInverse};
   io::EmulatedFpga ecs_board_{io::Image::kIcoboard};
   io::EmulatorToReaderLink encoder_lines_{twin_board_};
@@ -99,7 +99,7 @@ class InProcessHil final : public runtime::RunTask {
   io::EmulatedSpiBus ecs_bus_{ecs_board_};
   io::IcoBoardInverse twin_driver_{twin_bus_};
   io::IcoBoard ecs_driver_{ecs_bus_};
-  TwinTask twin_;
+  RelbotTwin twin_;
   EcsTask ecs_;
   std::uint64_t twin_cycle_ = 0;
   HilObservations seen_{};

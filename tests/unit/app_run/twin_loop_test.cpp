@@ -14,7 +14,9 @@
 #include "hiltwin/app_relbot/input_profile.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/twin_task.h"
+#include "hiltwin/app_relbot/profile_pwm_source.h"
+#include "hiltwin/app_relbot/relbot_channels.h"
+#include "hiltwin/app_relbot/relbot_twin.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
@@ -33,9 +35,7 @@ struct TwinRig {
         backend(io::OpenBackend("mock", io::BackendOptions{})),
         driver(backend->bus()),
         params(DefaultRelbotParams()),
-        model(params, Integrator::kRk4, 2.5e-4),
-        geometry(WheelGeometryOf(params)),
-        task(driver, model, geometry) {
+        twin(driver, params, Integrator::kRk4, 2.5e-4) {
     backend->emulated_board()->SetPwmSource(&pwm_source);
     EXPECT_TRUE(driver.Init(250'000).ok);
     runtime::SessionConfig config;
@@ -49,7 +49,7 @@ struct TwinRig {
     config.injector.Add(runtime::ParseOverrunInjection("every=997,extra-us=400"));  // miss path
     config.log = runtime::LogConfig{log_path, 1};
     config.timing_log_path = log_path + ".timing";
-    session.emplace(std::move(config), task);
+    session.emplace(std::move(config), twin.task());
   }
 
   InputProfile profile;
@@ -57,9 +57,7 @@ struct TwinRig {
   std::unique_ptr<io::IoBackend> backend;
   io::IcoBoardInverse driver;
   RelbotParams params;
-  RelbotModel model;
-  io::WheelGeometry geometry;
-  TwinTask task;
+  RelbotTwin twin;
   std::optional<runtime::RunSession> session;
 };
 
@@ -82,8 +80,8 @@ TEST(TwinLoop, RunsTwentyThousandCyclesWithoutAllocating) {
   EXPECT_EQ(report.misses.releases, report.releases);  // every release is in the one ledger
   EXPECT_EQ(report.stop_reason, statemachine::StopReason::kFinished);
   EXPECT_EQ(report.final_state, statemachine::State::kStopped);
-  EXPECT_NE(rig.model.Outputs().wheel_left_m, 0.0);
-  EXPECT_EQ(rig.model.steps(), kCycles);
+  EXPECT_NE(rig.twin.model().Outputs().wheel_left_m, 0.0);
+  EXPECT_EQ(rig.twin.model().steps(), kCycles);
   EXPECT_EQ(report.link.io_errors, 0U);
   ASSERT_TRUE(report.log.has_value());
   EXPECT_EQ(report.log->rows_written, kCycles);
@@ -99,10 +97,10 @@ TEST(TwinLoop, EncoderPositionsReachTheBoardAndTheSafeOutputsStopThePulses) {
   TwinRig rig(log_path);
   const runtime::RunReport report = rig.session->Run();  // ends with the safe outputs
   ASSERT_TRUE(report.outputs_safe);
-  const auto& sent = rig.task.last().encoder_counts;
+  const auto& sent = rig.twin.task().encoder_next();
   // The counts are the wheel travel at the encoder's scale: counts per motor turn times motor
   // turns per wheel turn over the wheel's circumference (about 12 732 counts/m by default).
-  const RelbotOutputs& wheels = rig.task.last().outputs;
+  const RelbotOutputs wheels = rig.twin.outputs();
   const RelbotParams& p = rig.params;
   const double counts_per_m = p.gear_ratio_motor_rev_per_wheel_rev *
                               p.encoder_counts_per_motor_rev /
@@ -113,7 +111,7 @@ TEST(TwinLoop, EncoderPositionsReachTheBoardAndTheSafeOutputsStopThePulses) {
   EXPECT_NEAR(sent[kRightChannel], wheels.wheel_right_m * counts_per_m, 1.0);
   // The safe outputs repeat what the last live exchange sent (the step before the last one's
   // positions), so the emulator settles there and emits no more pulses: a robot at rest.
-  const auto& held = rig.task.encoder_sent();
+  const auto& held = rig.twin.task().encoder_sent();
   EXPECT_NEAR(held[kLeftChannel], sent[kLeftChannel], 20);  // one 250 µs step of travel
   const io::EmulatedFpga& board = *rig.backend->emulated_board();
   const io::EncoderEmulator& left = board.encoder(kLeftChannel);

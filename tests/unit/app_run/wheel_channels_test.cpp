@@ -1,7 +1,7 @@
 // Which board channel is which wheel (thesis appendix G: board channel 1 = index 0 = right
 // wheel, channel 2 = index 1 = left wheel), proven through the whole board path: an ECS driver
 // writes PWM on one channel of its board; the ECS board's PWM generator drives the twin board's
-// PWM reader; TwinTask reads it through its IcoBoardInverse driver, steps the RELbot and sends
+// PWM reader; the RELbot twin task reads it through its IcoBoardInverse driver, steps the RELbot and sends
 // the wheel positions; the twin board's encoder emulator pulses them to the ECS board's
 // quadrature readers, and the ECS driver reads the counts back. With the frames of
 // docs/relbot-model.md (X forward, Y left, θ counter-clockwise) a lone right wheel turns the
@@ -15,7 +15,7 @@
 #include "hiltwin/app_relbot/relbot_channels.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/twin_task.h"
+#include "hiltwin/app_relbot/relbot_twin.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/icoboard.h"
@@ -28,12 +28,11 @@ constexpr std::uint64_t kCycles = 1'600;   // 0.4 s: less than a quarter turn, s
 constexpr std::int32_t kPwm = 1400;        // duty 1400/2048 = 0.68 on the one driven channel
 
 /// An ECS board and a twin board wired to each other, each with its own driver; the twin's
-/// driver serves TwinTask. Both boards count time in data frames since INIT (no clock).
+/// driver serves the twin task. Both boards count time in data frames since INIT (no clock).
 struct HilRig {
   HilRig()
       : params(DefaultRelbotParams()),
-        model(params, Integrator::kRk4, static_cast<double>(kStepNs) * 1e-9),
-        task(twin, model, WheelGeometryOf(params)) {
+        relbot(twin, params, Integrator::kRk4, static_cast<double>(kStepNs) * 1e-9) {
     ecs_board.SetEncoderSource(&lines);
     twin_board.SetPwmSource(&pwm_wires);
     EXPECT_TRUE(ecs.Init(kStepNs).ok);
@@ -44,9 +43,9 @@ struct HilRig {
   /// emulator finished pulsing by now), then the twin exchanges and steps.
   void Cycle(const std::array<std::int32_t, io::kChannels>& pwm, std::uint64_t k) {
     ASSERT_TRUE(ecs.Exchange(pwm, ecs_in).ok());
-    ASSERT_TRUE(task.Exchange(true).ok());
+    ASSERT_TRUE(relbot.task().Exchange(true).ok());
     const scheduler::CycleContext context{k, 0, kStepNs, static_cast<std::int64_t>(k) * kStepNs};
-    ASSERT_TRUE(task.Step(context).code == runtime::StepStatus::Code::kOk);
+    ASSERT_TRUE(relbot.task().Step(context).code == runtime::StepStatus::Code::kOk);
   }
 
   io::EmulatedFpga ecs_board{io::Image::kIcoboard};
@@ -58,8 +57,7 @@ struct HilRig {
   io::IcoBoard ecs{ecs_bus};
   io::IcoBoardInverse twin{twin_bus};
   RelbotParams params;
-  RelbotModel model;
-  TwinTask task;
+  RelbotTwin relbot;
   io::EcsInputs ecs_in{};
 };
 
@@ -82,12 +80,12 @@ DriveResult DriveOneChannel(std::size_t driven) {
   DriveResult drive;
   for (std::uint64_t k = 0; k < kCycles; ++k) {
     rig.Cycle(pwm, k);
-    if (k + 1 == kCycles / 2) drive.halfway = rig.model.Outputs();
+    if (k + 1 == kCycles / 2) drive.halfway = rig.relbot.outputs();
   }
-  drive.duty_read = rig.task.last().duty;
-  drive.end = rig.model.Outputs();
-  EXPECT_TRUE(rig.task.Exchange(true).ok());  // the last step's positions go out
-  drive.sent = rig.task.encoder_sent();
+  drive.duty_read = rig.relbot.duty();
+  drive.end = rig.relbot.outputs();
+  EXPECT_TRUE(rig.relbot.task().Exchange(true).ok());  // the last step's positions go out
+  drive.sent = rig.relbot.task().encoder_sent();
   for (int frame = 0; frame < 2; ++frame) EXPECT_TRUE(rig.ecs.Exchange(pwm, rig.ecs_in).ok());
   drive.ecs_read = rig.ecs_in.absolute_counts;
   EXPECT_EQ(rig.ecs_board.encoder_lines().counters().illegal_transitions, 0U);

@@ -8,6 +8,7 @@
 
 #include "fakes/loop_allocations.h"
 #include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/app_relbot/relbot_plant.h"
 #include "hiltwin/app_relbot/twin_build.h"
 #include "hiltwin/runtime/run_session.h"
 
@@ -50,7 +51,7 @@ RecordedRun RunRecorded(double seconds, runtime::VirtualCycleCosts costs, std::s
   run.trajectory = recorder.trajectory();
   run.not_recorded = recorder.cycles_not_recorded();
   run.allocations = allocations.count;
-  run.last_left_m = twin->task->last().outputs.wheel_left_m;
+  run.last_left_m = twin->task->outputs()[relbot_port::kWheelLeftM];
   return run;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-/// The twin as its controller sees it: a RunTask that forwards every call to a TwinTask and
+/// The RELbot twin as its controller sees it: a RunTask that forwards every call to the twin
+/// task (a PlantTwinTask running the RELbot plant) and
 /// records, for each stepped cycle, when its board exchange happened and the wheel positions
 /// its step computed. `hiltwin tune` turns the record into the RMS error the controller sees
 /// (analysis::ControllerViewRmsError). The storage is reserved up front: on the loop thread
@@ -11,15 +12,16 @@
 #include <vector>
 
 #include "hiltwin/analysis/tuning.h"
-#include "hiltwin/app_relbot/twin_task.h"
+#include "hiltwin/plant/plant_twin_task.h"
 #include "hiltwin/runtime/run_task.h"
 
 namespace hiltwin::app {
 
 class TrajectoryRecorder final : public runtime::RunTask {
  public:
-  /// `twin` is not owned and must outlive the recorder; room for `capacity_cycles` cycles.
-  TrajectoryRecorder(TwinTask& twin, kernel_glue::TimeNs period_ns, std::size_t capacity_cycles);
+  /// `twin` runs the RELbot plant; it is not owned and must outlive the recorder; room for
+  /// `capacity_cycles` cycles.
+  TrajectoryRecorder(plant::PlantTwinTask& twin, kernel_glue::TimeNs period_ns, std::size_t capacity_cycles);
 
   io::ExchangeStatus Exchange(bool live_outputs) noexcept override {
     return twin_.Exchange(live_outputs);
@@ -35,7 +37,7 @@ class TrajectoryRecorder final : public runtime::RunTask {
   [[nodiscard]] std::size_t cycles_not_recorded() const noexcept { return not_recorded_; }
 
  private:
-  TwinTask& twin_;
+  plant::PlantTwinTask& twin_;
   analysis::TwinTrajectory record_;
   std::size_t capacity_;
   std::size_t not_recorded_ = 0;

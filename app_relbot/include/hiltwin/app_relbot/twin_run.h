@@ -16,8 +16,10 @@ struct TwinRunOptions {
   SessionOptions session;
   std::string input = "openloop";
   double controller_rate_hz = 0.0;  ///< 0: min(1000 Hz, --rate), the thesis ECS rate
+  std::string plant = "relbot";   ///< --plant: a registered name or fmu:PATH.fmu
+  std::string plant_map_path;     ///< --plant-map ("" = the plant's own map)
   std::string config_path;
-  std::string integrator = "rk4";
+  std::string integrator;  ///< "" = the plant's default (the RELbot's is rk4)
 };
 
 /// Adds every `run` flag (shared and own) to `app`.

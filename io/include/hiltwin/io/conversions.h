@@ -49,6 +49,11 @@ struct WheelGeometry {
 /// Encoder counts per metre of wheel travel for `geometry`.
 [[nodiscard]] double CountsPerMetre(const WheelGeometry& geometry) noexcept;
 
+/// A plant output to absolute encoder counts: floor(value · counts_per_unit), the one rule
+/// every encoder channel uses (plant maps, plant/plant_map.h). Non-finite results give 0;
+/// results are clamped to ±2^62.
+[[nodiscard]] std::int64_t ValueToCounts(double value, double counts_per_unit) noexcept;
+
 /// Wheel travel in metres to absolute encoder counts, floored: appendix G truncates towards
 /// zero, which makes the count around zero two counts wide; flooring keeps every count equal.
 /// Non-finite inputs give 0; results are clamped to ±2^62.

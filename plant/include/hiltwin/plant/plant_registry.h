@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hiltwin/plant/plant.h"
+#include "hiltwin/plant/plant_map.h"
 
 namespace hiltwin::plant {
 
@@ -26,6 +27,9 @@ struct PlantEntry {
   std::string name;
   std::string description;  ///< one line for --help and "unknown plant" errors
   PlantFactory make;
+  /// The plant's board wiring when --plant-map is not given (the RELbot's appendix G map);
+  /// empty: the plant needs a --plant-map.
+  std::function<PlantMap(const Plant&)> default_map;
 };
 
 /// Adds a plant; returns true so it can initialise a namespace-scope constant. A second entry

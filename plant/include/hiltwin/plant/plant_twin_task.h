@@ -22,8 +22,8 @@ namespace hiltwin::plant {
 class PlantTwinTask final : public runtime::RunTask {
  public:
   /// None of the references is owned; all must outlive the task. `plant` must be started
-  /// (Plant::Start) at `step_s`, and `initial_outputs` are what Start wrote, so the first
-  /// exchange already sends the plant's initial position.
+  /// (Plant::Start) at `step_s`, and `initial_outputs` are what Start wrote: the encoders
+  /// count from there, as an incremental encoder counts from wherever it was switched on.
   PlantTwinTask(io::IcoBoardInverse& board, Plant& plant, BoundPlantMap map, double step_s,
                 std::span<const double> initial_outputs);
 
@@ -43,7 +43,11 @@ class PlantTwinTask final : public runtime::RunTask {
   [[nodiscard]] std::span<const double> inputs() const noexcept { return u_; }
   [[nodiscard]] std::span<const double> outputs() const noexcept { return y_; }
   [[nodiscard]] std::uint64_t steps() const noexcept { return steps_; }
-  /// The absolute counts of the last exchange (live or safe).
+  /// The counts the last step computed, to go out with the next live exchange.
+  [[nodiscard]] const std::array<std::int32_t, io::kChannels>& encoder_next() const noexcept {
+    return encoder_out_;
+  }
+  /// The counts of the last exchange (live or safe).
   [[nodiscard]] const std::array<std::int32_t, io::kChannels>& encoder_sent() const noexcept {
     return encoder_sent_;
   }
@@ -60,6 +64,7 @@ class PlantTwinTask final : public runtime::RunTask {
   io::TwinInputs inputs_{};
   std::vector<double> u_;
   std::vector<double> y_;
+  std::array<std::int64_t, io::kChannels> counts_origin_{};  ///< counts of the initial outputs
   std::array<std::int32_t, io::kChannels> encoder_out_{};   ///< computed by the last step
   std::array<std::int32_t, io::kChannels> encoder_sent_{};  ///< on the wire last
   std::uint64_t steps_ = 0;

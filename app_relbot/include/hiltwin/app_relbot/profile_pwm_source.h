@@ -1,0 +1,34 @@
+#pragma once
+/// An input profile played into the emulated board's PWM reader, as a controller would play it:
+/// what drives the mock board's twin when no controller is connected.
+
+#include <array>
+#include <cstdint>
+
+#include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/io/emulated_fpga.h"
+
+namespace hiltwin::app {
+
+/// Plays an input profile into the emulated board's PWM reader the way a controller would:
+/// sampled and held at the controller's rate (thesis fig. 5.1 was played by a 1 kHz ECS).
+/// The mock board's time is its frame count times the twin's whole-nanosecond period, so the
+/// source counts in frames: frame k holds the controller's sample floor(k * controller rate /
+/// twin rate), taken at that sample's exact time. A frame that coincides with a controller
+/// sample therefore reads it whatever the period's rounding (7 kHz is 142857 ns, and 7 of them
+/// end 1 ns before the millisecond: counted in nanoseconds, every such frame would read the
+/// previous sample, a whole period of extra delay at some rates and none at others).
+class ProfilePwmSource final : public io::PwmSignalSource {
+ public:
+  ProfilePwmSource(const InputProfile& profile, double controller_rate_hz,
+                   double twin_rate_hz) noexcept;
+  void DutyAt(std::int64_t t_ns, std::array<double, io::kChannels>& duty_out) noexcept override;
+
+ private:
+  const InputProfile& profile_;
+  double controller_rate_hz_;
+  double twin_rate_hz_;
+  double twin_period_ns_;  ///< whole nanoseconds, as the board counts them
+};
+
+}  // namespace hiltwin::app

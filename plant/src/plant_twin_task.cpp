@@ -1,0 +1,99 @@
+// Any plant behind the IcoBoard (plant_twin_task.h).
+#include "hiltwin/plant/plant_twin_task.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hiltwin/io/conversions.h"
+
+namespace hiltwin::plant {
+
+PlantTwinTask::PlantTwinTask(io::IcoBoardInverse& board, Plant& plant, BoundPlantMap map,
+                             double step_s, std::span<const double> initial_outputs)
+    : board_(board),
+      plant_(plant),
+      map_(std::move(map)),
+      step_s_(step_s),
+      u_(map_.initial_inputs),
+      y_(initial_outputs.begin(), initial_outputs.end()) {
+  y_.resize(plant_.Info().outputs.size(), 0.0);
+  // An incremental encoder counts from 0 at power-up wherever the shaft stands, so the counts
+  // are the travel since the plant's initial outputs: a plant that starts at x0 = 0.1 m sends
+  // 0 counts in cycle 1, not a burst of pulses that would drive the controller's view there.
+  for (const BoundPlantMap::Encoder& e : map_.encoders) {
+    counts_origin_[e.channel_index] = io::ValueToCounts(y_[e.output_index], e.counts_per_unit);
+  }
+}
+
+void PlantTwinTask::CountsFromOutputs() noexcept {
+  for (const BoundPlantMap::Encoder& e : map_.encoders) {
+    const std::int64_t counts = io::ValueToCounts(y_[e.output_index], e.counts_per_unit);
+    encoder_out_[e.channel_index] = static_cast<std::int32_t>(counts - counts_origin_[e.channel_index]);
+  }
+}
+
+io::ExchangeStatus PlantTwinTask::Exchange(bool live_outputs) noexcept {
+  // One full-duplex frame: the counts of the previous step go out, the PWM measured over the
+  // last period comes in (the one-period twin delay of thesis §3.7). The driver sends
+  // differences against what it sent before, so repeating encoder_sent_ means zero pulses.
+  if (live_outputs) encoder_sent_ = encoder_out_;
+  return board_.Exchange(encoder_sent_, inputs_);
+}
+
+runtime::StepStatus PlantTwinTask::Step(const scheduler::CycleContext&) noexcept {
+  for (const BoundPlantMap::Pwm& p : map_.pwm) u_[p.input_index] = p.gain * inputs_.duty[p.channel_index];
+  const PlantStatus status = plant_.Step(u_, y_);
+  if (status.code == PlantStatus::Code::kFault) return runtime::StepStatus::ModelFault(status.reason);
+  ++steps_;
+  model_time_s_ = static_cast<double>(steps_) * step_s_;
+  if (status.code == PlantStatus::Code::kFinished) {
+    return {runtime::StepStatus::Code::kFinished, status.reason};
+  }
+  if (!std::all_of(y_.begin(), y_.end(), [](double v) { return std::isfinite(v); })) {
+    return runtime::StepStatus::ModelFault("the plant's output became non-finite (NaN or Inf)");
+  }
+  CountsFromOutputs();
+  return runtime::StepStatus::Ok();
+}
+
+std::vector<std::string> PlantTwinTask::LogColumns() const {
+  std::vector<std::string> columns;
+  for (const Port& port : plant_.Info().inputs) columns.push_back(port.name);
+  for (const Port& port : plant_.Info().outputs) columns.push_back(port.name);
+  columns.insert(columns.end(), map_.encoder_columns.begin(), map_.encoder_columns.end());
+  return columns;
+}
+
+void PlantTwinTask::FillLogRow(std::span<double> values) const noexcept {
+  std::size_t i = 0;
+  const auto put = [&](double v) {
+    if (i < values.size()) values[i++] = v;
+  };
+  for (const double v : u_) put(v);
+  for (const double v : y_) put(v);
+  for (const BoundPlantMap::Encoder& e : map_.encoders) {
+    put(static_cast<double>(encoder_out_[e.channel_index]));
+  }
+}
+
+runtime::TelemetryShape PlantTwinTask::TelemetryShapeOf() const {
+  return {"twin", map_.pose.has_value(), map_.joint_names};
+}
+
+void PlantTwinTask::FillTelemetry(runtime::TaskTelemetry& out) const noexcept {
+  out.has_pose = map_.pose.has_value();
+  if (map_.pose) {
+    out.x_m = y_[(*map_.pose)[0]];
+    out.y_m = y_[(*map_.pose)[1]];
+    out.theta_rad = y_[(*map_.pose)[2]];
+  }
+  const std::size_t joints = std::min(map_.joints.size(), out.joint_position_rad.size());
+  out.joint_count = static_cast<std::uint8_t>(joints);
+  for (std::size_t j = 0; j < joints; ++j) {
+    const double value = y_[map_.joints[j].output_index];
+    out.joint_position_rad[j] = value * map_.joints[j].to_rad;
+    out.joint_position_m[j] = value * map_.joints[j].to_m;
+  }
+}
+
+}  // namespace hiltwin::plant
