@@ -15,7 +15,7 @@ command -v clang-tidy >/dev/null || {
   exit 1
 }
 cd "$root"
-mapfile -t files < <(find kernel_glue scheduler qos statemachine io tracing runtime telemetry analysis \
+mapfile -t files < <(find kernel_glue scheduler qos statemachine io tracing runtime fmi telemetry analysis \
                           trace_capture app_relbot tests bench -name '*.cpp' 2>/dev/null | sort)
 echo "== tidy: function size (at most 80 lines) in ${#files[@]} files"
 findings=$(printf '%s\n' "${files[@]}" |
