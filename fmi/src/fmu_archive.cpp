@@ -9,7 +9,6 @@
 #include <array>
 #include <cerrno>
 #include <cstdlib>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -32,6 +31,9 @@ struct ZipFileCloser {
   void operator()(zip_file_t* file) const noexcept { zip_fclose(file); }
 };
 
+// strerror's thread-safe spelling.
+std::string ErrnoText() { return std::generic_category().message(errno); }
+
 ZipPtr OpenZip(const std::filesystem::path& fmu_path) {
   int code = 0;
   zip_t* archive = zip_open(fmu_path.c_str(), ZIP_RDONLY, &code);
@@ -48,14 +50,15 @@ ZipPtr OpenZip(const std::filesystem::path& fmu_path) {
 }
 
 std::filesystem::path MakePrivateDir() {
-  const char* tmp = std::getenv("TMPDIR");
-  std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") +
-                        "/hiltwin-fmu-XXXXXX";
+  // Opening happens before any helper thread runs, so nothing sets the environment meanwhile.
+  const char* tmp = std::getenv("TMPDIR");  // NOLINT(concurrency-mt-unsafe)
+  std::string pattern =
+      std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/hiltwin-fmu-XXXXXX";
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   if (mkdtemp(buffer.data()) == nullptr) {
     throw PlantError("cannot make a folder to unpack the FMU into (" + pattern +
-                     "): " + std::strerror(errno) + ": set TMPDIR to a writable folder");
+                     "): " + ErrnoText() + ": set TMPDIR to a writable folder");
   }
   return {buffer.data()};
 }
@@ -70,8 +73,8 @@ void WriteEntry(zip_t* archive, zip_uint64_t index, const std::filesystem::path&
   // O_EXCL | O_NOFOLLOW: a second entry of the same name or a link never redirects a write.
   const int fd = ::open(target.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
   if (fd < 0) {
-    throw PlantError(where + ": cannot unpack to " + target.string() + ": " +
-                     std::strerror(errno) + " (is the entry in the archive twice?)");
+    throw PlantError(where + ": cannot unpack to " + target.string() + ": " + ErrnoText() +
+                     " (is the entry in the archive twice?)");
   }
   std::array<char, 65536> buffer{};
   bool ok = true;
@@ -88,8 +91,10 @@ void WriteEntry(zip_t* archive, zip_uint64_t index, const std::filesystem::path&
   }
   ::close(fd);
   if (!ok) {
-    throw PlantError(where + ": unpacking failed (damaged entry or disk full): export the FMU "
-                     "again or free space in " + target.parent_path().string());
+    throw PlantError(where +
+                     ": unpacking failed (damaged entry or disk full): export the FMU "
+                     "again or free space in " +
+                     target.parent_path().string());
   }
 }
 

@@ -28,7 +28,8 @@ std::string PlatformsPresent(const std::filesystem::path& unpacked) {
 
 template <typename Function>
 void LookUp(void* handle, const char* symbol, Function*& out, const std::string& where) {
-  dlerror();  // clear, so a stale error is not taken for this lookup's
+  // dlerror's state is per thread in glibc, which is all the lookup needs.
+  dlerror();  // NOLINT(concurrency-mt-unsafe): clear, so a stale error is not taken for ours
   void* address = dlsym(handle, symbol);
   if (address == nullptr) {
     throw PlantError(where + " does not export " + symbol + ", a function every FMI 2.0 " +
@@ -54,7 +55,7 @@ FmuLibrary::FmuLibrary(const std::filesystem::path& unpacked, std::string_view m
   }
   handle_ = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle_ == nullptr) {
-    const char* why = dlerror();
+    const char* why = dlerror();  // NOLINT(concurrency-mt-unsafe): per thread in glibc
     throw PlantError(std::string(fmu_name) + ": " + entry_ + " cannot be loaded (" +
                      (why != nullptr ? why : "dlopen failed") + "): it must be a Linux " +
                      "x86-64 shared library whose dependencies are installed");
@@ -90,8 +91,8 @@ void FmuLibrary::LookUpAll(std::string_view fmu_name) {
   const char* platform = functions_.get_types_platform();
   if (platform == nullptr || std::strcmp(platform, HILTWIN_FMI2_TYPES_PLATFORM) != 0) {
     throw PlantError(where + ": fmi2GetTypesPlatform returned \"" +
-                     (platform != nullptr ? platform : "(null)") + "\", not \"default\": " +
-                     "hiltwin passes the standard's default types");
+                     (platform != nullptr ? platform : "(null)") +
+                     "\", not \"default\": " + "hiltwin passes the standard's default types");
   }
 }
 

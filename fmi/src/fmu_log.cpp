@@ -9,12 +9,18 @@ namespace hiltwin::fmi {
 
 const char* StatusName(fmi2Status status) noexcept {
   switch (status) {
-    case fmi2OK: return "fmi2OK";
-    case fmi2Warning: return "fmi2Warning";
-    case fmi2Discard: return "fmi2Discard";
-    case fmi2Error: return "fmi2Error";
-    case fmi2Fatal: return "fmi2Fatal";
-    case fmi2Pending: return "fmi2Pending";
+    case fmi2OK:
+      return "fmi2OK";
+    case fmi2Warning:
+      return "fmi2Warning";
+    case fmi2Discard:
+      return "fmi2Discard";
+    case fmi2Error:
+      return "fmi2Error";
+    case fmi2Fatal:
+      return "fmi2Fatal";
+    case fmi2Pending:
+      return "fmi2Pending";
   }
   return "an unknown fmi2Status";
 }
@@ -32,8 +38,7 @@ FmuLog::FmuLog(std::string instance_name, std::size_t capacity_messages, Sink si
 }
 
 void FmuLog::Callback(fmi2ComponentEnvironment environment, fmi2String /*instance_name*/,
-                      fmi2Status status, fmi2String category, fmi2String message,
-                      ...) noexcept {
+                      fmi2Status status, fmi2String category, fmi2String message, ...) noexcept {
   // The FMU's instance name is ours (we passed it to fmi2Instantiate), so it is not copied.
   auto* log = static_cast<FmuLog*>(environment);
   if (log == nullptr || message == nullptr) {

@@ -31,8 +31,7 @@ class FmuLog {
 
   /// The fmi2CallbackLogger to give the FMU, with `this` as its componentEnvironment.
   static void Callback(fmi2ComponentEnvironment environment, fmi2String instance_name,
-                       fmi2Status status, fmi2String category, fmi2String message,
-                       ...) noexcept;
+                       fmi2Status status, fmi2String category, fmi2String message, ...) noexcept;
 
   /// Not real-time. Writes every queued message, then one line with the number dropped since
   /// the last drain if any. Returns the messages written. Serialised by a mutex that the

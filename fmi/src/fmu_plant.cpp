@@ -1,11 +1,11 @@
 // FmuPlant: the FMI 2.0 co-simulation calling sequence behind the plant interface.
-#include "fmu_plant_impl.h"
-
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <string>
 #include <utility>
+
+#include "fmu_plant_impl.h"
 
 namespace hiltwin::fmi {
 namespace {
@@ -14,11 +14,11 @@ using plant::PlantError;
 using plant::PlantStatus;
 
 // Static text per call and status: Step cannot build strings.
-#define HILTWIN_FMI_STEP_REASONS(call)                                                    \
-  {                                                                                       \
-    call " returned fmi2OK", call " returned fmi2Warning", call " returned fmi2Discard",  \
+#define HILTWIN_FMI_STEP_REASONS(call)                                                        \
+  {                                                                                           \
+    call " returned fmi2OK", call " returned fmi2Warning", call " returned fmi2Discard",      \
         call " returned fmi2Error", call " returned fmi2Fatal", call " returned fmi2Pending", \
-        call " returned an unknown fmi2Status"                                            \
+        call " returned an unknown fmi2Status"                                                \
   }
 constexpr const char* kSetRealReasons[] = HILTWIN_FMI_STEP_REASONS("fmi2SetReal");
 constexpr const char* kDoStepReasons[] = HILTWIN_FMI_STEP_REASONS("fmi2DoStep");
@@ -29,9 +29,12 @@ const char* StepFaultReason(StepCall call, fmi2Status status) noexcept {
   const int raw = static_cast<int>(status);
   const std::size_t index = raw >= 0 && raw <= 5 ? static_cast<std::size_t>(raw) : 6U;
   switch (call) {
-    case StepCall::kSetReal: return kSetRealReasons[index];
-    case StepCall::kDoStep: return kDoStepReasons[index];
-    case StepCall::kGetReal: return kGetRealReasons[index];
+    case StepCall::kSetReal:
+      return kSetRealReasons[index];
+    case StepCall::kDoStep:
+      return kDoStepReasons[index];
+    case StepCall::kGetReal:
+      return kGetRealReasons[index];
   }
   return "an FMU call failed";
 }

@@ -67,11 +67,11 @@ class FmuPlantImpl final : public FmuPlant {
   std::vector<fmi2Real> zero_inputs_;
 
   fmi2Component component_ = nullptr;
-  bool initialised_ = false;     ///< fmi2ExitInitializationMode returned ok
-  fmi2Status worst_ = fmi2OK;    ///< the last failing status: what FMI 2.0 still allows
-  plant::PlantStatus status_;    ///< latched: after a fault the FMU is not called again
+  bool initialised_ = false;   ///< fmi2ExitInitializationMode returned ok
+  fmi2Status worst_ = fmi2OK;  ///< the last failing status: what FMI 2.0 still allows
+  plant::PlantStatus status_;  ///< latched: after a fault the FMU is not called again
   double step_s_ = 0.0;
-  std::uint64_t steps_ = 0;      ///< model time = steps_ * step_s_ (never accumulated)
+  std::uint64_t steps_ = 0;  ///< model time = steps_ * step_s_ (never accumulated)
 };
 
 }  // namespace hiltwin::fmi

@@ -109,7 +109,7 @@ DocPtr Parse(const std::filesystem::path& xml_file, const Where& where) {
                              XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING));
   if (!doc || ctxt->wellFormed == 0) {
     const xmlError* last = xmlCtxtGetLastError(ctxt.get());
-    std::string why = first.seen ? first.message
+    std::string why = first.seen                                    ? first.message
                       : last != nullptr && last->message != nullptr ? last->message
                                                                     : "unreadable";
     while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) {

@@ -25,7 +25,7 @@ struct ModelDescription {
   std::string model_name;
   std::string guid;
   std::string generation_tool;
-  std::string model_identifier;  ///< <CoSimulation modelIdentifier=...>
+  std::string model_identifier;          ///< <CoSimulation modelIdentifier=...>
   std::optional<double> default_step_s;  ///< <DefaultExperiment stepSize=...>
   std::vector<ScalarVariable> variables;
 

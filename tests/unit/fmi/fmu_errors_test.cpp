@@ -18,9 +18,9 @@
 namespace hiltwin::fmi {
 namespace {
 
+using test::TestFmu;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
-using test::TestFmu;
 
 std::string OpenError(const std::filesystem::path& fmu) {
   try {
@@ -36,11 +36,11 @@ std::string OpenError(const std::filesystem::path& fmu) {
 class FmuRefused : public ::testing::Test {
  protected:
   void SetUp() override {
-    const char* old = std::getenv("TMPDIR");
+    const char* old = std::getenv("TMPDIR");  // NOLINT(concurrency-mt-unsafe): one thread
     old_tmpdir_ = old != nullptr ? old : "";
     had_tmpdir_ = old != nullptr;
-    tmp_ = std::filesystem::temp_directory_path() /
-           ("hiltwin-fmi-test-" + std::to_string(::getpid()));
+    tmp_ =
+        std::filesystem::temp_directory_path() / ("hiltwin-fmi-test-" + std::to_string(::getpid()));
     std::filesystem::remove_all(tmp_);
     std::filesystem::create_directories(tmp_ / "unpack");
     ::setenv("TMPDIR", (tmp_ / "unpack").c_str(), 1);  // NOLINT(concurrency-mt-unsafe): one thread
@@ -59,7 +59,7 @@ class FmuRefused : public ::testing::Test {
   // A zip with the given entries (name, content), made with libzip as a hostile tool would.
   [[nodiscard]] std::filesystem::path MakeZip(
       const std::string& name, const std::vector<std::pair<std::string, std::string>>& entries) {
-    const std::filesystem::path path = tmp_ / name;
+    std::filesystem::path path = tmp_ / name;
     int error = 0;
     zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
     EXPECT_NE(archive, nullptr);

@@ -1,6 +1,8 @@
 // The FMU's logger: messages logged from inside fmi2DoStep wait in the ring and come out at a
 // drain (never during Step); none is lost below the ring's capacity, and above it the drop
 // count is exact and reported.
+#include "fmu_log.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -8,16 +10,15 @@
 #include <string>
 #include <vector>
 
-#include "fmu_log.h"
 #include "hiltwin/fmi/fmu_plant.h"
 #include "test_fmus.h"
 
 namespace hiltwin::fmi {
 namespace {
 
+using test::TestFmu;
 using ::testing::EndsWith;
 using ::testing::HasSubstr;
-using test::TestFmu;
 
 constexpr std::size_t kRingMessages = 64;
 
@@ -81,8 +82,8 @@ TEST(FmuLogRing, LongMessagesAreCutNotOverflowed) {
   ASSERT_EQ(lines.size(), 3U);
   EXPECT_THAT(lines[0], ::testing::StartsWith("fmu inst [fmi2Warning] cat: xxx"));
   EXPECT_THAT(lines[0], EndsWith("x..."));
-  EXPECT_EQ(lines[0].size(), std::string("fmu inst [fmi2Warning] cat: ").size() +
-                                 FmuLog::kTextBytes - 1);
+  EXPECT_EQ(lines[0].size(),
+            std::string("fmu inst [fmi2Warning] cat: ").size() + FmuLog::kTextBytes - 1);
   EXPECT_EQ(lines[1], "fmu inst [fmi2Error]: value 42");
   EXPECT_THAT(lines[2], HasSubstr("1 log messages dropped"));
 }

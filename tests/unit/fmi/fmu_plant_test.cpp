@@ -1,5 +1,7 @@
 // FmuPlant with the good test FMUs: what Info says, the analytic answers through the plant
 // interface, start/reset/finish, the fault path, no allocation in Step, the unpack folder.
+#include "hiltwin/fmi/fmu_plant.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -11,18 +13,17 @@
 #include <vector>
 
 #include "fakes/alloc_counter.h"
-#include "hiltwin/fmi/fmu_plant.h"
 #include "test_fmus.h"
 
 namespace hiltwin::fmi {
 namespace {
 
-using ::testing::AllOf;
-using ::testing::HasSubstr;
-using ::testing::Pair;
 using test::LagY;
 using test::MsdResponse;
 using test::TestFmu;
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::Pair;
 
 constexpr double kStepS = 1e-3;
 constexpr int kTwoSecondsSteps = 2000;
@@ -40,12 +41,10 @@ TEST(FmuInfo, LagPortsUnitsStepAndDetails) {
   EXPECT_EQ(info.outputs[0].unit, "rad");
   EXPECT_DOUBLE_EQ(info.model_step_s, 0.001);
   EXPECT_FALSE(info.step_is_fixed);
-  EXPECT_THAT(info.details,
-              ::testing::ElementsAre(Pair("modelName", "FirstOrderLag"),
-                                     Pair("modelIdentifier", "lag"),
-                                     Pair("generationTool", "hiltwin tests/fmus"),
-                                     Pair("guid", "{hiltwin-test-fmu-lag}"),
-                                     Pair("fmiVersion", "2.0")));
+  EXPECT_THAT(info.details, ::testing::ElementsAre(
+                                Pair("modelName", "FirstOrderLag"), Pair("modelIdentifier", "lag"),
+                                Pair("generationTool", "hiltwin tests/fmus"),
+                                Pair("guid", "{hiltwin-test-fmu-lag}"), Pair("fmiVersion", "2.0")));
 }
 
 TEST(FmuInfo, MsdUnitsIncludingADeclaredType) {
