@@ -1,0 +1,33 @@
+/* First-order lag y' = (K u - y) / tau, stepped exactly with u held over the step:
+ * y <- K u + (y - K u) exp(-h / tau). So y(t) = K u (1 - exp(-t / tau)) from y = 0 holds to
+ * rounding, and tests compare against it tightly. */
+#include <math.h>
+
+#include "fmu_common.h"
+
+enum { kU = 0, kY = 1, kK = 2, kTau = 3 }; /* value references, as in lag.xml.in */
+
+const size_t kModelRealCount = 4;
+
+void ModelSetStartValues(FmuInstance* instance) {
+  instance->r[kU] = 0.0;
+  instance->r[kY] = 0.0;
+  instance->r[kK] = 2.0;
+  instance->r[kTau] = 0.5;
+}
+
+fmi2Status ModelExitInitialization(FmuInstance* instance) {
+  if (!(instance->r[kTau] > 0.0)) {
+    FmuLog(instance, fmi2Error, "logStatusError", "tau = %g s must be positive",
+           instance->r[kTau]);
+    return fmi2Error;
+  }
+  return fmi2OK;
+}
+
+fmi2Status ModelDoStep(FmuInstance* instance, double h_s) {
+  double* r = instance->r;
+  const double target = r[kK] * r[kU];
+  r[kY] = target + (r[kY] - target) * exp(-h_s / r[kTau]);
+  return fmi2OK;
+}
