@@ -7,6 +7,7 @@
 #include "hiltwin/app_relbot/command.h"
 #include "hiltwin/app_relbot/relbot_plant.h"
 #include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/fmi/fmu_plant.h"
 #include "hiltwin/plant/plant_registry.h"
 
 namespace hiltwin::app {
@@ -30,7 +31,7 @@ std::unique_ptr<plant::Plant> OpenPlant(const TwinRunOptions& o,
                                         const plant::PlantEntry** entry_out) {
   const plant::PlantOptions options{o.config_path, o.integrator};
   if (o.plant.starts_with(kFmuPrefix)) {
-    Usage("TODO-FMU");  // replaced by fmi::OpenFmuPlant when the fmi module lands
+    return fmi::OpenFmuPlant(o.plant.substr(kFmuPrefix.size()), options);
   }
   const plant::PlantEntry* entry = plant::FindPlant(o.plant);
   if (entry == nullptr) {
