@@ -15,8 +15,11 @@ command -v clang-tidy >/dev/null || {
   exit 1
 }
 cd "$root"
-mapfile -t files < <(find kernel_glue scheduler qos statemachine io tracing runtime fmi telemetry analysis \
-                          trace_capture app_relbot tests bench -name '*.cpp' 2>/dev/null | sort)
+# plants/<name>/ holds 20-sim generated code (not ours: a big model's CalculateDynamic is long
+# by nature) and msd20sim's hand-written copy of that style, so only plants/ itself is checked.
+mapfile -t files < <(find kernel_glue scheduler qos statemachine io tracing runtime plant fmi \
+                          plants telemetry analysis trace_capture app_relbot tests bench \
+                          -name '*.cpp' -not -path 'plants/*/*' 2>/dev/null | sort)
 echo "== tidy: function size (at most 80 lines) in ${#files[@]} files"
 findings=$(printf '%s\n' "${files[@]}" |
            xargs -P "$(nproc)" -n 6 clang-tidy -p "$build_dir" --quiet \
