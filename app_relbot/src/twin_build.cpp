@@ -93,7 +93,9 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   try {
     twin->plant->Start(step_s, y0);
   } catch (const plant::PlantError& e) {
-    Usage("--rate " + Num(o.session.rate_hz) + ": " + e.what());
+    // A plant that names the flag itself (a 20-sim step mismatch) is quoted as it is.
+    const std::string why = e.what();
+    Usage(why.starts_with("--rate") ? why : "--rate " + Num(o.session.rate_hz) + ": " + why);
   }
   twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
   twin->pwm_source =
