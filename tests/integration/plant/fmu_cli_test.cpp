@@ -15,6 +15,7 @@
 
 #include "fakes/csv_table.h"
 #include "fakes/process.h"
+#include "plant_test_support.h"
 
 namespace {
 
@@ -50,21 +51,9 @@ unit = "m"
 counts_per_unit = 5000
 )";
 
-class FmuCli : public ::testing::Test {
+class FmuCli : public hiltwin::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hiltwin_fmu_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  [[nodiscard]] std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string Write(const std::string& name, const std::string& text) const {
-    std::ofstream(Path(name)) << text;
-    return Path(name);
-  }
   /// A constant duty on board channel 1 from t = 0.
   std::string ConstantInput(double duty) const {
     return Write("input.csv", "time,left,right\n0,0," + std::to_string(duty) + "\n100,0," +
@@ -86,7 +75,6 @@ class FmuCli : public ::testing::Test {
     return static_cast<std::size_t>(it - t.columns.begin());
   }
 
-  fs::path dir_;
 };
 
 TEST_F(FmuCli, AFirstOrderLagFollowsItsAnalyticStepResponse) {
@@ -128,13 +116,9 @@ TEST_F(FmuCli, AMassSpringDamperRingsDownFromItsInitialPositionAsTheAnalyticSolu
   const std::size_t x = Column(log, "x");
   const std::size_t enc = Column(log, "enc1");
   // m x'' + c x' + k x = 0 from x0 = 0.1 m at rest: m = 1 kg, k = 40 N/m, c = 0.8 N s/m.
-  const double wn = std::sqrt(40.0);
-  const double zeta = 0.8 / (2.0 * std::sqrt(40.0 * 1.0));
-  const double wd = wn * std::sqrt(1.0 - zeta * zeta);
   for (const std::vector<double>& row : log.rows) {
     const double t = row[0];
-    const double expected = 0.1 * std::exp(-zeta * wn * t) *
-                            (std::cos(wd * t) + zeta * wn / wd * std::sin(wd * t));
+    const double expected = hiltwin::test::UnderdampedFreeResponseM(0.1, 1.0, 40.0, 0.8, t);
     ASSERT_NEAR(row[x], expected, 1e-9) << "t = " << t;
     // An incremental encoder counts from where the mass started.
     ASSERT_EQ(row[enc], std::floor(row[x] * 5000.0) - std::floor(0.1 * 5000.0)) << "t = " << t;

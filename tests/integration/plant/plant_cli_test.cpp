@@ -13,28 +13,17 @@
 
 #include "fakes/csv_table.h"
 #include "fakes/process.h"
+#include "plant_test_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-class PlantCli : public ::testing::Test {
+class PlantCli : public hiltwin::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hiltwin_plant_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  [[nodiscard]] std::string Path(const std::string& name) const { return (dir_ / name).string(); }
 
-  std::string Write(const std::string& name, const std::string& text) const {
-    std::ofstream(Path(name)) << text;
-    return Path(name);
-  }
 
   static hiltwin::test::RunResult Run(std::vector<std::string> extra) {
     std::vector<std::string> argv = {HILTWIN_BINARY, "run", "--no-progress", "--clock", "virtual"};
@@ -47,7 +36,6 @@ class PlantCli : public ::testing::Test {
     return nlohmann::json::parse(in);
   }
 
-  fs::path dir_;
 };
 
 TEST_F(PlantCli, TheRelbotsShippedMapGivesTheSameLogAsItsBuiltInOne) {

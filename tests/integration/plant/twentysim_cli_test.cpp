@@ -13,22 +13,15 @@
 
 #include "fakes/csv_table.h"
 #include "fakes/process.h"
+#include "plant_test_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-class TwentySimCli : public ::testing::Test {
+class TwentySimCli : public hiltwin::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hiltwin_20sim_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  [[nodiscard]] std::string Path(const std::string& name) const { return (dir_ / name).string(); }
   static hiltwin::test::RunResult Run(std::vector<std::string> extra) {
     std::vector<std::string> argv = {HILTWIN_BINARY, "run",    "--no-progress", "--clock",
                                      "virtual",      "--plant", "msd20sim",     "--plant-map",
@@ -36,7 +29,6 @@ class TwentySimCli : public ::testing::Test {
     argv.insert(argv.end(), extra.begin(), extra.end());
     return hiltwin::test::Run(argv);
   }
-  fs::path dir_;
 };
 
 TEST_F(TwentySimCli, RunsAtItsStepAndRingsDownAsTheAnalyticSolution) {
@@ -52,13 +44,9 @@ TEST_F(TwentySimCli, RunsAtItsStepAndRingsDownAsTheAnalyticSolution) {
                                       "enc_position"}));
   // m x'' + c x' + k x = 0 from x0 = 0.05 m at rest; m = 1 kg, k = 100 N/m, c = 4 N s/m.
   // RK4 at 1 ms is within 1e-9 m of it (the unit tests measured 8e-12).
-  const double wn = 10.0;
-  const double zeta = 4.0 / (2.0 * 10.0);
-  const double wd = wn * std::sqrt(1.0 - zeta * zeta);
   for (const std::vector<double>& row : log.rows) {
     const double t = row[0];
-    const double expected =
-        0.05 * std::exp(-zeta * wn * t) * (std::cos(wd * t) + zeta * wn / wd * std::sin(wd * t));
+    const double expected = hiltwin::test::UnderdampedFreeResponseM(0.05, 1.0, 100.0, 4.0, t);
     ASSERT_NEAR(row[2], expected, 1e-9) << "t = " << t;
     ASSERT_EQ(row[4], std::floor(row[2] * 1e5) - std::floor(0.05 * 1e5)) << "t = " << t;
   }
