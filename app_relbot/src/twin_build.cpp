@@ -73,7 +73,7 @@ TwinPlant MakeTwinPlant(const TwinRunOptions& o) {
       Usage("--plant " + o.plant + " needs --plant-map FILE.toml: which PWM channel drives which "
             "of its inputs and which output each encoder follows (docs/plants.md)");
     }
-    static_cast<void>(plant::BindPlantMap(out.map, *out.plant));  // refused now, not mid-build
+    out.bound = plant::BindPlantMap(out.map, *out.plant);  // refused now, before the board opens
     return out;
   } catch (const plant::PlantError& e) {
     Usage("--plant " + o.plant + ": " + e.what());
@@ -109,8 +109,7 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   twin->input_name = profile_drives ? twin->profile->name() : "the controller on " + o.session.io;
   twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
   InitBoard(*twin->driver, period_ns);
-  twin->task.emplace(*twin->driver, *twin->plant, plant::BindPlantMap(made.map, *twin->plant),
-                     step_s, y0);
+  twin->task.emplace(*twin->driver, *twin->plant, std::move(made.bound), step_s, y0);
   return twin;
 }
 

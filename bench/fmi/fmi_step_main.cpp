@@ -15,20 +15,17 @@
 #include <exception>
 #include <vector>
 
+#include "bench_stats.h"
 #include "hiltwin/fmi/fmu_plant.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using hiltwin::bench::Median;
 constexpr double kStepS = 1e-3;
 constexpr std::size_t kInputSamples = 1024;  // a varying input, so nothing is constant-folded
 
 volatile double g_sink = 0.0;
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
 
 std::vector<double> Inputs() {
   std::vector<double> u(kInputSamples);
@@ -103,9 +100,9 @@ int main(int argc, char** argv) try {
   std::printf("fmi_step: %ld steps x %d rounds, %s, step %.0f us; median (min) ns per step\n",
               steps, rounds, fmu_path, kStepS * 1e6);
   std::printf("  FmuPlant::Step via plant::Plant&             %7.1f  (%7.1f)\n", adapter,
-              *std::min_element(adapter_ns.begin(), adapter_ns.end()));
+              hiltwin::bench::MinOf(adapter_ns));
   std::printf("  fmi2SetReal+fmi2DoStep+fmi2GetReal direct    %7.1f  (%7.1f)\n", direct,
-              *std::min_element(direct_ns.begin(), direct_ns.end()));
+              hiltwin::bench::MinOf(direct_ns));
   std::printf("  adapter overhead (difference)                %7.1f   target < 50 ns: %s\n",
               adapter - direct, adapter - direct < 50.0 ? "met" : "NOT met");
   std::printf("  ratio adapter / direct                       %7.2f\n", adapter / direct);

@@ -14,37 +14,22 @@
 #include <cstdlib>
 #include <vector>
 
-#include "hiltwin/app_relbot/input_profile.h"
 #include "hiltwin/app_relbot/relbot_model.h"
 #include "hiltwin/app_relbot/relbot_plant.h"
 #include "hiltwin/plant/plant_registry.h"
+#include "bench_stats.h"
+#include "relbot_duty_samples.h"
 
 namespace {
 
 using hiltwin::app::Duty;
 using Clock = std::chrono::steady_clock;
+using hiltwin::bench::Median;
+using hiltwin::bench::MinOf;
 
 constexpr double kStepS = 2.5e-4;  // 4 kHz, the thesis's RELbot twin rate
 
 volatile double g_sink = 0.0;  // keeps the results observable
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
-double Min(const std::vector<double>& values) {
-  return *std::min_element(values.begin(), values.end());
-}
-
-std::vector<Duty> ProfileSamples() {
-  const hiltwin::app::InputProfile profile = hiltwin::app::OpenLoopProfile();
-  std::vector<Duty> samples(static_cast<std::size_t>(profile.period_s() * 1000.0));
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    samples[i] = profile.At(static_cast<double>(i) * 1e-3);
-  }
-  return samples;
-}
 
 double NsPerStep(Clock::time_point start, Clock::time_point end, long steps) {
   return std::chrono::duration<double, std::nano>(end - start).count() / static_cast<double>(steps);
@@ -87,7 +72,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s [steps_per_round > 0] [rounds > 0]\n", argv[0]);
     return 2;
   }
-  const std::vector<Duty> duty = ProfileSamples();
+  const std::vector<Duty> duty = hiltwin::bench::OpenLoopDutiesAt1kHz();
   hiltwin::app::RegisterRelbotPlant();
   const std::unique_ptr<hiltwin::plant::Plant> plant =
       hiltwin::plant::FindPlant("relbot")->make({});
@@ -108,8 +93,8 @@ int main(int argc, char** argv) {
   std::printf("plant_step: %ld steps x %d rounds per variant, RELbot rk4, step %.0f us, "
               "openloop duties; median (min) ns per step\n",
               steps, rounds, kStepS * 1e6);
-  std::printf("  RelbotModel::Step, called directly    %7.1f  (%7.1f)\n", direct, Min(direct_ns));
-  std::printf("  plant::Plant::Step (RELbot plant)     %7.1f  (%7.1f)\n", via, Min(interface_ns));
+  std::printf("  RelbotModel::Step, called directly    %7.1f  (%7.1f)\n", direct, MinOf(direct_ns));
+  std::printf("  plant::Plant::Step (RELbot plant)     %7.1f  (%7.1f)\n", via, MinOf(interface_ns));
   std::printf("  interface overhead                    %7.1f   target < 20 ns: %s\n",
               via - direct, via - direct < 20.0 ? "met" : "NOT met");
   return 0;

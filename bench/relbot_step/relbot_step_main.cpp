@@ -22,31 +22,19 @@
 
 #include "hiltwin/app_relbot/input_profile.h"
 #include "hiltwin/app_relbot/relbot_model.h"
+#include "bench_stats.h"
+#include "relbot_duty_samples.h"
 
 namespace {
 
 using hiltwin::app::Duty;
 using hiltwin::app::RelbotState;
 using Clock = std::chrono::steady_clock;
+using hiltwin::bench::Median;
 
 constexpr double kStepS = 2.5e-4;  // 4 kHz, the thesis's RELbot twin rate
 
 volatile double g_sink = 0.0;  // keeps the results observable
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
-// Duties of the openloop profile at 1 kHz, one period; steps use sample k / 4.
-std::vector<Duty> ProfileSamples() {
-  const hiltwin::app::InputProfile profile = hiltwin::app::OpenLoopProfile();
-  std::vector<Duty> samples(static_cast<std::size_t>(profile.period_s() * 1000.0));
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    samples[i] = profile.At(static_cast<double>(i) * 1e-3);
-  }
-  return samples;
-}
 
 double TimeHiltwin(hiltwin::app::RelbotModel& model, const std::vector<Duty>& duty, long steps) {
   model.Reset();
@@ -108,7 +96,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s [steps_per_round > 0] [rounds > 0]\n", argv[0]);
     return 2;
   }
-  const std::vector<Duty> duty = ProfileSamples();
+  const std::vector<Duty> duty = hiltwin::bench::OpenLoopDutiesAt1kHz();
   const hiltwin::app::RelbotParams params;
   hiltwin::app::RelbotModel rk4(params, hiltwin::app::Integrator::kRk4, kStepS);
   hiltwin::app::RelbotModel rk2(params, hiltwin::app::Integrator::kRk2, kStepS);
@@ -136,9 +124,9 @@ int main(int argc, char** argv) {
               "openloop duties; median (min) ns per step\n",
               steps, rounds, kStepS * 1e6);
   std::printf("  hiltwin RelbotModel::Step rk4      %7.1f  (%7.1f)\n", ours,
-              *std::min_element(ours_ns.begin(), ours_ns.end()));
+              hiltwin::bench::MinOf(ours_ns));
   std::printf("  Boost.Odeint runge_kutta4, same f  %7.1f  (%7.1f)\n", peer,
-              *std::min_element(odeint_ns.begin(), odeint_ns.end()));
+              hiltwin::bench::MinOf(odeint_ns));
   std::printf("  ratio hiltwin / odeint             %7.2f   target <= 1.00: %s\n", ours / peer,
               ours / peer <= 1.0 ? "met" : "NOT met");
   std::printf("  rk4 step vs 300 ns target          %7.1f   %s\n", ours,

@@ -48,6 +48,7 @@ void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin);
 struct TwinPlant {
   std::unique_ptr<plant::Plant> plant;
   plant::PlantMap map;
+  plant::BoundPlantMap bound;  ///< `map` checked against `plant`'s ports, for the task
 };
 [[nodiscard]] TwinPlant MakeTwinPlant(const TwinRunOptions& o);
 
