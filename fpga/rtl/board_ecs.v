@@ -26,9 +26,12 @@ module board_ecs (
   assign init_divider = 16'd0;
   assign pulse_limit  = 1'b0;
 
+  // step_ns >= 10, registered while the request is stable (it is from the engine's take on).
+  reg step_ok;
   always @(posedge clk) begin
+    step_ok   <= (payload[63:36] != 28'd0) || (payload[35:32] >= 4'd10);
     init_done <= init_go;
-    if (init_go) init_ok <= (payload[63:32] >= 32'd10);
+    if (init_go) init_ok <= step_ok;
   end
 
   genvar c;

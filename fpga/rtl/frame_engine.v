@@ -62,20 +62,31 @@ module frame_engine #(
   wire enc_class   = (op >= 8'd8 && op <= 8'd11) || (op == OP_ALL && TWIN != 0);
   wire none_class  = (op == OP_NOOP) || (op == OP_RESET);
 
-  // Per channel: "not addressed by a per-channel opcode, so must be 0", or the field check.
-  function word_ok(input [15:0] w, input addressed, input pwm, input enc);
-    if (!addressed)  word_ok = (w == 16'd0);
-    else if (pwm)    word_ok = (w[13:0] <= 14'd2048);   // magnitude <= kPwmMagnitudeMax
-    else if (enc)    word_ok = !w[15];                  // reserved bit
-    else             word_ok = 1'b1;
-  endfunction
-
-  wire [3:0] addressed = per_channel ? selected : 4'b1111;
-  wire words_ok = word_ok(w0, addressed[0], pwm_class, enc_class) &
-                  word_ok(w1, addressed[1], pwm_class, enc_class) &
-                  word_ok(w2, addressed[2], pwm_class, enc_class) &
-                  word_ok(w3, addressed[3], pwm_class, enc_class);
-  wire payload_ok = none_class ? (payload == 64'd0) : words_ok;
+  // The field checks in two registered stages (the request is stable from take on, the CHECK
+  // state comes 12 clocks later), so no long compare chain ends in CHECK's many enables.
+  // Stage 1: per-word primitives and the opcode's class.
+  reg [3:0] word_zero, word_pwm_ok, word_enc_ok, addressed;
+  reg       none_r, pwm_r, enc_r, op_ok_r, status_ok_r;
+  always @(posedge clk) begin
+    word_zero   <= {w3 == 16'd0, w2 == 16'd0, w1 == 16'd0, w0 == 16'd0};
+    word_pwm_ok <= {w3[13:0] <= 14'd2048, w2[13:0] <= 14'd2048,   // magnitude <= 2048
+                    w1[13:0] <= 14'd2048, w0[13:0] <= 14'd2048};
+    word_enc_ok <= {!w3[15], !w2[15], !w1[15], !w0[15]};          // reserved bit
+    addressed   <= per_channel ? selected : 4'b1111;
+    none_r      <= none_class;
+    pwm_r       <= pwm_class;
+    enc_r       <= enc_class;
+    op_ok_r     <= (op <= OP_TEST);
+    status_ok_r <= (status == 8'd0);
+  end
+  // Stage 2: io::Decode's verdict without the CRC (S_CRC computes that meanwhile). A word not
+  // addressed by a per-channel opcode must be 0; an addressed one must pass its class's check.
+  wire [3:0] words_pass = (~addressed & word_zero) |
+                          (addressed & (pwm_r ? word_pwm_ok : enc_r ? word_enc_ok : 4'b1111));
+  reg fields_ok;
+  always @(posedge clk) begin
+    fields_ok <= op_ok_r && status_ok_r && (none_r ? (&word_zero) : (&words_pass));
+  end
 
   // ---- CRC over bytes 0..10 of the request (S_CRC) or of the answer being built (S_ACRC) ------
   wire [87:0] crc_frame = (state == S_ACRC) ? build : request[95:8];  // bytes 0..10
@@ -99,22 +110,36 @@ module frame_engine #(
   crc8 u_crc (.crc_in(crc), .data(crc_byte), .crc_out(crc_next));
 
   // ---- the answer's bytes 2..9 ----------------------------------------------------------------
-  // op_answered: the request's opcode, NOOP when byte 0 is not an opcode (EmulatedFpga).
-  wire [7:0] op_answered = (op <= OP_TEST) ? op : OP_NOOP;
-  reg  [63:0] answer_payload;
+  // Opcode decodes, registered like fields_ok (the request is stable from take on), so the
+  // BUILD state's payload multiplexer starts from flip-flops.
+  reg [7:0] op_answered;     // the request's opcode, NOOP when byte 0 is not one (EmulatedFpga)
+  reg       is_init, is_all, is_test, is_readback, is_enc_readback;
+  reg [3:0] readback_mask;
+  always @(posedge clk) begin
+    op_answered     <= (op <= OP_TEST) ? op : OP_NOOP;
+    is_init         <= (op == OP_INIT);
+    is_all          <= (op == OP_ALL);
+    is_test         <= (op == OP_TEST);
+    is_readback     <= per_channel;
+    is_enc_readback <= op[3];
+    readback_mask   <= selected;
+  end
+
+  reg [63:0] answer_payload;
   always @(*) begin
     answer_payload = 64'd0;
-    if (op_answered == OP_INIT) begin
+    if (is_init) begin
       // A damaged INIT still encodes an InitAnswer: version 1, 4 channels, identity 0.
       answer_payload = {8'd1, 8'd4, rejected ? 8'd0 : IDENTITY, 8'd0, 16'd0, answer_divider};
     end else if (!rejected) begin
-      if (op == OP_ALL) begin
+      if (is_all) begin
         if (initialised) answer_payload = (TWIN != 0) ? pwm_words : enc_words;
-      end else if (op == OP_TEST) begin
+      end else if (is_test) begin
         answer_payload = payload;
-      end else if (per_channel) begin
-        answer_payload = (op[3] ? enc_words : pwm_words) &
-                         {{16{selected[0]}}, {16{selected[1]}}, {16{selected[2]}}, {16{selected[3]}}};
+      end else if (is_readback) begin
+        answer_payload = (is_enc_readback ? enc_words : pwm_words) &
+                         {{16{readback_mask[0]}}, {16{readback_mask[1]}},
+                          {16{readback_mask[2]}}, {16{readback_mask[3]}}};
       end
     end
   end
@@ -150,18 +175,18 @@ module frame_engine #(
           answer_divider <= 16'd0;
           wait_left      <= 3'd1;
           state          <= S_WAIT;
-          if ((crc ^ 8'hFF) != crc_rx || op > OP_TEST || status != 8'd0 || !payload_ok) begin
+          if ((crc ^ 8'hFF) != crc_rx || !fields_ok) begin
             rejected <= 1'b1;          // never act on a damaged request
-          end else if (op == OP_INIT) begin
+          end else if (is_init) begin
             clr         <= 1'b1;
             init_go     <= 1'b1;
             initialised <= 1'b0;
             state       <= S_INIT;
-          end else if (op == OP_RESET) begin
+          end else if (op_answered == OP_RESET) begin
             clr         <= 1'b1;
             initialised <= 1'b0;
             wait_left   <= 3'd2;       // let the board's status (pulse limit) clear
-          end else if (op == OP_ALL && initialised) begin
+          end else if (is_all && initialised) begin
             all_go    <= 1'b1;
             wait_left <= 3'd6;         // encoder plan (limit, end position) and samples settle
           end

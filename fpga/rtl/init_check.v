@@ -25,7 +25,14 @@ module init_check (
     .done(div_done), .quotient(div_quotient)
   );
 
-  wire range_ok = (step_ns >= 32'd10) && (divider >= 32'd4) && (divider <= 32'd65535);
+  // Registered: the request (and so step_ns, divider) is stable from the frame engine's take,
+  // a dozen clocks before go; this keeps the 32-bit compares off the go path.
+  reg step_ok, divider_ok;
+  always @(posedge clk) begin
+    step_ok    <= (step_ns[31:4] != 28'd0) || (step_ns[3:0] >= 4'd10);          // >= 10
+    divider_ok <= (divider[31:16] == 16'd0) && (divider[15:2] != 14'd0);        // 4..65535
+  end
+  wire range_ok = step_ok && divider_ok;
 
   always @(posedge clk) begin
     done      <= 1'b0;
