@@ -106,8 +106,12 @@ module frame_engine #(
       default: crc_byte = crc_frame[7:0];
     endcase
   end
+  // The selected byte is registered before it enters the CRC step (the byte multiplexer and
+  // the XOR tree together miss 100 MHz), so a pass takes 12 clocks: index 0 only loads.
+  reg  [7:0] crc_data;
+  always @(posedge clk) crc_data <= crc_byte;
   wire [7:0] crc_next;
-  crc8 u_crc (.crc_in(crc), .data(crc_byte), .crc_out(crc_next));
+  crc8 u_crc (.crc_in(crc), .data(crc_data), .crc_out(crc_next));
 
   // ---- the answer's bytes 2..9 ----------------------------------------------------------------
   // Opcode decodes, registered like fields_ok (the request is stable from take on), so the
@@ -165,9 +169,9 @@ module frame_engine #(
           state <= S_CRC;
         end
         S_CRC: begin
-          crc   <= crc_next;
+          if (index != 4'd0) crc <= crc_next;
           index <= index + 4'd1;
-          if (index == 4'd10) state <= S_CHECK;
+          if (index == 4'd11) state <= S_CHECK;
         end
         S_CHECK: begin
           rejected       <= 1'b0;
@@ -209,9 +213,9 @@ module frame_engine #(
           state <= S_ACRC;
         end
         S_ACRC: begin
-          crc   <= crc_next;
+          if (index != 4'd0) crc <= crc_next;
           index <= index + 4'd1;
-          if (index == 4'd10) state <= S_WRITE;
+          if (index == 4'd11) state <= S_WRITE;
         end
         S_WRITE: if (cs_idle) begin     // never change MISO during a transfer
           answer <= {build, crc ^ 8'hFF};
