@@ -21,6 +21,7 @@ packages=(
   libcpp-httplib-dev                            # the live web page (--web)
   chromium                                      # the web page test (headless)
   libzip-dev libxml2-dev                        # FMI 2.0 FMUs: unpacking, modelDescription.xml
+  yosys nextpnr-ice40 fpga-icestorm verilator   # the IcoBoard gateware (fpga/, docs/fpga.md)
 )
 
 # One dpkg-query for all: names it does not know at all are missing too.
