@@ -31,8 +31,35 @@ void EmulatedFpga::PublishPeriod() noexcept {
 }
 
 void EmulatedFpga::Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept {
+  // Transfer n shifts out the answer to request n-1 (the register as it stood when CS fell);
+  // the request arriving in it is acted upon at its end.
+  SendAnswer(miso);
+  TakeRequest(mosi);
+}
+
+void EmulatedFpga::SendAnswer(FrameBytes& miso) noexcept {
+  miso = answer_register_;
+  // Answer faults skip the answers to NOOPs (the driver's fetches, whose answers nobody reads).
+  if (answer_register_data_) {
+    if (faults_.delay_answers > 0) {
+      --faults_.delay_answers;
+      miso = previous_miso_;
+    } else if (faults_.drop_answers > 0) {
+      --faults_.drop_answers;
+      miso.fill(0xFF);
+    } else if (faults_.corrupt_answers > 0) {
+      --faults_.corrupt_answers;
+      const std::uint32_t bit = corrupt_bit_++ % kFrameBits;
+      miso[bit / 8] = static_cast<std::uint8_t>(miso[bit / 8] ^ (1U << (bit % 8)));
+    }
+  }
+  previous_miso_ = miso;
+}
+
+void EmulatedFpga::TakeRequest(const FrameBytes& mosi) noexcept {
   FrameBytes request_bytes = mosi;
-  if (faults_.corrupt_requests > 0) {
+  const bool data = request_bytes[0] != static_cast<std::uint8_t>(Opcode::kNoop);
+  if (data && faults_.corrupt_requests > 0) {
     --faults_.corrupt_requests;
     const std::uint32_t bit = corrupt_bit_++ % kFrameBits;
     request_bytes[bit / 8] = static_cast<std::uint8_t>(request_bytes[bit / 8] ^ (1U << (bit % 8)));
@@ -55,26 +82,10 @@ void EmulatedFpga::Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept {
   if (initialised_) answer.status = static_cast<std::uint8_t>(answer.status | kStatusInitialised);
   if (pulse_limit_) answer.status = static_cast<std::uint8_t>(answer.status | kStatusPulseLimit);
 
-  FrameBytes answer_bytes;
-  if (Encode(answer, Direction::kAnswer, image_, answer_bytes) != FrameError::kOk) {
-    answer_bytes.fill(0xFF);  // cannot happen for values the model produces; fail visibly
+  if (Encode(answer, Direction::kAnswer, image_, answer_register_) != FrameError::kOk) {
+    answer_register_.fill(0xFF);  // cannot happen for values the model produces; fail visibly
   }
-
-  if (faults_.delay_answers > 0) {
-    --faults_.delay_answers;
-    miso = previous_answer_;
-  } else if (faults_.drop_answers > 0) {
-    --faults_.drop_answers;
-    miso.fill(0xFF);
-  } else {
-    miso = answer_bytes;
-    if (faults_.corrupt_answers > 0) {
-      --faults_.corrupt_answers;
-      const std::uint32_t bit = corrupt_bit_++ % kFrameBits;
-      miso[bit / 8] = static_cast<std::uint8_t>(miso[bit / 8] ^ (1U << (bit % 8)));
-    }
-  }
-  previous_answer_ = answer_bytes;
+  answer_register_data_ = data;
 }
 
 void EmulatedFpga::HandleRequest(const Frame& request, Frame& answer) noexcept {

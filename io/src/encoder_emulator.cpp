@@ -66,8 +66,13 @@ std::int64_t PulseSegment::EdgeTimeNs(std::uint32_t j) const noexcept {
 }
 
 bool EncoderEmulator::Configure(std::int64_t step_ns, std::uint32_t clock_divider) noexcept {
+  // The twin image's INIT range: the gateware's divider and sub-tick counters are 16 bits wide.
+  if (step_ns < kNsPerFpgaClock || clock_divider < kMinClockDivider ||
+      clock_divider > kMaxClockDivider) {
+    return false;
+  }
   const std::uint32_t subticks = SubticksPerStep(step_ns, clock_divider);
-  if (subticks == 0 || clock_divider < kMinClockDivider) return false;
+  if (subticks < 1 || subticks > kMaxSubticksPerStep) return false;
   step_ns_ = step_ns;
   segment_.subticks = subticks;
   segment_.divider = clock_divider;

@@ -64,7 +64,12 @@ IcoBoardLink::IcoBoardLink(SpiBus& bus, Image image, const kernel_glue::Clock* c
 ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   ExchangeStatus status;
   request.sequence = ++sequence_;
-  if (Encode(request, Direction::kRequest, image_, tx_) != FrameError::kOk) {
+  // The fetch: a NOOP with its own sequence number, whose transfer carries the answer to
+  // `request` (the board answers one transfer late; docs/spi-protocol.md, "Pipelined answers").
+  Frame fetch;
+  fetch.sequence = ++sequence_;
+  if (Encode(request, Direction::kRequest, image_, tx_) != FrameError::kOk ||
+      Encode(fetch, Direction::kRequest, image_, fetch_tx_) != FrameError::kOk) {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;
     status.reason = "request field out of range (driver bug)";
@@ -72,7 +77,8 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   }
   const KindCounters kind = CountersOfKind(counters_, request.opcode);
   ++*kind.sent;
-  const TransferStatus transfer = spi_.Transfer(tx_, rx_);
+  // The request transfer's MISO answers the previous exchange's fetch: no information.
+  const TransferStatus transfer = spi_.TransferPair(tx_, request_rx_, fetch_tx_, rx_);
   status.transfer_ns = transfer.duration_ns;
   // INIT configures this side's own board, which answered; a wire peer whose heartbeat is stale
   // right now (hung, or just restarting) does not make that answer invalid. The first data

@@ -30,11 +30,28 @@ const char* ToString(StopCause cause) noexcept {
 TimedSpi::TimedSpi(SpiBus& bus, const kernel_glue::Clock* clock) noexcept
     : bus_(bus), clock_(clock != nullptr ? clock : &monotonic_) {}
 
+BusStatus SpiBus::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                const FrameBytes& fetch, FrameBytes& answer) noexcept {
+  const BusStatus first = Transfer(request, request_miso);
+  if (first.result == BusResult::kIoError) return first;
+  return Transfer(fetch, answer);
+}
+
 TransferStatus TimedSpi::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
+  const kernel_glue::TimeNs start_ns = clock_->NowNs();
+  return Record(start_ns, bus_.Transfer(mosi, miso));
+}
+
+TransferStatus TimedSpi::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                      const FrameBytes& fetch, FrameBytes& answer) noexcept {
+  const kernel_glue::TimeNs start_ns = clock_->NowNs();
+  return Record(start_ns, bus_.TransferPair(request, request_miso, fetch, answer));
+}
+
+TransferStatus TimedSpi::Record(kernel_glue::TimeNs start_ns, const BusStatus& bus_status) noexcept {
   TransferStatus status;
-  status.start_ns = clock_->NowNs();
-  const BusStatus bus_status = bus_.Transfer(mosi, miso);
-  status.duration_ns = clock_->NowNs() - status.start_ns;
+  status.start_ns = start_ns;
+  status.duration_ns = clock_->NowNs() - start_ns;
   status.result = bus_status.result;
   status.reason = bus_status.reason;
   ++timing_.transfers;

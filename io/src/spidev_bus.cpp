@@ -1,7 +1,6 @@
 #include "hiltwin/io/spidev_bus.h"
 
 #include <fcntl.h>
-#include <linux/spi/spidev.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
@@ -77,17 +76,37 @@ SpidevBus::~SpidevBus() {
   if (fd_ >= 0) ops_.Close(fd_);
 }
 
-BusStatus SpidevBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
-  spi_ioc_transfer transfer;
+namespace {
+
+void FillTransfer(const SpidevConfig& config, const FrameBytes& mosi, FrameBytes& miso,
+                  spi_ioc_transfer& transfer) noexcept {
   std::memset(&transfer, 0, sizeof transfer);
   // The kernel ABI carries user pointers as 64-bit integers.
   transfer.tx_buf = reinterpret_cast<std::uintptr_t>(mosi.data());
   transfer.rx_buf = reinterpret_cast<std::uintptr_t>(miso.data());
   transfer.len = static_cast<std::uint32_t>(kFrameBytes);
-  transfer.speed_hz = config_.speed_hz;
-  transfer.bits_per_word = config_.bits_per_word;
+  transfer.speed_hz = config.speed_hz;
+  transfer.bits_per_word = config.bits_per_word;
   transfer.delay_usecs = 0;
   transfer.cs_change = 0;
+}
+
+}  // namespace
+
+void ComposeExchangeMessage(const SpidevConfig& config, const FrameBytes& request,
+                            FrameBytes& request_miso, const FrameBytes& fetch, FrameBytes& answer,
+                            std::array<spi_ioc_transfer, 2>& message) noexcept {
+  FillTransfer(config, request, request_miso, message[0]);
+  FillTransfer(config, fetch, answer, message[1]);
+  // Release CS after the request (the board acts on it while CS is high) and keep it released
+  // for the fetch gap; the last transfer of a message ends with CS released anyway.
+  message[0].cs_change = 1;
+  message[0].delay_usecs = static_cast<std::uint16_t>((kFetchGapNs + 999) / 1000);
+}
+
+BusStatus SpidevBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
+  spi_ioc_transfer transfer;
+  FillTransfer(config_, mosi, miso, transfer);
   int error = 0;
   const int result = ops_.Ioctl(fd_, SPI_IOC_MESSAGE(1), &transfer, error);
   if (result < 0) {
@@ -96,6 +115,22 @@ BusStatus SpidevBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept
   }
   if (result != static_cast<int>(kFrameBytes)) {
     return {BusResult::kIoError, "spidev transferred fewer than 12 bytes"};
+  }
+  return {};
+}
+
+BusStatus SpidevBus::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                  const FrameBytes& fetch, FrameBytes& answer) noexcept {
+  std::array<spi_ioc_transfer, 2> message;
+  ComposeExchangeMessage(config_, request, request_miso, fetch, answer, message);
+  int error = 0;
+  const int result = ops_.Ioctl(fd_, SPI_IOC_MESSAGE(2), message.data(), error);
+  if (result < 0) {
+    last_errno_ = error;
+    return {BusResult::kIoError, "spidev transfer failed (ioctl SPI_IOC_MESSAGE)"};
+  }
+  if (result != static_cast<int>(2 * kFrameBytes)) {
+    return {BusResult::kIoError, "spidev transferred fewer than 24 bytes (request and fetch)"};
   }
   return {};
 }

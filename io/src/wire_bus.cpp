@@ -396,7 +396,8 @@ BusStatus WireBus::PeerStatus() const noexcept {
   return {};
 }
 
-BusStatus WireBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
+template <typename Transfers>
+BusStatus WireBus::RunOnBoard(Transfers&& transfers) noexcept {
   WireSegment& seg = *segment_;
   std::array<bool, kChannels> pins{};
   if (side_ == Image::kIcoboardInverse) {
@@ -408,11 +409,25 @@ BusStatus WireBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
   }
   board_.SetDigitalInputs(pins);
   const bool twin = side_ == Image::kIcoboardInverse;
+  // The board samples (and publishes its period) while acting on the request; the fetch's NOOP
+  // changes nothing on the wire, so one window around both keeps the ECS's replay bound valid.
   if (twin) seg.twin_sampling_ns.store(clock_.NowNs(), std::memory_order_seq_cst);
-  board_.Exchange(mosi, miso);
+  transfers();
   if (twin) seg.twin_sampling_ns.store(kNotSampling, std::memory_order_seq_cst);
   Publish(clock_.NowNs());
   return PeerStatus();
+}
+
+BusStatus WireBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
+  return RunOnBoard([&]() noexcept { board_.Exchange(mosi, miso); });
+}
+
+BusStatus WireBus::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                const FrameBytes& fetch, FrameBytes& answer) noexcept {
+  return RunOnBoard([&]() noexcept {
+    board_.Exchange(request, request_miso);
+    board_.Exchange(fetch, answer);
+  });
 }
 
 bool WireBus::ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept {

@@ -1,6 +1,8 @@
 // The worked frames of docs/spi-protocol.md: this test parses the document's hex lines (it does
 // not keep its own copy of the bytes), builds each frame from the values the document states in
 // prose, and checks that the codec encodes exactly the documented bytes and decodes them back.
+// The worked pipelined exchange is replayed through the board model: the fetch's MISO must be
+// the answer to the request of the transfer before.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -9,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_emulator.h"
 #include "hiltwin/io/frame.h"
 
@@ -120,6 +123,26 @@ std::vector<Case> Cases() {
   cases.push_back({"test-request", Direction::kRequest, Image::kIcoboardInverse, f});
   f = Frame{};
   cases.push_back({"noop-request", Direction::kRequest, Image::kIcoboardInverse, f});
+  // The pipelined exchange.
+  f = Frame{};
+  f.opcode = Opcode::kAll;
+  f.sequence = 3;
+  f.enc = {EncWord{100, false}, EncWord{-100, false}, EncWord{0, false}, EncWord{0, false}};
+  cases.push_back({"exchange-request-mosi", Direction::kRequest, Image::kIcoboardInverse, f});
+  f = Frame{};
+  f.sequence = 2;
+  f.status = kStatusInitialised;
+  cases.push_back({"exchange-request-miso", Direction::kAnswer, Image::kIcoboardInverse, f});
+  f = Frame{};
+  f.sequence = 4;
+  cases.push_back({"exchange-fetch-mosi", Direction::kRequest, Image::kIcoboardInverse, f});
+  f = Frame{};
+  f.opcode = Opcode::kAll;
+  f.sequence = 3;
+  f.status = kStatusInitialised;
+  f.pwm = {PwmWord{1024, false, false}, PwmWord{512, true, false}, PwmWord{0, false, false},
+           PwmWord{2047, false, false}};
+  cases.push_back({"exchange-fetch-miso", Direction::kAnswer, Image::kIcoboardInverse, f});
   return cases;
 }
 
@@ -143,6 +166,48 @@ TEST(SpiProtocolDoc, WorkedFramesMatchTheCodec) {
   // The identity sits at byte 4 of the INIT answers, 11 for the ECS image as in the seed.
   EXPECT_EQ(documented.at("init-answer-icoboard")[4], 11);
   EXPECT_EQ(documented.at("init-answer-icoboard_inverse")[4], kIdentityIcoboardInverse);
+}
+
+/// The duties of the worked exchange on the twin board's PWM inputs.
+class WorkedDuties final : public PwmSignalSource {
+ public:
+  void DutyAt(std::int64_t /*t_ns*/, std::array<double, kChannels>& duty_out) noexcept override {
+    duty_out = {0.5, -0.25, 0.0, 1.0};
+  }
+};
+
+TEST(SpiProtocolDoc, WorkedExchangeIsWhatTheBoardModelSends) {
+  const auto documented = ReadWorkedFrames();
+  for (const char* name : {"exchange-request-mosi", "exchange-request-miso", "exchange-fetch-mosi",
+                           "exchange-fetch-miso"}) {
+    ASSERT_EQ(documented.count(name), 1U) << name << " missing from docs/spi-protocol.md";
+  }
+  EmulatedFpga board(Image::kIcoboardInverse);
+  WorkedDuties duties;
+  board.SetPwmSource(&duties);
+  // The twin's INIT at 4 kHz (sequence 1) and its fetch (NOOP 2), as the driver sends them.
+  Frame init;
+  init.opcode = Opcode::kInit;
+  init.sequence = 1;
+  init.init_request = {250'000, ClockDividerForStep(250'000)};
+  Frame fetch;
+  fetch.sequence = 2;
+  FrameBytes mosi{};
+  FrameBytes miso{};
+  ASSERT_EQ(Encode(init, Direction::kRequest, Image::kIcoboardInverse, mosi), FrameError::kOk);
+  board.Exchange(mosi, miso);
+  ASSERT_EQ(Encode(fetch, Direction::kRequest, Image::kIcoboardInverse, mosi), FrameError::kOk);
+  board.Exchange(mosi, miso);
+  ASSERT_TRUE(board.initialised());
+  // Request transfer: MISO answers the fetch before; fetch transfer: MISO answers the request.
+  board.Exchange(documented.at("exchange-request-mosi"), miso);
+  EXPECT_EQ(miso, documented.at("exchange-request-miso"));
+  board.Exchange(documented.at("exchange-fetch-mosi"), miso);
+  EXPECT_EQ(miso, documented.at("exchange-fetch-miso"));
+  // The answer echoes the request's opcode and sequence (bytes 0-1); the fetch is NOOP 4.
+  EXPECT_EQ(miso[0], documented.at("exchange-request-mosi")[0]);
+  EXPECT_EQ(miso[1], documented.at("exchange-request-mosi")[1]);
+  EXPECT_EQ(documented.at("exchange-fetch-mosi")[1], documented.at("exchange-request-mosi")[1] + 1);
 }
 
 }  // namespace

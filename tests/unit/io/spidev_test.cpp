@@ -16,8 +16,8 @@
 namespace hiltwin::io {
 namespace {
 
-/// Records every call; SPI_IOC_MESSAGE forwards the frame to an emulated board, so a driver can
-/// run over it end to end.
+/// Records every call; SPI_IOC_MESSAGE(1) and (2) forward their frames to an emulated board in
+/// order, so a driver can run over it end to end.
 class FakeSpidev final : public FileOps {
  public:
   int Open(const char* path, int flags, int& errno_out) noexcept override {
@@ -50,14 +50,21 @@ class FakeSpidev final : public FileOps {
         return 0;
       default: break;
     }
-    if (request == SPI_IOC_MESSAGE(1)) {
-      std::memcpy(&last, argument, sizeof last);
-      FrameBytes tx;
-      std::memcpy(tx.data(), reinterpret_cast<const void*>(static_cast<std::uintptr_t>(last.tx_buf)), tx.size());
-      FrameBytes rx;
-      board.Exchange(tx, rx);
-      std::memcpy(reinterpret_cast<void*>(static_cast<std::uintptr_t>(last.rx_buf)), rx.data(), rx.size());
-      return short_transfer ? 6 : static_cast<int>(last.len);
+    if (request == SPI_IOC_MESSAGE(1) || request == SPI_IOC_MESSAGE(2)) {
+      const std::size_t count = request == SPI_IOC_MESSAGE(1) ? 1 : 2;
+      const auto* transfers = static_cast<const spi_ioc_transfer*>(argument);
+      message.assign(transfers, transfers + count);
+      last = transfers[count - 1];
+      int bytes = 0;
+      for (const spi_ioc_transfer& t : message) {
+        FrameBytes tx;
+        std::memcpy(tx.data(), reinterpret_cast<const void*>(static_cast<std::uintptr_t>(t.tx_buf)), tx.size());
+        FrameBytes rx;
+        board.Exchange(tx, rx);
+        std::memcpy(reinterpret_cast<void*>(static_cast<std::uintptr_t>(t.rx_buf)), rx.data(), rx.size());
+        bytes += static_cast<int>(t.len);
+      }
+      return short_transfer ? bytes - 6 : bytes;
     }
     errno_out = ENOTTY;
     return -1;
@@ -76,7 +83,8 @@ class FakeSpidev final : public FileOps {
   std::uint32_t speed = 0;
   std::vector<unsigned long> requests;
   std::vector<int> closed;
-  spi_ioc_transfer last{};
+  spi_ioc_transfer last{};              ///< the last transfer of the latest message
+  std::vector<spi_ioc_transfer> message;  ///< the latest message's transfers
   EmulatedFpga board{Image::kIcoboardInverse};
 };
 
@@ -100,30 +108,76 @@ TEST(SpidevBus, ConfiguresModeBitsAndSpeedAndReadsThemBack) {
   EXPECT_EQ(fake.closed, std::vector<int>{42});
 }
 
-TEST(SpidevBus, TransferIsOneTwelveByteMessage) {
+TEST(SpidevBus, ExchangeIsOneMessageOfRequestAndFetch) {
   FakeSpidev fake;
   SpidevBus bus("/dev/spidev0.0", SpidevConfig{}, fake);
   IcoBoardInverse driver(bus);
   ASSERT_TRUE(driver.Init(250'000).ok);  // the driver runs unchanged over spidev
-  EXPECT_EQ(fake.last.len, 12U);
-  EXPECT_EQ(fake.last.speed_hz, 31'000'000U);
-  EXPECT_EQ(fake.last.bits_per_word, 8);
-  EXPECT_EQ(fake.last.cs_change, 0);
+  ASSERT_EQ(fake.message.size(), 2U);
+  EXPECT_EQ(fake.requests.back(), SPI_IOC_MESSAGE(2));
+  for (const spi_ioc_transfer& t : fake.message) {
+    EXPECT_EQ(t.len, 12U);
+    EXPECT_EQ(t.speed_hz, 31'000'000U);
+    EXPECT_EQ(t.bits_per_word, 8);
+  }
+  EXPECT_EQ(fake.message[0].cs_change, 1);  // CS released between request and fetch ...
+  EXPECT_EQ(fake.message[0].delay_usecs, 2);  // ... for at least 2 µs
+  EXPECT_EQ(fake.message[1].cs_change, 0);
   TwinInputs in;
   ASSERT_TRUE(driver.Exchange({1, 2, 3, 4}, in).ok());
   EXPECT_EQ(fake.board.encoder(3).PositionAt(1'000'000'000), 4);
+  EXPECT_EQ(driver.timing().transfers, 2U);  // one per exchange
 
   fake.short_transfer = true;
   const ExchangeStatus s = driver.Exchange({1, 2, 3, 4}, in);
   EXPECT_EQ(s.code, ExchangeStatus::Code::kFault);
-  EXPECT_STREQ(s.reason, "spidev transferred fewer than 12 bytes");
+  EXPECT_STREQ(s.reason, "spidev transferred fewer than 24 bytes (request and fetch)");
   fake.short_transfer = false;
-  fake.fail_request = SPI_IOC_MESSAGE(1);
+  fake.fail_request = SPI_IOC_MESSAGE(2);
   fake.fail_errno = EIO;
+  EXPECT_EQ(driver.Exchange({1, 2, 3, 4}, in).code, ExchangeStatus::Code::kFault);
+  EXPECT_EQ(bus.last_errno(), EIO);
+  // A single transfer is still one 12-byte SPI_IOC_MESSAGE(1).
+  fake.fail_request = 0;
   FrameBytes tx{};
   FrameBytes rx{};
+  EXPECT_EQ(bus.Transfer(tx, rx).result, BusResult::kOk);
+  EXPECT_EQ(fake.requests.back(), SPI_IOC_MESSAGE(1));
+  EXPECT_EQ(fake.last.len, 12U);
+  EXPECT_EQ(fake.last.cs_change, 0);
+  fake.fail_request = SPI_IOC_MESSAGE(1);
   EXPECT_EQ(bus.Transfer(tx, rx).result, BusResult::kIoError);
-  EXPECT_EQ(bus.last_errno(), EIO);
+}
+
+TEST(SpidevBus, ExchangeMessageComposition) {
+  SpidevConfig config;
+  config.speed_hz = 20'000'000;
+  config.bits_per_word = 8;
+  const FrameBytes request{1, 2, 3};
+  const FrameBytes fetch{0, 3};
+  FrameBytes request_miso{};
+  FrameBytes answer{};
+  std::array<spi_ioc_transfer, 2> message;
+  std::memset(message.data(), 0xA5, sizeof message);  // every field must be written
+  ComposeExchangeMessage(config, request, request_miso, fetch, answer, message);
+  EXPECT_EQ(message[0].tx_buf, reinterpret_cast<std::uintptr_t>(request.data()));
+  EXPECT_EQ(message[0].rx_buf, reinterpret_cast<std::uintptr_t>(request_miso.data()));
+  EXPECT_EQ(message[1].tx_buf, reinterpret_cast<std::uintptr_t>(fetch.data()));
+  EXPECT_EQ(message[1].rx_buf, reinterpret_cast<std::uintptr_t>(answer.data()));
+  for (const spi_ioc_transfer& t : message) {
+    EXPECT_EQ(t.len, 12U);
+    EXPECT_EQ(t.speed_hz, 20'000'000U);
+    EXPECT_EQ(t.bits_per_word, 8);
+    EXPECT_EQ(t.tx_nbits, 0);
+    EXPECT_EQ(t.rx_nbits, 0);
+    EXPECT_EQ(t.word_delay_usecs, 0);
+    EXPECT_EQ(t.pad, 0);
+  }
+  EXPECT_EQ(message[0].cs_change, 1);
+  EXPECT_EQ(message[0].delay_usecs, 2);
+  EXPECT_GE(std::int64_t{message[0].delay_usecs} * 1000, kFetchGapNs);
+  EXPECT_EQ(message[1].cs_change, 0);
+  EXPECT_EQ(message[1].delay_usecs, 0);
 }
 
 TEST(SpidevBus, SetUpFailuresSayWhatAndWhatToDo) {

@@ -7,6 +7,13 @@
 /// Time: with no clock, the board's time is (data frames since INIT) × (step from INIT): the
 /// k-th ALL frame after INIT happens at k·step, exactly as on the twin's virtual clock. With a
 /// clock (wire backend), the board reads that clock at every ALL frame.
+///
+/// Pipelined answers (docs/spi-protocol.md, "Pipelined answers"): a full-duplex slave shifts out
+/// byte 0 while byte 0 of the request is still arriving, so transfer n carries the answer to
+/// request n-1. The board keeps an answer register (all zeros at construction, which the host
+/// reads as an idle MISO); each transfer shifts it out, then the board acts on the request that
+/// arrived and replaces the register with the answer to it. The driver fetches that answer with
+/// a NOOP transfer (IcoBoardLink).
 
 #include <array>
 #include <cstdint>
@@ -28,12 +35,16 @@ class PwmSignalSource {
   virtual void DutyAt(std::int64_t t_ns, std::array<double, kChannels>& duty_out) noexcept = 0;
 };
 
-/// Fault-injection hooks; counts are consumed one per transfer (ros2_control mock_components).
+/// Fault-injection hooks (ros2_control mock_components). NOOPs (the driver's fetches) are
+/// skipped: request faults are consumed one per request whose opcode byte is not NOOP, answer
+/// faults one per answer to such a request, so "the next N" counts the frames whose answers the
+/// host reads.
 struct FaultInjection {
   std::uint32_t corrupt_requests = 0;  ///< next N requests arrive with one bit flipped
   std::uint32_t corrupt_answers = 0;   ///< next N answers leave with one bit flipped
-  std::uint32_t drop_answers = 0;      ///< next N transfers get no answer (MISO idles high)
-  std::uint32_t delay_answers = 0;     ///< next N transfers get the previous transfer's answer
+  std::uint32_t drop_answers = 0;      ///< next N answers are not sent (MISO idles high)
+  std::uint32_t delay_answers = 0;     ///< next N answers are replaced by what the board sent
+                                       ///< in the transfer before
   bool stick_encoder = false;          ///< twin: the emulator emits nothing; ECS: the readers see nothing
   std::optional<Image> answer_as_image;  ///< INIT answers this image's identity
 };
@@ -54,6 +65,9 @@ class EmulatedFpga final : public SpiDevice {
  public:
   explicit EmulatedFpga(Image image, const kernel_glue::Clock* clock = nullptr) noexcept;
 
+  /// One transfer: `miso` is the answer register as it stood when the transfer began (the
+  /// answer to the previous request, answer faults applied); then the board acts on `mosi` and
+  /// the register becomes the answer to it.
   void Exchange(const FrameBytes& mosi, FrameBytes& miso) noexcept override;
 
   /// Input sources (not owned; null = idle line: duty 0 / count held).
@@ -99,6 +113,10 @@ class EmulatedFpga final : public SpiDevice {
   void HandleInit(const Frame& request, Frame& answer) noexcept;
   void HandleAll(const Frame& request, Frame& answer) noexcept;
   void FillReadback(Opcode opcode, Frame& answer) const noexcept;
+  /// Shifts out the answer register, applying the answer faults to answers of non-NOOPs.
+  void SendAnswer(FrameBytes& miso) noexcept;
+  /// Decodes the request (after the request faults) and acts on it: the new answer register.
+  void TakeRequest(const FrameBytes& mosi) noexcept;
   void ResetState() noexcept;
   /// Twin image: hands the periods just started to the sink.
   void PublishPeriod() noexcept;
@@ -127,7 +145,9 @@ class EmulatedFpga final : public SpiDevice {
   std::array<bool, kChannels> pins_in_{};
   std::array<bool, kChannels> pins_out_{};
   std::array<double, kChannels> duty_scratch_{};
-  FrameBytes previous_answer_{};
+  FrameBytes answer_register_{};      ///< answer to the latest request; zeros at power-up
+  bool answer_register_data_ = false;  ///< it answers a request whose opcode byte is not NOOP
+  FrameBytes previous_miso_{};         ///< what the latest transfer shifted out
 };
 
 /// The emulated bus: forwards each transfer to a device (not owned).

@@ -16,6 +16,10 @@ namespace hiltwin::io {
 
 /// Smallest divider: edges at least 4 clocks (40 ns) apart, twice what the reader needs.
 constexpr std::uint32_t kMinClockDivider = 4;
+/// Largest divider and sub-tick count INIT accepts (the gateware's 16-bit counters). The host's
+/// ClockDividerForStep stays within them: S <= 16383 and D <= 52428 for any step up to 2^32 ns.
+constexpr std::uint32_t kMaxClockDivider = 65535;
+constexpr std::uint32_t kMaxSubticksPerStep = 65535;
 /// The reader's two-flop synchroniser must see each A/B state for this many clocks.
 constexpr std::int64_t kReaderMinStateClocks = 2;
 /// Largest change per period the 14-bit relative position can express (half a turn).
@@ -72,7 +76,9 @@ struct PulseSegment {
 /// One channel of the twin image's encoder emulator.
 class EncoderEmulator {
  public:
-  /// Applies the INIT parameters; false (and no change) when the divider leaves no sub-tick.
+  /// Applies the INIT parameters; false (and no change) unless step_ns >= 10,
+  /// kMinClockDivider <= divider <= kMaxClockDivider and 1 <= S <= kMaxSubticksPerStep with
+  /// S = floor(floor(step_ns / 10) / divider) (docs/spi-protocol.md, INIT).
   bool Configure(std::int64_t step_ns, std::uint32_t clock_divider) noexcept;
   /// Position 0, nothing pending.
   void Reset() noexcept;

@@ -108,7 +108,9 @@ class IcoBoardLink {
   [[nodiscard]] const char* bus_name() const noexcept { return spi_.bus().Name(); }
 
  protected:
-  /// Encodes `request` (sequence filled in), transfers, decodes into `answer` and checks it.
+  /// One exchange: encodes `request` (sequence filled in), transfers it and then a NOOP fetch
+  /// (the next sequence number) in one bus transaction, decodes the fetch's MISO, the board's
+  /// answer to `request`, into `answer` and checks it.
   ExchangeStatus Transact(Frame& request, Frame& answer) noexcept;
 
   TimedSpi spi_;
@@ -124,7 +126,9 @@ class IcoBoardLink {
   Frame request_{};
   Frame answer_{};
   FrameBytes tx_{};
-  FrameBytes rx_{};
+  FrameBytes fetch_tx_{};
+  FrameBytes request_rx_{};  ///< MISO of the request transfer (answers the previous fetch)
+  FrameBytes rx_{};          ///< MISO of the fetch transfer: the answer to the request
 };
 
 /// The twin's driver (image icoboard_inverse).

@@ -1,8 +1,9 @@
 #pragma once
-/// The bus under the IcoBoard drivers. Backends implement SpiBus::Transfer (virtual, noexcept);
-/// drivers call it only through TimedSpi, a non-virtual wrapper that times every transfer and
-/// returns a small status struct (ros2_control's trigger_read pattern), so driver code is the
-/// same on every backend.
+/// The bus under the IcoBoard drivers. Backends implement SpiBus::Transfer (virtual, noexcept)
+/// and may override TransferPair (a request transfer and the fetch of its answer in one bus
+/// transaction); drivers call them only through TimedSpi, a non-virtual wrapper that times every
+/// exchange and returns a small status struct (ros2_control's trigger_read pattern), so driver
+/// code is the same on every backend.
 
 #include <cstdint>
 
@@ -33,9 +34,21 @@ class SpiBus {
   virtual ~SpiBus() = default;
   /// Sends `mosi` and fills `miso` with what the board shifted out during the same transfer.
   virtual BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept = 0;
+  /// Two transfers with chip select released between them and at least kFetchGapNs from the
+  /// end of the first to the start of the second (docs/spi-protocol.md, "Pipelined answers"):
+  /// `request` (its MISO into `request_miso`), then `fetch` (its MISO, the board's answer to
+  /// `request`, into `answer`). The default calls Transfer twice (an emulated board answers at
+  /// once, so the gap is moot) and stops after a first transfer that failed with kIoError;
+  /// otherwise the second transfer's status is returned.
+  virtual BusStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                 const FrameBytes& fetch, FrameBytes& answer) noexcept;
   /// Backend name for messages ("mock", "wire:lab1", "spidev:/dev/spidev0.0").
   [[nodiscard]] virtual const char* Name() const noexcept = 0;
 };
+
+/// Least time between the end of a request transfer and the start of its fetch: the gateware
+/// has the answer ready 1.5 µs after the request's last SCLK edge (spec: 150 clocks at 100 MHz).
+constexpr std::int64_t kFetchGapNs = 2'000;
 
 /// A transfer's status plus its timing.
 struct TransferStatus {
@@ -47,7 +60,7 @@ struct TransferStatus {
 
 /// Running timing statistics of a bus (constant memory, updated on the loop's thread).
 struct TransferTiming {
-  std::uint64_t transfers = 0;
+  std::uint64_t transfers = 0;  ///< single transfers plus request/fetch pairs (one per exchange)
   kernel_glue::TimeNs total_ns = 0;
   kernel_glue::TimeNs max_ns = 0;
 };
@@ -59,6 +72,9 @@ class TimedSpi {
   TimedSpi(const TimedSpi&) = delete;  // may point at its own monotonic clock
   TimedSpi& operator=(const TimedSpi&) = delete;
   TransferStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept;
+  /// SpiBus::TransferPair, timed and counted as one transfer (an exchange).
+  TransferStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                              const FrameBytes& fetch, FrameBytes& answer) noexcept;
   [[nodiscard]] const TransferTiming& timing() const noexcept { return timing_; }
   [[nodiscard]] SpiBus& bus() noexcept { return bus_; }
   [[nodiscard]] const SpiBus& bus() const noexcept { return bus_; }
@@ -67,6 +83,9 @@ class TimedSpi {
   SpiBus& bus_;
   const kernel_glue::Clock* clock_;
   kernel_glue::MonotonicClock monotonic_;
+  /// Adds one transfer (or pair) that began at `start_ns` to the timing statistics.
+  TransferStatus Record(kernel_glue::TimeNs start_ns, const BusStatus& bus_status) noexcept;
+
   TransferTiming timing_{};
 };
 

@@ -1,8 +1,13 @@
 #pragma once
-/// The real backend: Linux spidev (`/dev/spidevB.C`), one SPI_IOC_MESSAGE(1) per 12-byte frame.
+/// The real backend: Linux spidev (`/dev/spidevB.C`). An exchange (request + fetch of its
+/// answer) is one SPI_IOC_MESSAGE(2): chip select is released between the two 12-byte transfers
+/// and the kernel waits kFetchGapNs after the first, so the board has its answer ready.
 /// The OS is reached through a small FileOps interface so the set-up and transfer can be tested
 /// against a fake without an SPI device (docs/spi-protocol.md: how to verify on a Raspberry Pi).
 
+#include <linux/spi/spidev.h>
+
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -30,6 +35,14 @@ struct SpidevConfig {
   std::uint8_t bits_per_word = 8;
 };
 
+/// The two transfers of one exchange for SPI_IOC_MESSAGE(2): `request` then `fetch`, 12 bytes
+/// each at the configured speed and word size; the first releases chip select (cs_change = 1)
+/// and is followed by a kFetchGapNs pause (delay_usecs = 2), the second leaves chip select as
+/// the controller ends a message. Pure, so the composition is tested without a device.
+void ComposeExchangeMessage(const SpidevConfig& config, const FrameBytes& request,
+                            FrameBytes& request_miso, const FrameBytes& fetch, FrameBytes& answer,
+                            std::array<spi_ioc_transfer, 2>& message) noexcept;
+
 class SpidevBus final : public SpiBus {
  public:
   /// Opens `path`, writes mode, bits per word and speed, reads them back. Throws
@@ -39,7 +52,11 @@ class SpidevBus final : public SpiBus {
   SpidevBus(const SpidevBus&) = delete;
   SpidevBus& operator=(const SpidevBus&) = delete;
 
+  /// One SPI_IOC_MESSAGE(1) of 12 bytes.
   BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept override;
+  /// Request and fetch in one SPI_IOC_MESSAGE(2) (ComposeExchangeMessage).
+  BusStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                         const FrameBytes& fetch, FrameBytes& answer) noexcept override;
   [[nodiscard]] const char* Name() const noexcept override { return name_.c_str(); }
   [[nodiscard]] const SpidevConfig& config() const noexcept { return config_; }
   /// errno of the last failed transfer (0 if none).

@@ -48,6 +48,10 @@ class WireBus final : public SpiBus, public PeerLink {
   WireBus& operator=(const WireBus&) = delete;
 
   BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept override;
+  /// Request and fetch against this side's board inside one sampling window, then one publish
+  /// and heartbeat: the wire sees an exchange exactly as it saw a single transfer.
+  BusStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                         const FrameBytes& fetch, FrameBytes& answer) noexcept override;
   [[nodiscard]] const char* Name() const noexcept override { return label_.c_str(); }
 
   /// This side's board model (fault injection, inspection).
@@ -73,6 +77,10 @@ class WireBus final : public SpiBus, public PeerLink {
   void Attach();
   void Publish(std::int64_t now_ns) noexcept;
   void Beat(std::int64_t now_ns) noexcept;
+  /// Reads the digital inputs off the wire into the board, runs `transfers` (callable) inside
+  /// the twin's sampling window, publishes and returns the peer's status.
+  template <typename Transfers>
+  BusStatus RunOnBoard(Transfers&& transfers) noexcept;
 
   std::string label_;
   std::string segment_name_;
