@@ -48,7 +48,13 @@ void VerilatedBoardDevice::Track(const io::FrameBytes& mosi) noexcept {
       time_ns_ = clock_ != nullptr ? clock_->NowNs()
                                    : static_cast<std::int64_t>(data_frames_) * step_ns_;
       ++data_frames_;
-      if (clock_ == nullptr) target_ps_ = origin_ps_ + (time_ns_ + timing_.phase_ns) * 1000;
+      if (clock_ == nullptr) {
+        const std::int64_t at_ns =
+            timing_.all_interval_ns > 0
+                ? static_cast<std::int64_t>(data_frames_ - 1) * timing_.all_interval_ns
+                : time_ns_;
+        target_ps_ = origin_ps_ + (at_ns + timing_.phase_ns) * 1000;
+      }
       ApplyPwmSource();
       break;
     default: break;

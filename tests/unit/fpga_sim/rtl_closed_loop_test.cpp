@@ -25,7 +25,7 @@ constexpr std::int64_t kTwinPhaseNs = 10'000;
 
 class RtlHilBoards final : public app::test::HilBoards {
  public:
-  RtlHilBoards() : pair_(kTwinPhaseNs) {}
+  RtlHilBoards() : pair_(WithPhase(kTwinPhaseNs), DeviceTiming{}) {}
   io::SpiBus& twin_bus() noexcept override { return pair_.twin_bus; }
   io::SpiBus& ecs_bus() noexcept override { return pair_.ecs_bus; }
   std::int64_t twin_time_ns() const noexcept override { return pair_.twin_board.time_ns(); }

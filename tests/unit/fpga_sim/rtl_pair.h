@@ -15,12 +15,12 @@ inline DeviceTiming WithPhase(std::int64_t phase_ns) {
 }
 
 struct RtlBoardPair {
-  /// `twin_phase_ns`: the twin board's ALLs that much after their board time.
-  explicit RtlBoardPair(std::int64_t twin_phase_ns = 0)
-      : twin_board(bench, io::Image::kIcoboardInverse, WithPhase(twin_phase_ns)) {}
+  RtlBoardPair(const DeviceTiming& twin_timing, const DeviceTiming& ecs_timing)
+      : twin_board(bench, io::Image::kIcoboardInverse, twin_timing),
+        ecs_board(bench, io::Image::kIcoboard, ecs_timing) {}
   RtlBench bench{true, true, true};
   VerilatedBoardDevice twin_board;
-  VerilatedBoardDevice ecs_board{bench, io::Image::kIcoboard};
+  VerilatedBoardDevice ecs_board;
   io::EmulatedSpiBus twin_bus{twin_board, "verilated"};
   io::EmulatedSpiBus ecs_bus{ecs_board, "verilated"};
 };

@@ -23,6 +23,9 @@ struct DeviceTiming {
   std::int64_t request_gap_ns = 2'000;     ///< idle after a transfer that is not a NOOP (spec15 §1)
   std::int64_t fetch_gap_ns = 500;         ///< idle after a NOOP transfer
   std::int64_t phase_ns = 0;               ///< this board's ALLs at board time + phase
+  /// ALL k at k·interval instead of k·step (0: the step from INIT). A twin whose messages come
+  /// less often than its INIT step leaves the A/B lines quiet at the end of each interval.
+  std::int64_t all_interval_ns = 0;
 };
 
 class VerilatedBoardDevice final : public io::SpiDevice {
