@@ -150,7 +150,7 @@ int main() {
               pure.cpu_ns, pure.wall_ns, pure.cpu_ns <= 300.0 ? "met" : "MISSED");
   std::printf("  same, timed by TimedSpi on CLOCK_MONOTONIC:   %7.1f ns cpu %7.1f ns wall\n",
               timed.cpu_ns, timed.wall_ns);
-  std::printf("  breakdown: codec encode+decode of one frame:  %7.1f ns cpu %7.1f ns wall  (x2 per exchange)\n",
+  std::printf("  breakdown: codec encode+decode of one frame:  %7.1f ns cpu %7.1f ns wall  (x3.5 per exchange)\n",
               codec.cpu_ns, codec.wall_ns);
   std::printf("  reference: twin + ECS exchange, 220 edges decoded: %7.1f ns cpu %7.1f ns wall\n",
               pair.cpu_ns, pair.wall_ns);

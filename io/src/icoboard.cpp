@@ -96,6 +96,25 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   }
   status.peer_absent = transfer.result == BusResult::kPeerAbsent || peer_lost_at_init;
   if (transfer.result == BusResult::kPeerStopped) status.peer_stopped = transfer.reason;
+  const ExchangeStatus checked = CheckAnswer(request, answer);
+  if (!checked.ok()) {
+    status.code = checked.code;
+    status.reason = checked.reason;
+    return status;
+  }
+  status.board_answered = true;
+  if (peer_lost) {
+    ++counters_.faults;
+    status.code = ExchangeStatus::Code::kFault;
+    status.reason = transfer.reason;
+    return status;
+  }
+  ++*kind.received;
+  return status;
+}
+
+ExchangeStatus IcoBoardLink::CheckAnswer(const Frame& request, Frame& answer) noexcept {
+  ExchangeStatus status;
   if (IsIdle(rx_)) {
     ++counters_.frames_missed;
     status.code = ExchangeStatus::Code::kMissed;
@@ -137,14 +156,6 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
     status.reason = "the board is not initialised (reset or power loss): run INIT again";
     return status;
   }
-  status.board_answered = true;
-  if (peer_lost) {
-    ++counters_.faults;
-    status.code = ExchangeStatus::Code::kFault;
-    status.reason = transfer.reason;
-    return status;
-  }
-  ++*kind.received;
   return status;
 }
 

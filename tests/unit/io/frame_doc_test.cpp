@@ -62,6 +62,29 @@ struct Case {
   Frame frame;
 };
 
+/// The worked pipelined exchange: request transfer (ALL 3) and fetch transfer (NOOP 4).
+void AddExchangeCases(std::vector<Case>& cases) {
+  Frame f;
+  f.opcode = Opcode::kAll;
+  f.sequence = 3;
+  f.enc = {EncWord{100, false}, EncWord{-100, false}, EncWord{0, false}, EncWord{0, false}};
+  cases.push_back({"exchange-request-mosi", Direction::kRequest, Image::kIcoboardInverse, f});
+  f = Frame{};
+  f.sequence = 2;
+  f.status = kStatusInitialised;
+  cases.push_back({"exchange-request-miso", Direction::kAnswer, Image::kIcoboardInverse, f});
+  f = Frame{};
+  f.sequence = 4;
+  cases.push_back({"exchange-fetch-mosi", Direction::kRequest, Image::kIcoboardInverse, f});
+  f = Frame{};
+  f.opcode = Opcode::kAll;
+  f.sequence = 3;
+  f.status = kStatusInitialised;
+  f.pwm = {PwmWord{1024, false, false}, PwmWord{512, true, false}, PwmWord{0, false, false},
+           PwmWord{2047, false, false}};
+  cases.push_back({"exchange-fetch-miso", Direction::kAnswer, Image::kIcoboardInverse, f});
+}
+
 std::vector<Case> Cases() {
   std::vector<Case> cases;
   Frame f;
@@ -123,26 +146,7 @@ std::vector<Case> Cases() {
   cases.push_back({"test-request", Direction::kRequest, Image::kIcoboardInverse, f});
   f = Frame{};
   cases.push_back({"noop-request", Direction::kRequest, Image::kIcoboardInverse, f});
-  // The pipelined exchange.
-  f = Frame{};
-  f.opcode = Opcode::kAll;
-  f.sequence = 3;
-  f.enc = {EncWord{100, false}, EncWord{-100, false}, EncWord{0, false}, EncWord{0, false}};
-  cases.push_back({"exchange-request-mosi", Direction::kRequest, Image::kIcoboardInverse, f});
-  f = Frame{};
-  f.sequence = 2;
-  f.status = kStatusInitialised;
-  cases.push_back({"exchange-request-miso", Direction::kAnswer, Image::kIcoboardInverse, f});
-  f = Frame{};
-  f.sequence = 4;
-  cases.push_back({"exchange-fetch-mosi", Direction::kRequest, Image::kIcoboardInverse, f});
-  f = Frame{};
-  f.opcode = Opcode::kAll;
-  f.sequence = 3;
-  f.status = kStatusInitialised;
-  f.pwm = {PwmWord{1024, false, false}, PwmWord{512, true, false}, PwmWord{0, false, false},
-           PwmWord{2047, false, false}};
-  cases.push_back({"exchange-fetch-miso", Direction::kAnswer, Image::kIcoboardInverse, f});
+  AddExchangeCases(cases);
   return cases;
 }
 

@@ -76,6 +76,31 @@ TEST(WirePeerLink, OnlyTheWireBackendHasAPeer) {
   EXPECT_NE(OpenBackend("wire:" + name, {})->peer_link(), nullptr);
 }
 
+TEST(WireBus, AnExchangeIsTheRequestAndItsFetchOnThisSidesBoard) {
+  // The driver's request transfer and its NOOP fetch run against this side's board as one
+  // exchange: the ALL publishes one encoder period, the fetch none, and the fetch carries the
+  // ALL's answer (with the PWM the ECS put on the wire).
+  const std::string name = FreshName("pair");
+  WireBus twin_bus(name, Image::kIcoboardInverse);
+  WireBus ecs_bus(name, Image::kIcoboard);
+  IcoBoard ecs(ecs_bus);
+  IcoBoardInverse twin(twin_bus);
+  ASSERT_TRUE(twin.Init(250'000).ok);  // publishes period 1 (position 0)
+  ASSERT_TRUE(ecs.Init(1'000'000).ok);
+  EcsInputs ecs_in{};
+  ASSERT_TRUE(ecs.Exchange({1000, 0, 0, 0}, ecs_in).ok());
+  TwinInputs twin_in{};
+  const ExchangeStatus status = twin.Exchange({100, 0, 0, 0}, twin_in);
+  ASSERT_TRUE(status.ok()) << status.reason;
+  EXPECT_EQ(twin_in.pwm[0], 1000);
+  EXPECT_EQ(twin_bus.board().data_frames(), 1U);
+  EncoderPeriod period;
+  ASSERT_TRUE(twin_bus.ReadEncoderPeriod(2, period));
+  EXPECT_EQ(period.channels[0].pulses, 100U);
+  EXPECT_FALSE(twin_bus.ReadEncoderPeriod(3, period));  // the fetch published nothing
+  EXPECT_EQ(twin.timing().transfers, 2U);               // INIT and the ALL: one per exchange
+}
+
 TEST(StopCause, NamesMatchTheRunReportsStopReasons) {
   EXPECT_STREQ(ToString(StopCause::kFinished), "finished");
   EXPECT_STREQ(ToString(StopCause::kStopRequested), "stop_requested");

@@ -112,6 +112,9 @@ class IcoBoardLink {
   /// (the next sequence number) in one bus transaction, decodes the fetch's MISO, the board's
   /// answer to `request`, into `answer` and checks it.
   ExchangeStatus Transact(Frame& request, Frame& answer) noexcept;
+  /// Judges rx_ (the fetch's MISO) as the answer to `request`, decoded into `answer`: kOk, or
+  /// the code and reason of the first check it fails, with that counter incremented.
+  ExchangeStatus CheckAnswer(const Frame& request, Frame& answer) noexcept;
 
   TimedSpi spi_;
   Image image_;

@@ -32,7 +32,8 @@ struct BusStatus {
 class SpiBus {
  public:
   virtual ~SpiBus() = default;
-  /// Sends `mosi` and fills `miso` with what the board shifted out during the same transfer.
+  /// Sends `mosi` and fills `miso` with what the board shifted out during the same transfer
+  /// (from a pipelined board: the answer to the previous request).
   virtual BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept = 0;
   /// Two transfers with chip select released between them and at least kFetchGapNs from the
   /// end of the first to the start of the second (docs/spi-protocol.md, "Pipelined answers"):
