@@ -115,7 +115,7 @@ class RtlBench {
   void AfterRisingEdge() noexcept;
   void ApplyLoneInputs() noexcept;
   void CheckWires(std::uint8_t a, std::uint8_t b) noexcept;
-  void Record(Slot slot) ;
+  void Record(Slot slot);
 
   std::unique_ptr<Board> twin_;
   std::unique_ptr<Board> ecs_;

@@ -49,7 +49,7 @@ class VerilatedBoardDevice final : public io::SpiDevice {
   /// ALL frames since INIT.
   [[nodiscard]] std::uint64_t data_frames() const noexcept { return data_frames_; }
   [[nodiscard]] std::int64_t step_ns() const noexcept { return step_ns_; }
-  /// Transfers done, and the sum of how late they started against their board time.
+  /// Transfers done, and the most any started after the time it was due.
   [[nodiscard]] std::uint64_t transfers() const noexcept { return transfers_; }
   [[nodiscard]] std::int64_t max_late_ns() const noexcept { return max_late_ps_ / 1000; }
 
@@ -75,8 +75,5 @@ class VerilatedBoardDevice final : public io::SpiDevice {
   std::uint64_t transfers_ = 0;
   std::int64_t max_late_ps_ = 0;
 };
-
-/// An emulated SPI bus named "verilated" over a VerilatedBoardDevice.
-using VerilatedSpiBus = io::EmulatedSpiBus;
 
 }  // namespace hiltwin::fpga_sim
