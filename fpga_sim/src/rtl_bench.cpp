@@ -2,6 +2,8 @@
 
 #include <verilated.h>
 
+#include <algorithm>
+
 #include "Vicoboard.h"
 #include "Vicoboard_inverse.h"
 
@@ -135,6 +137,7 @@ void RtlBench::AfterRisingEdge() noexcept {
   } else if (pwm_active_) {
     ApplyLoneInputs();
   }
+  if (clocks_ >= feed_next_clock_) ServiceLineFeed();
   if (recording_) {
     if (twin_) Record(Slot::kTwin);
     if (ecs_) Record(Slot::kEcs);
@@ -265,6 +268,64 @@ void RtlBench::SetEncoderInput(std::size_t c, bool a, bool b) noexcept {
   const auto bit = static_cast<CData>(1U << c);
   *ecs_->enc_a = static_cast<CData>(a ? (*ecs_->enc_a | bit) : (*ecs_->enc_a & ~bit));
   *ecs_->enc_b = static_cast<CData>(b ? (*ecs_->enc_b | bit) : (*ecs_->enc_b & ~bit));
+}
+
+void RtlBench::QueueEncoderPeriod(std::size_t c, std::uint64_t start_clock,
+                                  std::int32_t start_counts, std::uint32_t pulses,
+                                  std::int32_t direction, std::uint32_t subticks,
+                                  std::uint32_t divider) noexcept {
+  if (!ecs_ || wired_) return;
+  Feed& feed = feeds_[c];
+  if (feed.count == kFeedQueue) {  // the oldest waiting period is dropped
+    feed.head = (feed.head + 1) % kFeedQueue;
+    --feed.count;
+  }
+  feed.queue[(feed.head + feed.count) % kFeedQueue] =
+      FeedPeriod{start_clock, start_counts, pulses, direction, subticks == 0 ? 1 : subticks, divider};
+  ++feed.count;
+  feed_next_clock_ = std::min(feed_next_clock_, start_clock);
+}
+
+void RtlBench::SetLevels(std::size_t c, std::int64_t position) noexcept {
+  const auto quarter = static_cast<unsigned>(position & 3);
+  SetEncoderInput(c, quarter == 1 || quarter == 2, quarter >= 2);
+}
+
+void RtlBench::ServiceLineFeed() noexcept {
+  // Levels set now are sampled by the ECS's input flops at the next rising edge.
+  std::uint64_t next = UINT64_MAX;
+  for (std::size_t c = 0; c < io::kChannels; ++c) {
+    Feed& feed = feeds_[c];
+    for (;;) {
+      const FeedPeriod& p = feed.current;
+      if (feed.active && feed.edges_done < p.pulses) {
+        const std::uint64_t j = feed.edges_done + 1ULL;
+        const std::uint64_t subtick = (j * p.subticks + p.pulses - 1) / p.pulses;
+        const std::uint64_t at = p.start_clock + subtick * p.divider;
+        if (at <= clocks_) {
+          ++feed.edges_done;
+          SetLevels(c, p.start_counts + p.direction * static_cast<std::int64_t>(feed.edges_done));
+          continue;
+        }
+        next = std::min(next, at);
+      }
+      if (feed.count > 0) {
+        const FeedPeriod& waiting = feed.queue[feed.head];
+        if (waiting.start_clock <= clocks_) {
+          feed.current = waiting;
+          feed.head = (feed.head + 1) % kFeedQueue;
+          --feed.count;
+          feed.edges_done = 0;
+          feed.active = true;
+          SetLevels(c, feed.current.start_counts);
+          continue;
+        }
+        next = std::min(next, waiting.start_clock);
+      }
+      break;
+    }
+  }
+  feed_next_clock_ = next;
 }
 
 void RtlBench::SetPinInputs(Slot slot, std::uint8_t pins) noexcept {

@@ -56,6 +56,7 @@ void VerilatedBoardDevice::Track(const io::FrameBytes& mosi) noexcept {
         target_ps_ = origin_ps_ + (at_ns + timing_.phase_ns) * 1000;
       }
       ApplyPwmSource();
+      PullEncoderPeriods();
       break;
     default: break;
   }
@@ -71,6 +72,25 @@ void VerilatedBoardDevice::ApplyPwmSource() noexcept {
     const auto high = static_cast<std::uint32_t>(std::nearbyint(magnitude * io::kPwmPeriodClocks));
     bench_.SetPwmInput(c, high, duty < 0.0);
   }
+}
+
+void VerilatedBoardDevice::PullEncoderPeriods() noexcept {
+  if (slot_ != Slot::kEcs || bench_.wired() || encoder_source_ == nullptr) return;
+  const io::LineView view = encoder_source_->Lines(time_ns_);
+  // At the first ALL after INIT only the newest period counts (the lines' power-up position).
+  std::uint64_t index = data_frames_ == 1 && view.newest > 0 ? view.newest : periods_pulled_ + 1;
+  const std::int64_t origin_clock = origin_ps_ / kClockPs + timing_.phase_ns / io::kNsPerFpgaClock +
+                                    timing_.line_delay_clocks;
+  for (; index <= view.newest; ++index) {
+    if (!encoder_source_->Period(index, period_scratch_)) continue;
+    for (std::size_t c = 0; c < io::kChannels; ++c) {
+      const io::PulseSegment& s = period_scratch_.channels[c];
+      const std::int64_t start = origin_clock + s.start_ns / io::kNsPerFpgaClock;
+      bench_.QueueEncoderPeriod(c, static_cast<std::uint64_t>(std::max<std::int64_t>(start, 0)),
+                                s.start_counts, s.pulses, s.direction, s.subticks, s.divider);
+    }
+  }
+  periods_pulled_ = view.newest;
 }
 
 void VerilatedBoardDevice::Exchange(const io::FrameBytes& mosi, io::FrameBytes& miso) noexcept {

@@ -83,6 +83,13 @@ class RtlBench {
   void SetPwmInput(std::size_t c, std::uint32_t high_clocks, bool negative) noexcept;
   /// ECS alone: the A/B levels on channel c (held until changed).
   void SetEncoderInput(std::size_t c, bool a, bool b) noexcept;
+  /// ECS alone: plays one emulator period on channel c's A/B inputs, edge j of `pulses` at clock
+  /// start_clock + ceil(j·S/N)·D, from position `start_counts` (its levels are taken at
+  /// start_clock; edges of the previous period not yet played are dropped, as the emulator
+  /// re-plans from where it is). Periods must be queued in start order; up to 8 wait per channel.
+  void QueueEncoderPeriod(std::size_t c, std::uint64_t start_clock, std::int32_t start_counts,
+                          std::uint32_t pulses, std::int32_t direction, std::uint32_t subticks,
+                          std::uint32_t divider) noexcept;
   /// A board alone: its digital input pins (bit c = channel c).
   void SetPinInputs(Slot slot, std::uint8_t pins) noexcept;
 
@@ -116,6 +123,8 @@ class RtlBench {
   void ApplyLoneInputs() noexcept;
   void CheckWires(std::uint8_t a, std::uint8_t b) noexcept;
   void Record(Slot slot);
+  void ServiceLineFeed() noexcept;
+  void SetLevels(std::size_t c, std::int64_t position) noexcept;
 
   std::unique_ptr<Board> twin_;
   std::unique_ptr<Board> ecs_;
@@ -130,6 +139,26 @@ class RtlBench {
   std::uint8_t pwm_dir_in_ = 0;
   bool pwm_active_ = false;
   std::uint32_t pwm_phase_ = 0;
+  // ECS alone: A/B periods to play.
+  struct FeedPeriod {
+    std::uint64_t start_clock = 0;
+    std::int64_t start_counts = 0;
+    std::uint32_t pulses = 0;
+    std::int32_t direction = 0;
+    std::uint32_t subticks = 1;
+    std::uint32_t divider = 4;
+  };
+  static constexpr std::size_t kFeedQueue = 8;
+  struct Feed {
+    FeedPeriod current{};
+    std::uint32_t edges_done = 0;
+    bool active = false;
+    std::array<FeedPeriod, kFeedQueue> queue{};
+    std::size_t head = 0;
+    std::size_t count = 0;
+  };
+  std::array<Feed, io::kChannels> feeds_{};
+  std::uint64_t feed_next_clock_ = UINT64_MAX;
   // Recording and wire checks.
   bool recording_ = false;
   std::vector<OutputEdge> edges_;

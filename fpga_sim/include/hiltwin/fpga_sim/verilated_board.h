@@ -13,6 +13,7 @@
 
 #include "hiltwin/fpga_sim/rtl_bench.h"
 #include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/io/encoder_lines.h"
 #include "hiltwin/io/frame.h"
 #include "hiltwin/kernel_glue/clock.h"
 
@@ -26,6 +27,11 @@ struct DeviceTiming {
   /// ALL k at k·interval instead of k·step (0: the step from INIT). A twin whose messages come
   /// less often than its INIT step leaves the A/B lines quiet at the end of each interval.
   std::int64_t all_interval_ns = 0;
+  /// ECS alone fed by an EncoderLineSource: an edge at source time t reaches the A/B inputs at
+  /// origin + t + this many clocks, so that the ALL at board time t_k, acted on a fixed latency
+  /// later (the transfer, the synchroniser), counts exactly the edges up to t_k, as the model's
+  /// readers do. Calibrated against the model (tests/unit/fpga_sim/ecs_feed_test.cpp).
+  std::int64_t line_delay_clocks = 315;  // the middle of the 312 .. 319 that match
 };
 
 class VerilatedBoardDevice final : public io::SpiDevice {
@@ -39,6 +45,9 @@ class VerilatedBoardDevice final : public io::SpiDevice {
   /// Twin board alone: the PWM reader's inputs follow this source's duty, asked at every ALL
   /// (not owned; null = duty 0). The waveform is high for round(|duty|·4096) of every 4096 clocks.
   void SetPwmSource(io::PwmSignalSource* source) noexcept { pwm_source_ = source; }
+  /// ECS board alone: its A/B inputs replay the periods of this source (a twin board model's
+  /// emulator), pulled at every ALL (not owned; null = held still).
+  void SetEncoderSource(io::EncoderLineSource* source) noexcept { encoder_source_ = source; }
   /// A board alone: its digital input pins.
   void SetDigitalInputs(const std::array<bool, io::kChannels>& pins) noexcept;
 
@@ -56,6 +65,7 @@ class VerilatedBoardDevice final : public io::SpiDevice {
  private:
   void Track(const io::FrameBytes& mosi) noexcept;
   void ApplyPwmSource() noexcept;
+  void PullEncoderPeriods() noexcept;
 
   RtlBench& bench_;
   io::Image image_;
@@ -63,6 +73,9 @@ class VerilatedBoardDevice final : public io::SpiDevice {
   DeviceTiming timing_;
   const kernel_glue::Clock* clock_;
   io::PwmSignalSource* pwm_source_ = nullptr;
+  io::EncoderLineSource* encoder_source_ = nullptr;
+  std::uint64_t periods_pulled_ = 0;  ///< newest source period queued on the bench
+  io::EncoderPeriod period_scratch_{};
   std::array<double, io::kChannels> duty_{};
 
   bool initialised_ = false;
