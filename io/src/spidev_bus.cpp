@@ -105,7 +105,7 @@ void ComposeExchangeMessage(const SpidevConfig& config, const FrameBytes& reques
 }
 
 BusStatus SpidevBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
-  spi_ioc_transfer transfer;
+  spi_ioc_transfer transfer{};
   FillTransfer(config_, mosi, miso, transfer);
   int error = 0;
   const int result = ops_.Ioctl(fd_, SPI_IOC_MESSAGE(1), &transfer, error);
@@ -121,7 +121,7 @@ BusStatus SpidevBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept
 
 BusStatus SpidevBus::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
                                   const FrameBytes& fetch, FrameBytes& answer) noexcept {
-  std::array<spi_ioc_transfer, 2> message;
+  std::array<spi_ioc_transfer, 2> message{};
   ComposeExchangeMessage(config_, request, request_miso, fetch, answer, message);
   int error = 0;
   const int result = ops_.Ioctl(fd_, SPI_IOC_MESSAGE(2), message.data(), error);
