@@ -220,7 +220,11 @@ INSTANTIATE_TEST_SUITE_P(
                       Clocking{31'250'000, 3'750}, Clocking{31'250'000, 5'000},
                       Clocking{31'250'000, 6'250}, Clocking{31'250'000, 7'500},
                       Clocking{31'250'000, 8'750}, Clocking{25'000'000, 0}, Clocking{25'000'000, 5'000},
-                      Clocking{25'000'000, 9'999}, Clocking{10'000'000, 3'000}));
+                      Clocking{25'000'000, 9'999}, Clocking{10'000'000, 3'000}),
+    [](const ::testing::TestParamInfo<Clocking>& param_info) {
+      return "Sclk" + std::to_string(param_info.param.sclk_hz / 1000) + "kHzLead" +
+             std::to_string(param_info.param.lead_ps) + "ps";
+    });
 
 }  // namespace
 }  // namespace hiltwin::fpga_sim::test
