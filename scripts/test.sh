@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds and runs every default test three times: the normal build, under ASan+UBSan, and
 # with the LTTng tracepoints compiled out (the same suite minus the LTTng-only tests).
-# Opt-in labels (soak) are excluded; run them with: ctest --test-dir build -L soak
+# Opt-in labels are excluded: soak, and rtl_long (the RTL co-simulation's minutes-long runs,
+# docs/fpga-cosim.md); run them with: ctest --test-dir build -L soak (or -L rtl_long)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=$(nproc)
@@ -11,7 +12,7 @@ run_suite() {
   echo "== building $build_dir"
   bash "$root/scripts/build.sh" "$build_dir" "$@"
   echo "== testing $build_dir"
-  ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE soak
+  ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE "soak|rtl_long"
 }
 
 run_suite "$root/build"

@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "hiltwin/app_relbot/commands.h"
+#if defined(HILTWIN_HAS_FPGA_SIM)
+#include "hiltwin/fpga_sim/verilated_backend.h"
+#endif
 
 namespace hiltwin::app {
 
@@ -34,6 +37,9 @@ int main(int argc, char** argv) {
       "and tells you whether a run can be trusted.",
       "hiltwin"};
   app.require_subcommand(1);
+#if defined(HILTWIN_HAS_FPGA_SIM)
+  hiltwin::fpga_sim::RegisterVerilatedBackend();  // --io verilated: the RTL under Verilator
+#endif
   app.fallthrough();  // --log-level may also follow the command
   app.set_version_flag("--version", "hiltwin 0.1.0");
   app.footer("Run 'hiltwin <command> --help' for the flags of one command.");

@@ -95,7 +95,7 @@ std::string Num(double value) {
 void AddSessionOptions(CLI::App& app, SessionOptions& o) {
   app.add_option("--rate", o.rate_hz, "update rate in Hz (1 .. 50000)")->capture_default_str();
   app.add_option("--duration", o.duration_s, "run length in seconds")->capture_default_str();
-  app.add_option("--io", o.io, "FPGA link: mock | wire:NAME | spidev:/dev/spidevB.C")
+  app.add_option("--io", o.io, "FPGA link: mock | wire:NAME | spidev:/dev/spidevB.C | verilated")
       ->capture_default_str();
   app.add_option("--qos", o.mk_rules,
                  "(m,k)-firm rule M:K: at least M deadlines met in any K cycles (repeatable; "

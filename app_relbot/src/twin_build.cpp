@@ -100,12 +100,12 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
   twin->pwm_source =
       std::make_unique<ProfilePwmSource>(*twin->profile, o.controller_rate_hz, o.session.rate_hz);
-  // Only the mock board plays the profile; on a wire or real SPI the controller drives the PWM.
-  const bool profile_drives = twin->backend->kind() == io::BackendSpec::Kind::kMock;
-  if (io::EmulatedFpga* board = twin->backend->emulated_board();
-      board != nullptr && profile_drives) {
-    board->SetPwmSource(twin->pwm_source.get());
-  }
+  // Only a board in this process (mock, verilated) plays the profile; on a wire or real SPI the
+  // controller drives the PWM.
+  const io::BackendSpec::Kind kind = twin->backend->kind();
+  const bool profile_drives =
+      (kind == io::BackendSpec::Kind::kMock || kind == io::BackendSpec::Kind::kVerilated) &&
+      twin->backend->AttachPwmSource(twin->pwm_source.get());
   twin->input_name = profile_drives ? twin->profile->name() : "the controller on " + o.session.io;
   twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
   InitBoard(*twin->driver, period_ns);

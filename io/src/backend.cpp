@@ -1,5 +1,7 @@
 #include "hiltwin/io/backend.h"
 
+#include <atomic>
+
 #include "hiltwin/io/wire_bus.h"
 
 namespace hiltwin::io {
@@ -54,10 +56,17 @@ class SpidevBackend final : public IoBackend {
   SpidevBus bus_;
 };
 
+std::atomic<VerilatedBackendFactory> verilated_factory{nullptr};
+
 }  // namespace
+
+void RegisterVerilatedBackendFactory(VerilatedBackendFactory factory) noexcept {
+  verilated_factory.store(factory);
+}
 
 BackendSpec ParseBackendSpec(std::string_view text) {
   if (text == "mock") return {BackendSpec::Kind::kMock, ""};
+  if (text == "verilated") return {BackendSpec::Kind::kVerilated, ""};
   const auto colon = text.find(':');
   if (colon == std::string_view::npos) {
     Reject(text, text.empty() ? "empty" : "unknown backend");
@@ -83,6 +92,12 @@ BackendSpec ParseBackendSpec(std::string_view text) {
     }
     return {BackendSpec::Kind::kSpidev, std::string(argument)};
   }
+  if (kind == "verilated") {
+    if (argument != "icoboard" && argument != "icoboard_inverse") {
+      Reject(text, "the verilated board's image must be icoboard or icoboard_inverse");
+    }
+    return {BackendSpec::Kind::kVerilated, std::string(argument)};
+  }
   if (kind == "mock") Reject(text, "mock takes no argument");
   Reject(text, "unknown backend '" + std::string(kind) + "'");
 }
@@ -90,7 +105,8 @@ BackendSpec ParseBackendSpec(std::string_view text) {
 std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptions& options) {
   const BackendSpec parsed = ParseBackendSpec(spec);
   if (options.mock_board_image && parsed.kind == BackendSpec::Kind::kSpidev) {
-    throw ConfigError("a board image can only be chosen for an emulated board (mock, wire), "
+    throw ConfigError("a board image can only be chosen for an emulated board (mock, wire, "
+                      "verilated), "
                       "not for '" + std::string(spec) + "': the real board carries its own image");
   }
   switch (parsed.kind) {
@@ -101,6 +117,15 @@ std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptio
                                            options.mock_board_image);
     case BackendSpec::Kind::kSpidev:
       return std::make_unique<SpidevBackend>(parsed.argument, options.spidev);
+    case BackendSpec::Kind::kVerilated: {
+      const VerilatedBackendFactory factory = verilated_factory.load();
+      if (factory == nullptr) {
+        throw ConfigError("I/O backend '" + std::string(spec) +
+                          "': this program has no verilated boards (build with "
+                          "-DHILTWIN_FPGA_SIM=ON and apt-get install verilator)");
+      }
+      return factory(parsed.argument, options);
+    }
   }
   throw ConfigError("unreachable backend kind");
 }

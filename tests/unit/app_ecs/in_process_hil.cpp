@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "hiltwin/kernel_glue/clock.h"
 
@@ -25,9 +26,36 @@ double LengthS(const HilConfig& config) {
                                      : config.duty_profile->period_s();
 }
 
+class EmulatedBoards final : public HilBoards {
+ public:
+  EmulatedBoards() noexcept {
+    ecs_board_.SetEncoderSource(&encoder_lines_);
+    twin_board_.SetPwmSource(&pwm_lines_);
+  }
+  io::SpiBus& twin_bus() noexcept override { return twin_bus_; }
+  io::SpiBus& ecs_bus() noexcept override { return ecs_bus_; }
+  std::int64_t twin_time_ns() const noexcept override { return twin_board_.time_ns(); }
+  std::int64_t ecs_time_ns() const noexcept override { return ecs_board_.time_ns(); }
+  std::uint64_t ecs_data_frames() const noexcept override { return ecs_board_.data_frames(); }
+  std::uint64_t line_errors() const noexcept override {
+    const io::EncoderLineCounters lines = ecs_board_.encoder_lines().counters();
+    return lines.illegal_transitions + lines.too_fast_edges + lines.resyncs;
+  }
+
+ private:
+  io::EmulatedFpga twin_board_{io::Image::kIcoboardInverse};
+  io::EmulatedFpga ecs_board_{io::Image::kIcoboard};
+  io::EmulatorToReaderLink encoder_lines_{twin_board_};
+  io::GeneratorToReaderLink pwm_lines_{ecs_board_};
+  io::EmulatedSpiBus twin_bus_{twin_board_};
+  io::EmulatedSpiBus ecs_bus_{ecs_board_};
+};
+
 }  // namespace
 
-InProcessHil::InProcessHil(const HilConfig& config)
+std::unique_ptr<HilBoards> MakeEmulatedBoards() { return std::make_unique<EmulatedBoards>(); }
+
+InProcessHil::InProcessHil(const HilConfig& config, std::unique_ptr<HilBoards> boards)
     : config_(config),
       ecs_period_ns_(kernel_glue::PeriodNsFromRateHz(config.ecs_rate_hz)),
       twin_period_ns_(kernel_glue::PeriodNsFromRateHz(config.twin_rate_hz)),
@@ -38,14 +66,15 @@ InProcessHil::InProcessHil(const HilConfig& config)
       params_(DefaultRelbotParams()),
       geometry_(WheelGeometryOf(params_)),
       count_m_(1.0 / io::CountsPerMetre(geometry_)),
+      boards_(std::move(boards)),
+      twin_driver_(boards_->twin_bus()),
+      ecs_driver_(boards_->ecs_bus()),
       twin_(twin_driver_, params_, Integrator::kRk4, 1.0 / config.twin_rate_hz),
       ecs_(config.setpoints != nullptr
                ? EcsTask(ecs_driver_, *config.setpoints, config.gains, geometry_, ecs_period_ns_)
                : EcsTask(ecs_driver_, *config.duty_profile, geometry_, ecs_period_ns_)) {
-  ecs_board_.SetEncoderSource(&encoder_lines_);
-  twin_board_.SetPwmSource(&pwm_lines_);
   if (!twin_driver_.Init(twin_period_ns_).ok || !ecs_driver_.Init(ecs_period_ns_).ok) {
-    throw std::runtime_error("the emulated boards refused INIT");
+    throw std::runtime_error("the boards refused INIT");
   }
 }
 
@@ -66,7 +95,7 @@ runtime::StepStatus InProcessHil::Step(const scheduler::CycleContext& context) n
     twin_context.period_ns = twin_period_ns_;
     twin_context.release_ns = static_cast<std::int64_t>(twin_cycle_) * twin_period_ns_;
     twin_context.model_time_ns = twin_context.release_ns;
-    if (twin_board_.time_ns() != twin_context.release_ns) ++seen_.board_time_mismatches;
+    if (boards_->twin_time_ns() != twin_context.release_ns) ++seen_.board_time_mismatches;
     const runtime::StepStatus twin_status = twin_.task().Step(twin_context);
     if (twin_status.code != runtime::StepStatus::Code::kOk) return twin_status;
   }
@@ -75,8 +104,8 @@ runtime::StepStatus InProcessHil::Step(const scheduler::CycleContext& context) n
 
 void InProcessHil::Observe(std::uint64_t ecs_cycle) noexcept {
   ++seen_.ecs_cycles;
-  if (ecs_board_.time_ns() != static_cast<std::int64_t>(ecs_cycle) * ecs_period_ns_ ||
-      ecs_board_.data_frames() != ecs_cycle + 1) {
+  if (boards_->ecs_time_ns() != static_cast<std::int64_t>(ecs_cycle) * ecs_period_ns_ ||
+      boards_->ecs_data_frames() != ecs_cycle + 1) {
     ++seen_.board_time_mismatches;
   }
   const EcsCycleRecord& r = ecs_.last();
@@ -119,8 +148,7 @@ void InProcessHil::Observe(std::uint64_t ecs_cycle) noexcept {
 HilObservations InProcessHil::observations() const noexcept {
   HilObservations seen = seen_;
   seen.twin_cycles = twin_cycle_;
-  const io::EncoderLineCounters lines = ecs_board_.encoder_lines().counters();
-  seen.line_errors = lines.illegal_transitions + lines.too_fast_edges + lines.resyncs;
+  seen.line_errors = boards_->line_errors();
   return seen;
 }
 

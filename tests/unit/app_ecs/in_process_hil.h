@@ -14,8 +14,12 @@
 //
 // The boards have no clock: each counts its time as data frames × step. After every cycle the
 // rig checks that both boards' times are the ECS's and the twin's cycle × period.
+//
+// The boards are pluggable (HilBoards): by default the emulated pair (io::EmulatedFpga joined by
+// the line links above); tests/unit/fpga_sim plugs in the verilated RTL pair wired pin to pin.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 #include "hiltwin/app_relbot/ecs_task.h"
@@ -26,6 +30,24 @@
 #include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app::test {
+
+/// The rig's two boards, each behind its own bus, already joined by their wires.
+class HilBoards {
+ public:
+  virtual ~HilBoards() = default;
+  [[nodiscard]] virtual io::SpiBus& twin_bus() noexcept = 0;
+  [[nodiscard]] virtual io::SpiBus& ecs_bus() noexcept = 0;
+  /// Board time (ns since INIT) of each board's latest ALL; ALLs the ECS board has served.
+  [[nodiscard]] virtual std::int64_t twin_time_ns() const noexcept = 0;
+  [[nodiscard]] virtual std::int64_t ecs_time_ns() const noexcept = 0;
+  [[nodiscard]] virtual std::uint64_t ecs_data_frames() const noexcept = 0;
+  /// A/B edges a real quadrature reader would miscount (illegal, too fast) and resyncs.
+  [[nodiscard]] virtual std::uint64_t line_errors() const noexcept = 0;
+};
+
+/// The emulated pair: io::EmulatedFpga boards joined by EmulatorToReaderLink and
+/// GeneratorToReaderLink.
+[[nodiscard]] std::unique_ptr<HilBoards> MakeEmulatedBoards();
 
 struct HilConfig {
   double ecs_rate_hz = 1000.0;
@@ -63,7 +85,8 @@ struct HilObservations {
 
 class InProcessHil final : public runtime::RunTask {
  public:
-  explicit InProcessHil(const HilConfig& config);
+  explicit InProcessHil(const HilConfig& config,
+                        std::unique_ptr<HilBoards> boards = MakeEmulatedBoards());
 
   io::ExchangeStatus Exchange(bool live_outputs) noexcept override;
   runtime::StepStatus Step(const scheduler::CycleContext& context) noexcept override;
@@ -91,14 +114,9 @@ class InProcessHil final : public runtime::RunTask {
   RelbotParams params_;
   io::WheelGeometry geometry_;
   double count_m_;  ///< one encoder count in metres
-  io::EmulatedFpga twin_board_{io::Image::kIcoboardInverse};
-  io::EmulatedFpga ecs_board_{io::Image::kIcoboard};
-  io::EmulatorToReaderLink encoder_lines_{twin_board_};
-  io::GeneratorToReaderLink pwm_lines_{ecs_board_};
-  io::EmulatedSpiBus twin_bus_{twin_board_};
-  io::EmulatedSpiBus ecs_bus_{ecs_board_};
-  io::IcoBoardInverse twin_driver_{twin_bus_};
-  io::IcoBoard ecs_driver_{ecs_bus_};
+  std::unique_ptr<HilBoards> boards_;
+  io::IcoBoardInverse twin_driver_;
+  io::IcoBoard ecs_driver_;
   RelbotTwin twin_;
   EcsTask ecs_;
   std::uint64_t twin_cycle_ = 0;

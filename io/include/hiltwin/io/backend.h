@@ -1,5 +1,8 @@
 #pragma once
-/// Choosing a backend at run time from a string: `mock`, `wire:NAME`, `spidev:/dev/spidevB.C`.
+/// Choosing a backend at run time from a string: `mock`, `wire:NAME`, `spidev:/dev/spidevB.C`,
+/// `verilated[:IMAGE]`. The verilated backend (the RTL of fpga/ compiled by Verilator) lives in
+/// the fpga_sim module, which io does not depend on: fpga_sim registers its factory here
+/// (fpga_sim::RegisterVerilatedBackend), and OpenBackend refuses `verilated` until it has.
 
 #include <memory>
 #include <optional>
@@ -24,13 +27,14 @@ class ConfigError : public std::invalid_argument {
 /// The accepted backend forms, for help texts and error messages.
 constexpr const char* kBackendForms =
     "mock, wire:NAME (NAME: 1-64 of letters, digits, '_', '-', '.'), "
-    "spidev:/dev/spidevB.C (e.g. spidev:/dev/spidev0.0)";
+    "spidev:/dev/spidevB.C (e.g. spidev:/dev/spidev0.0), "
+    "verilated[:icoboard|icoboard_inverse] (the RTL under Verilator)";
 
 /// A parsed backend string.
 struct BackendSpec {
-  enum class Kind { kMock, kWire, kSpidev };
+  enum class Kind { kMock, kWire, kSpidev, kVerilated };
   Kind kind = Kind::kMock;
-  std::string argument;  ///< wire name or device path
+  std::string argument;  ///< wire name, device path or verilated image (empty: the side's)
 };
 
 /// Parses `text`; throws ConfigError naming the text, the problem and kBackendForms.
@@ -54,7 +58,22 @@ class IoBackend {
   [[nodiscard]] virtual BackendSpec::Kind kind() const noexcept = 0;
   /// The process on the other end (wire); null when there is none to wait for (mock, spidev).
   [[nodiscard]] virtual PeerLink* peer_link() noexcept { return nullptr; }
+  /// Feeds the local twin board's PWM reader from `source` (mock: the emulated board,
+  /// verilated: the RTL's PWM inputs). False when this backend has no such input.
+  virtual bool AttachPwmSource(PwmSignalSource* source) noexcept {
+    EmulatedFpga* board = emulated_board();
+    if (board == nullptr) return false;
+    board->SetPwmSource(source);
+    return true;
+  }
 };
+
+/// Opens a `verilated` backend: `argument` is the image named in the spec (empty: choose from
+/// the options as for mock). Registered by the fpga_sim module.
+using VerilatedBackendFactory = std::unique_ptr<IoBackend> (*)(std::string_view argument,
+                                                                 const BackendOptions& options);
+/// Registers (or, with null, removes) the factory OpenBackend uses for `verilated`.
+void RegisterVerilatedBackendFactory(VerilatedBackendFactory factory) noexcept;
 
 /// Opens the backend named by `spec`. Throws ConfigError for a bad string or option, and
 /// std::runtime_error when the OS refuses (no such SPI device, /dev/shm unusable).
