@@ -1,6 +1,6 @@
 // ECS image (identity 11): the ECS host writes PWM and reads encoder counts.
-// Block diagram: spi_slave -> frame_engine <-> board_ecs (pwm_generator x4, quad_decoder x4);
-// por resets everything but the SPI front end. See docs/fpga.md.
+// Block diagram: board_link (por, spi_slave, frame_engine) <-> board_ecs (pwm_generator x4,
+// quad_decoder x4); por resets everything but the SPI front end. See docs/fpga.md.
 module icoboard (
   input  wire       clk,          // 100 MHz oscillator
   input  wire       spi_sclk,
@@ -18,25 +18,15 @@ module icoboard (
   input  wire [3:0] pin_in,       // digital inputs  (answer words' bit 14)
   output wire [3:0] pin_out       // digital outputs (request words' bit 14)
 );
-  wire        rst, take, pending, cs_idle;
-  wire [95:0] request, answer;
-  wire        clr, init_go, init_done, init_ok, all_go, pulse_limit;
+  wire        rst, clr, init_go, init_done, init_ok, all_go, pulse_limit;
   wire [15:0] init_divider;
   wire [63:0] payload, pwm_words, enc_words;
 
-  por u_por (.clk(clk), .rst(rst));
-
-  spi_slave u_spi (
-    .clk(clk), .rst(rst), .spi_sclk(spi_sclk), .spi_mosi(spi_mosi), .spi_cs_n(spi_cs_n),
-    .spi_miso(spi_miso), .answer(answer), .take(take), .pending(pending), .request(request),
-    .cs_idle(cs_idle)
-  );
-
-  frame_engine #(.TWIN(0), .IDENTITY(8'd11)) u_engine (
-    .clk(clk), .rst(rst), .pending(pending), .take(take), .request(request), .cs_idle(cs_idle),
-    .answer(answer), .clr(clr), .init_go(init_go), .init_done(init_done), .init_ok(init_ok),
-    .init_divider(init_divider), .all_go(all_go), .payload(payload), .pwm_words(pwm_words),
-    .enc_words(enc_words), .pulse_limit(pulse_limit)
+  board_link #(.TWIN(0), .IDENTITY(8'd11)) u_link (
+    .clk(clk), .spi_sclk(spi_sclk), .spi_mosi(spi_mosi), .spi_cs_n(spi_cs_n),
+    .spi_miso(spi_miso), .rst(rst), .clr(clr), .init_go(init_go), .init_done(init_done),
+    .init_ok(init_ok), .init_divider(init_divider), .all_go(all_go), .payload(payload),
+    .pwm_words(pwm_words), .enc_words(enc_words), .pulse_limit(pulse_limit)
   );
 
   board_ecs u_board (

@@ -1,6 +1,7 @@
 // Twin image (identity 22): the twin's host writes encoder positions and reads PWM.
-// Block diagram: spi_slave -> frame_engine <-> board_twin (pwm_reader x4, encoder_emulator x4,
-// subtick_timer, init_check) ; por resets everything but the SPI front end. See docs/fpga.md.
+// Block diagram: board_link (por, spi_slave, frame_engine) <-> board_twin (pwm_reader x4,
+// encoder_emulator x4, subtick_timer, init_check); por resets everything but the SPI front end.
+// See docs/fpga.md.
 module icoboard_inverse (
   input  wire       clk,          // 100 MHz oscillator
   input  wire       spi_sclk,
@@ -18,25 +19,15 @@ module icoboard_inverse (
   input  wire [3:0] pin_in,       // digital inputs  (answer words' bit 14)
   output wire [3:0] pin_out       // digital outputs (request words' bit 14)
 );
-  wire        rst, take, pending, cs_idle;
-  wire [95:0] request, answer;
-  wire        clr, init_go, init_done, init_ok, all_go, pulse_limit;
+  wire        rst, clr, init_go, init_done, init_ok, all_go, pulse_limit;
   wire [15:0] init_divider;
   wire [63:0] payload, pwm_words, enc_words;
 
-  por u_por (.clk(clk), .rst(rst));
-
-  spi_slave u_spi (
-    .clk(clk), .rst(rst), .spi_sclk(spi_sclk), .spi_mosi(spi_mosi), .spi_cs_n(spi_cs_n),
-    .spi_miso(spi_miso), .answer(answer), .take(take), .pending(pending), .request(request),
-    .cs_idle(cs_idle)
-  );
-
-  frame_engine #(.TWIN(1), .IDENTITY(8'd22)) u_engine (
-    .clk(clk), .rst(rst), .pending(pending), .take(take), .request(request), .cs_idle(cs_idle),
-    .answer(answer), .clr(clr), .init_go(init_go), .init_done(init_done), .init_ok(init_ok),
-    .init_divider(init_divider), .all_go(all_go), .payload(payload), .pwm_words(pwm_words),
-    .enc_words(enc_words), .pulse_limit(pulse_limit)
+  board_link #(.TWIN(1), .IDENTITY(8'd22)) u_link (
+    .clk(clk), .spi_sclk(spi_sclk), .spi_mosi(spi_mosi), .spi_cs_n(spi_cs_n),
+    .spi_miso(spi_miso), .rst(rst), .clr(clr), .init_go(init_go), .init_done(init_done),
+    .init_ok(init_ok), .init_divider(init_divider), .all_go(all_go), .payload(payload),
+    .pwm_words(pwm_words), .enc_words(enc_words), .pulse_limit(pulse_limit)
   );
 
   board_twin u_board (

@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <random>
 
 #include "hiltwin/io/encoder_emulator.h"
+#include "fakes/encoder_change_stream.h"
 #include "hiltwin/io/icoboard.h"
 #include "rtl_pair.h"
 
@@ -39,31 +39,7 @@ constexpr std::int64_t kTwinStepNs = 10'000;    // INIT step: the emulator's per
 constexpr std::int64_t kEcsSampleAfterNs = 11'000;
 constexpr std::size_t kRandomChannels = 4;
 
-class ChangeStream {
- public:
-  ChangeStream(std::uint64_t seed, std::int64_t limit) : rng_(seed), large_(-limit, limit) {}
-  std::int64_t Next() {
-    const int roll = kind_(rng_);
-    std::int64_t change = 0;
-    if (roll < 94) {
-      change = small_(rng_);
-    } else if (roll < 99) {
-      change = large_(rng_) / 4;
-    } else {
-      change = large_(rng_);
-    }
-    if (roll % 10 == 0) change = -previous_;
-    previous_ = change;
-    return change;
-  }
-
- private:
-  std::mt19937_64 rng_;
-  std::uniform_int_distribution<std::int64_t> small_{-100, 100};
-  std::uniform_int_distribution<std::int64_t> large_;
-  std::uniform_int_distribution<int> kind_{0, 99};
-  std::int64_t previous_ = 0;
-};
+using ChangeStream = ::hiltwin::test::EncoderChangeStream;
 
 TEST(HILTWIN_RTL_SUITE, NoCountErrorsThroughTheRtlBoards) {
   const auto step_ns = static_cast<std::int64_t>(1e9 / kRateHz + 0.5);

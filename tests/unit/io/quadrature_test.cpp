@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 
 #include <array>
-#include <random>
 
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_emulator.h"
+#include "fakes/encoder_change_stream.h"
 #include "hiltwin/io/icoboard.h"
 #include "board_pair.h"
 
@@ -34,33 +34,7 @@ struct Tally {
   std::array<int, 5> cases{};
 };
 
-/// Random position changes as in the thesis' test: mostly small, some large, some at the limit,
-/// every tenth a hard reversal of the previous change.
-class ChangeStream {
- public:
-  ChangeStream(std::uint64_t seed, std::int64_t limit) : rng_(seed), large_(-limit, limit) {}
-  std::int64_t Next() {
-    const int roll = kind_(rng_);
-    std::int64_t change = 0;
-    if (roll < 94) {
-      change = small_(rng_);
-    } else if (roll < 99) {
-      change = large_(rng_) / 4;
-    } else {
-      change = large_(rng_);
-    }
-    if (roll % 10 == 0) change = -previous_;
-    previous_ = change;
-    return change;
-  }
-
- private:
-  std::mt19937_64 rng_;
-  std::uniform_int_distribution<std::int64_t> small_{-100, 100};
-  std::uniform_int_distribution<std::int64_t> large_;
-  std::uniform_int_distribution<int> kind_{0, 99};
-  std::int64_t previous_ = 0;
-};
+using ChangeStream = ::hiltwin::test::EncoderChangeStream;
 
 Tally RunReliability(double rate_hz, std::uint64_t seed) {
   const auto step_ns = static_cast<std::int64_t>(1e9 / rate_hz + 0.5);
