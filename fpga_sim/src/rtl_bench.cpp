@@ -156,8 +156,8 @@ void RtlBench::ApplyLoneInputs() noexcept {
 
 void RtlBench::CheckWires(std::uint8_t a, std::uint8_t b) noexcept {
   for (std::size_t c = 0; c < io::kChannels; ++c) {
-    const bool a_changed = ((a ^ wire_a_) >> c & 1U) != 0;
-    const bool b_changed = ((b ^ wire_b_) >> c & 1U) != 0;
+    const bool a_changed = ((unsigned{a} ^ unsigned{wire_a_}) >> c & 1U) != 0;
+    const bool b_changed = ((unsigned{b} ^ unsigned{wire_b_}) >> c & 1U) != 0;
     if (!a_changed && !b_changed) continue;
     ++wire_.edges;
     if (a_changed && b_changed) ++wire_.illegal_transitions;
@@ -214,7 +214,7 @@ void RtlBench::Transfer(Slot slot, const io::FrameBytes& mosi, io::FrameBytes& m
   const std::int64_t t0 = now_ps_ + shape.lead_ps;
   auto bit_of = [&mosi](std::uint32_t i) -> CData {
     if (i >= io::kFrameBytes * 8) return 0;
-    return static_cast<CData>((mosi[i / 8] >> (7 - i % 8)) & 1U);
+    return static_cast<CData>((unsigned{mosi[i / 8]} >> (7U - i % 8U)) & 1U);
   };
   // One SPI edge at t: the clock edges before it run first; a clock edge at the same
   // picosecond is applied together with it (one evaluation of every board).

@@ -42,8 +42,9 @@ std::array<std::vector<ChannelEdge>, 4> SplitByChannel(const std::vector<OutputE
     const std::uint8_t before_b = b;
     (e.signal == Signal::kEncA ? a : b) = e.value;
     for (std::size_t c = 0; c < 4; ++c) {
-      if ((((before_a ^ a) | (before_b ^ b)) >> c & 1U) != 0) {
-        out[c].push_back({static_cast<std::int64_t>(e.clock), (a >> c & 1U) != 0, (b >> c & 1U) != 0});
+      if ((((unsigned{before_a} ^ unsigned{a}) | (unsigned{before_b} ^ unsigned{b})) >> c & 1U) != 0) {
+        out[c].push_back({static_cast<std::int64_t>(e.clock), (unsigned{a} >> c & 1U) != 0,
+                          (unsigned{b} >> c & 1U) != 0});
       }
     }
   }
@@ -130,22 +131,22 @@ TEST(Pins, PwmGeneratorIsHighFor2mClocksOfEvery4096) {
       int previous = -1;  // the channel's level at the last recorded change of the bus
       for (const OutputEdge& e : bench.edges()) {
         if (e.signal != Signal::kPwm) continue;
-        const int level = (e.value >> c) & 1;
+        const int level = static_cast<int>((unsigned{e.value} >> c) & 1U);
         if (previous >= 0 && level != previous) {
           (level == 1 ? rises : falls).push_back(static_cast<std::int64_t>(e.clock));
         }
         previous = level;
       }
-      const bool negative = (bench.Output(Slot::kEcs, Signal::kPwmDir) >> c & 1U) != 0;
+      const bool negative = (unsigned{bench.Output(Slot::kEcs, Signal::kPwmDir)} >> c & 1U) != 0;
       EXPECT_EQ(negative, values[c] < 0 && m != 0) << "channel " << c << " value " << values[c];
       if (m == 0) {
         EXPECT_TRUE(rises.empty()) << "channel " << c;
-        EXPECT_EQ(bench.Output(Slot::kEcs, Signal::kPwm) >> c & 1U, 0U);
+        EXPECT_EQ(unsigned{bench.Output(Slot::kEcs, Signal::kPwm)} >> c & 1U, 0U);
         continue;
       }
       if (m == 2048) {  // always high
         EXPECT_TRUE(falls.empty()) << "channel " << c;
-        EXPECT_EQ(bench.Output(Slot::kEcs, Signal::kPwm) >> c & 1U, 1U);
+        EXPECT_EQ(unsigned{bench.Output(Slot::kEcs, Signal::kPwm)} >> c & 1U, 1U);
         continue;
       }
       ASSERT_GE(rises.size(), 4U) << "channel " << c << " value " << values[c] << ", " << bench.edges().size() << " edges, ALL answer " << Hex(miso);

@@ -69,7 +69,7 @@ inline io::FrameBytes AllTwin(std::uint8_t sequence, const std::array<std::int32
   f.opcode = io::Opcode::kAll;
   f.sequence = sequence;
   for (std::size_t c = 0; c < io::kChannels; ++c) {
-    f.enc[c] = io::EncWord{static_cast<std::int16_t>(counts[c]), ((pins >> c) & 1U) != 0};
+    f.enc[c] = io::EncWord{static_cast<std::int16_t>(counts[c]), ((unsigned{pins} >> c) & 1U) != 0};
   }
   return Encoded(f, io::Image::kIcoboardInverse);
 }
@@ -82,7 +82,7 @@ inline io::FrameBytes AllEcs(std::uint8_t sequence, const std::array<std::int32_
   f.sequence = sequence;
   for (std::size_t c = 0; c < io::kChannels; ++c) {
     const std::int32_t v = pwm[c];
-    f.pwm[c] = io::PwmWord{static_cast<std::uint16_t>(v < 0 ? -v : v), v < 0, ((pins >> c) & 1U) != 0};
+    f.pwm[c] = io::PwmWord{static_cast<std::uint16_t>(v < 0 ? -v : v), v < 0, ((unsigned{pins} >> c) & 1U) != 0};
   }
   return Encoded(f, io::Image::kIcoboard);
 }
