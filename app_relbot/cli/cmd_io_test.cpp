@@ -184,10 +184,13 @@ io::BackendSpec::Kind CheckBackendFlags(const IoTestOptions& options) {
   }
   const bool mock = spec.kind == io::BackendSpec::Kind::kMock;
   if (!options.board_image.empty() && !mock) {
+    const bool rtl = spec.kind == io::BackendSpec::Kind::kVerilated;
     throw CommandError(ExitCode::kUsage,
-                       "--board-image " + options.board_image +
-                           " only applies to --io mock; a wired "
-                           "or real board carries its own image (drop --board-image)");
+                       "--board-image " + options.board_image + " only applies to --io mock; " +
+                           (rtl ? "the RTL board's image is chosen with --io verilated:IMAGE "
+                                  "(icoboard or icoboard_inverse)"
+                                : "a wired or real board carries its own image (drop "
+                                  "--board-image)"));
   }
   if (options.wait_peer_s > 0.0 && spec.kind != io::BackendSpec::Kind::kWire) {
     throw CommandError(ExitCode::kUsage,

@@ -109,6 +109,13 @@ std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptio
                       "verilated), "
                       "not for '" + std::string(spec) + "': the real board carries its own image");
   }
+  if (parsed.kind == BackendSpec::Kind::kVerilated && !parsed.argument.empty() &&
+      options.mock_board_image && ParseImage(parsed.argument) != options.mock_board_image) {
+    // Two flags naming two images for one board: neither may win silently.
+    throw ConfigError("'" + std::string(spec) + "' names the RTL board's image and the board "
+                      "image chosen besides it is " + ToString(*options.mock_board_image) +
+                      ": name the image once (--io verilated:IMAGE)");
+  }
   switch (parsed.kind) {
     case BackendSpec::Kind::kMock:
       return std::make_unique<MockBackend>(options.mock_board_image.value_or(options.side));

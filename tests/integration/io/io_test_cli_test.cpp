@@ -168,6 +168,11 @@ TEST(IoTestCli, UsageErrorsExitTwoAndSayWhatIsAccepted) {
   r = IoTest({"--io", "wire:x", "--board-image", "icoboard"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("mock"), std::string::npos) << r.err;
+  r = IoTest({"--io", "verilated", "--board-image", "icoboard"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("the RTL board's image is chosen with --io verilated:IMAGE"),
+            std::string::npos)
+      << r.err;
   r = IoTest({"--image", "inverse"});
   EXPECT_EQ(r.exit_code, 2);
   r = IoTest({"--io", "mock", "--wait-peer", "5"});

@@ -40,5 +40,28 @@ TEST(VerilatedBackend, IsRefusedUntilRegisteredThenInitsBothImages) {
   EXPECT_EQ(init.identity, io::kIdentityIcoboard);
 }
 
+TEST(VerilatedBackend, RefusesASpecImageThatContradictsTheChosenBoardImage) {
+  RegisterVerilatedBackend();
+  io::BackendOptions options;
+  options.mock_board_image = io::Image::kIcoboard;
+  try {
+    (void)io::OpenBackend("verilated:icoboard_inverse", options);
+    FAIL() << "two different images for one board were accepted";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("'verilated:icoboard_inverse' names the RTL board's "
+                                         "image and the board image chosen besides it is "
+                                         "icoboard"),
+              std::string::npos)
+        << e.what();
+  }
+  // Agreeing, or naming the image only once, opens the board with that image.
+  for (const char* spec : {"verilated:icoboard", "verilated"}) {
+    const auto backend = io::OpenBackend(spec, options);
+    io::IcoBoardLink link(backend->bus(), io::Image::kIcoboard);
+    const io::InitResult init = link.Init(250'000);
+    EXPECT_TRUE(init.ok) << spec << ": " << init.message;
+  }
+}
+
 }  // namespace
 }  // namespace hiltwin::fpga_sim
