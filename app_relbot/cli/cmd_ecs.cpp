@@ -17,6 +17,7 @@
 #include "hiltwin/app_relbot/relbot_params.h"
 #include "hiltwin/app_relbot/session_options.h"
 #include "hiltwin/app_relbot/setpoint_profile.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
@@ -112,6 +113,7 @@ int RunEcs(EcsOptions o) {
     ValidateSessionOptions(o.session);  // the rate first: the period depends on it
     return kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   }();
+  kernel_glue::InstallStopSignalHandlers();  // before any output exists: as `run` does
   std::ofstream report_file = OpenReport(o.session.report_path);
   const std::unique_ptr<Ecs> ecs = BuildEcs(o, period_ns);
   // By default the run lasts as long as its profile: the setpoints end settled.

@@ -301,9 +301,11 @@ int RunHil(HilOptions o) {
   } catch (const std::invalid_argument& e) {
     Usage(std::string("--wire: ") + e.what());
   }
+  // Before anything is created: a stop signal from here on ends the pair cleanly, never
+  // leaving a half-made report or work folder (docs/reliability.md, row M13).
+  kernel_glue::InstallStopSignalHandlers();
   const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
   std::ofstream report_file = OpenReport(o.report_path);
-  kernel_glue::InstallStopSignalHandlers();
   std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s\n",
               Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(), wire.c_str(),
               Num(o.duration_s).c_str());

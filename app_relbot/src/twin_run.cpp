@@ -18,6 +18,7 @@
 #include "hiltwin/io/backend.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/runtime/link_fault_injection.h"
 #include "hiltwin/runtime/run_session.h"
 
@@ -114,6 +115,10 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   Validate(o);
   const runtime::LinkFaultSchedule link_faults = LinkFaultsOf(o);
   const std::uint64_t planned = PlannedCycles(o.session);
+  // Before the first output exists: a stop signal during start-up (building the plant, INIT)
+  // then ends the run at its first cycle with a report, instead of killing the process with
+  // an empty report behind (docs/reliability.md, row M13).
+  kernel_glue::InstallStopSignalHandlers();
   std::ofstream report_file = OpenReport(o.session.report_path);
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(o, period_ns);
