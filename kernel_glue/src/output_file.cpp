@@ -52,8 +52,7 @@ std::string Problem(const std::string& path, int error_number) {
       return ": a part of the folder path '" + FolderOf(path) +
              "' is not a folder; check the path";
     case EISDIR:
-      return " is a folder; name a file in it, e.g. " +
-             (std::filesystem::path(path) / "out").string();
+      return " is a folder; name a file inside it";
     case EACCES:
     case EPERM:
       return ": permission denied (" + StrError(error_number) +

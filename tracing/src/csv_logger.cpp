@@ -202,7 +202,7 @@ CsvLogger::CsvLogger(CsvLoggerConfig config)
     (void)::ftruncate(fd_, 0);  // no torn header: an empty file is plainly unfinished
     ::close(fd_);
     fd_ = -1;
-    throw std::runtime_error("CsvLogger: cannot write the header of '" + config_.path +
+    throw LogWriteError("CsvLogger: cannot write the header of '" + config_.path +
                              "': " + ErrnoText(err) + "; free space or choose another folder");
   }
   file_bytes_ = accepted;

@@ -25,6 +25,7 @@
 #include <memory>
 #include <mutex>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,6 +34,13 @@
 #include "hiltwin/tracing/spsc_ring.h"
 
 namespace hiltwin::tracing {
+
+/// The log's file cannot be written at all (its header failed: a full disk, an I/O error):
+/// the disk's problem, not the path's.
+class LogWriteError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 /// Most value columns a logger accepts (time_s not counted); bounds the writer's line buffer.
 inline constexpr std::size_t kMaxLogColumns = 32;
@@ -63,7 +71,7 @@ class CsvLogger {
  public:
   /// Validates the config and opens the file; throws std::invalid_argument (bad config),
   /// kernel_glue::OutputFileError (the path cannot be opened: a link, a missing folder, ...) or
-  /// std::runtime_error (the header cannot be written, with path and errno text). Writes the
+  /// LogWriteError (the header cannot be written, with path and errno text). Writes the
   /// header.
   explicit CsvLogger(CsvLoggerConfig config);
   /// Stops (drains and closes) if still running.
