@@ -252,6 +252,8 @@ TEST_F(CsvLoggerTest, DropsCountOnlyRowsThatDecimationSelected) {
   EXPECT_EQ(logger.rows_offered(), 20U);
   EXPECT_EQ(logger.rows_written(), 4U);
   EXPECT_EQ(logger.rows_dropped(), 6U);  // 10 selected, 4 fit
+  EXPECT_EQ(logger.rows_selected(), 10U);
+  EXPECT_EQ(logger.rows_lost(), 0U);
 }
 
 TEST_F(CsvLoggerTest, WrongWidthAndAfterStopRowsAreCountedAsDropped) {
