@@ -25,8 +25,9 @@ namespace {
 // Large enough that the writer makes one write() per few hundred rows, small enough to stay
 // out of the way of the loop's locked memory budget.
 constexpr std::size_t kFileBufferBytes = std::size_t{256} * 1024;
-// The longest row: a cell is at most 24 characters (to_chars' shortest double) plus its comma,
-// and the newline.
+// Room for the longest row: a cell is at most 24 characters (to_chars' shortest double; the
+// fixed-point shortcuts print fewer) plus its comma, rounded up to 32, and the newline. The
+// buffer is written out before a row might not fit.
 constexpr std::size_t kMaxLineBytes = (kMaxLogColumns + 1) * 32 + 2;
 // Keeps the preallocated queue below ~8 GiB even at the widest row; a larger request is a
 // typo, not a plan.
@@ -202,8 +203,8 @@ CsvLogger::CsvLogger(CsvLoggerConfig config)
     (void)::ftruncate(fd_, 0);  // no torn header: an empty file is plainly unfinished
     ::close(fd_);
     fd_ = -1;
-    throw LogWriteError("CsvLogger: cannot write the header of '" + config_.path +
-                             "': " + ErrnoText(err) + "; free space or choose another folder");
+    throw LogWriteError("CsvLogger: cannot write the header of '" + config_.path + "': " +
+                        ErrnoText(err) + "; free space or choose another folder");
   }
   file_bytes_ = accepted;
   last_flush_ns_ = SteadyNowNs();
