@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -31,6 +32,10 @@ bool RegisterCommand(int order, CommandFactory factory) {
 
 int main(int argc, char** argv) {
   using hiltwin::app::ExitCode;
+  // Past a file-size limit (ulimit -f) the kernel sends SIGXFSZ, whose default kills the
+  // process mid-run with a core dump. Ignored, the write fails with EFBIG instead: the log ends
+  // on its last whole row and the run ends as an I/O fault (exit 5) with its report.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{
       "hiltwin: a real-time Hardware-in-the-Loop runtime for digital twins.\n"
       "Runs a plant model behind the plant's own electrical interface, checks every deadline\n"

@@ -1,5 +1,6 @@
 #include "hiltwin/app_relbot/session_options.h"
 
+#include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"
 
 #include <unistd.h>
@@ -12,6 +13,7 @@
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/scheduler/executive.h"
+#include "hiltwin/tracing/csv_logger.h"
 
 namespace hiltwin::app {
 namespace {
@@ -279,10 +281,19 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
     };
   }
   std::optional<runtime::RunSession> session;
-  // Only the two logs can fail to open; the message quotes the path of the one that did.
-  const std::string timing_log_quoted = "'" + config.timing_log_path + "'";
+  // Only the two logs can fail to open; the message names the flag of the one that did.
+  const std::string timing_log_path = config.timing_log_path;
+  const std::string timing_log_quoted = "'" + timing_log_path + "'";
   try {
     session.emplace(std::move(config), task);
+  } catch (const kernel_glue::OutputFileError& e) {
+    Usage(e.MessageFor(!timing_log_path.empty() && e.path() == timing_log_path ? "--timing-log"
+                                                                                : "--log"));
+  } catch (const tracing::LogWriteError& e) {
+    // The path was fine, the disk is not (already full, an I/O error): exit 5, not usage.
+    const bool timing = timing_log_quoted != "''" &&
+                        std::string(e.what()).find(timing_log_quoted) != std::string::npos;
+    throw CommandError(ExitCode::kIo, std::string(timing ? "--timing-log: " : "--log: ") + e.what());
   } catch (const std::invalid_argument& e) {
     Usage(e.what());
   } catch (const runtime::TelemetryError& e) {
@@ -298,10 +309,22 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
 std::ofstream OpenReport(const std::string& path) {
   std::ofstream file;
   if (path.empty()) return file;
-  file.open(path, std::ios::out | std::ios::trunc);
+  int fd = -1;
+  try {
+    fd = kernel_glue::OpenOutputFile(path, "--report");  // a link or a missing folder: exit 2
+  } catch (const kernel_glue::OutputFileError& e) {
+    Usage(e.what());
+  }
+  // The stream opens the very file just created through its descriptor (/proc/self/fd names
+  // the open file, not the path), so a link put in its place meanwhile is not followed; without
+  // /proc, the path checked a moment ago.
+  file.open("/proc/self/fd/" + std::to_string(fd), std::ios::out | std::ios::trunc);
+  if (!file) file.open(path, std::ios::out | std::ios::trunc);
+  const int error = errno;
+  ::close(fd);
   if (!file) {
-    Usage("--report " + path + ": cannot create the file (" + std::strerror(errno) +
-          "); check that the folder exists and is writable");
+    Usage("--report " + path + ": cannot create the file (" + std::strerror(error) +
+          "); check that the folder is writable");
   }
   return file;
 }
