@@ -3,12 +3,14 @@
 #include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/overrun_injection.h"
@@ -306,42 +308,54 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
   return session->Run();
 }
 
-std::ofstream OpenReport(const std::string& path) {
-  std::ofstream file;
-  if (path.empty()) return file;
-  int fd = -1;
+ReportFile::ReportFile(std::string path) : path_(std::move(path)) {
+  if (path_.empty()) return;
   try {
-    fd = kernel_glue::OpenOutputFile(path, "--report");  // a link or a missing folder: exit 2
+    fd_ = kernel_glue::OpenOutputFile(path_, "--report");  // a link or a missing folder: exit 2
   } catch (const kernel_glue::OutputFileError& e) {
     Usage(e.what());
   }
-  // The stream opens the very file just created through its descriptor (/proc/self/fd names
-  // the open file, not the path), so a link put in its place meanwhile is not followed; without
-  // /proc, the path checked a moment ago.
-  file.open("/proc/self/fd/" + std::to_string(fd), std::ios::out | std::ios::trunc);
-  if (!file) file.open(path, std::ios::out | std::ios::trunc);
-  const int error = errno;
-  ::close(fd);
-  if (!file) {
-    Usage("--report " + path + ": cannot create the file (" + std::strerror(error) +
-          "); check that the folder is writable");
-  }
-  return file;
 }
 
-void PrintOutcome(const SessionOptions& o, const SessionRole& role,
-                  const runtime::RunReport& report, const nlohmann::ordered_json& json,
-                  const std::string& extra_summary, std::ofstream& report_file) {
-  if (report_file.is_open()) {
-    report_file << json.dump(2) << '\n';
-    report_file.flush();
-    if (!report_file) {
-      throw CommandError(
-          ExitCode::kIo,
-          "--report " + o.report_path +
-              ": cannot write the run report; check the folder exists and is writable");
+ReportFile::ReportFile(ReportFile&& other) noexcept
+    : path_(std::move(other.path_)), fd_(std::exchange(other.fd_, -1)) {}
+
+ReportFile::~ReportFile() {
+  if (fd_ < 0) return;
+  // Never written: remove it, but only if the path still names the file this created.
+  struct stat ours {};
+  struct stat named {};
+  if (::fstat(fd_, &ours) == 0 && ::lstat(path_.c_str(), &named) == 0 &&
+      ours.st_dev == named.st_dev && ours.st_ino == named.st_ino) {
+    ::unlink(path_.c_str());
+  }
+  ::close(fd_);
+}
+
+void ReportFile::Write(const std::string& text) {
+  if (fd_ < 0) return;
+  std::size_t done = 0;
+  int error = 0;
+  while (done < text.size() && error == 0) {
+    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno != EINTR) {
+      error = errno;
     }
   }
+  if (::close(std::exchange(fd_, -1)) != 0 && error == 0) error = errno;
+  if (error != 0) {
+    throw CommandError(ExitCode::kIo, "--report " + path_ + ": cannot write the run report (" +
+                                          std::strerror(error) +
+                                          "); check the disk has space and the folder is writable");
+  }
+}
+
+void PrintOutcome(const SessionRole& role,
+                  const runtime::RunReport& report, const nlohmann::ordered_json& json,
+                  const std::string& extra_summary, ReportFile& report_file) {
+  report_file.Write(json.dump(2) + '\n');
   std::fputs(extra_summary.c_str(), stdout);
   std::fputs(runtime::FormatSummary(report).c_str(), stdout);
   std::fflush(stdout);

@@ -119,7 +119,7 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   // then ends the run at its first cycle with a report, instead of killing the process with
   // an empty report behind (docs/reliability.md, row M13).
   kernel_glue::InstallStopSignalHandlers();
-  std::ofstream report_file = OpenReport(o.session.report_path);
+  ReportFile report_file(o.session.report_path);
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(o, period_ns);
   const SessionRole role{command, "controller", "hiltwin ecs", o.controller_rate_hz, "twin"};
@@ -137,7 +137,7 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   if (!link_faults.empty()) faulting.emplace(*twin->task, *twin->backend->emulated_board(), link_faults);
   runtime::RunTask& task = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
   const runtime::RunReport report = RunSessionOf(std::move(config), task);
-  PrintOutcome(o.session, role, report, runtime::ToJson(report), "", report_file);
+  PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
   if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault &&
       o.plant == kRelbotPlantName) {
     std::fprintf(

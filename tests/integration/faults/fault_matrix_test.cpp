@@ -235,7 +235,9 @@ TEST_F(FaultMatrix, M09_TheWrongFpgaImageStopsAtInitWithExitFive) {
                                                     "--board-image", "icoboard"}));
   EXPECT_EQ(r.exit_code, 5) << r.err;
   EXPECT_NE(r.err.find("Failed to initialise FPGA: found icoboard"), std::string::npos) << r.err;
-  // Refused before the run: no cycle ran, so no log rows and no verdict to misread.
+  // Refused before the run: no cycle ran, so there is no report (not even an empty one) and no
+  // log to misread.
+  EXPECT_FALSE(fs::exists(Path("m09.json")));
   EXPECT_FALSE(fs::exists(Path("m09.csv")) && !ReadLog(Path("m09.csv")).rows.empty());
 }
 

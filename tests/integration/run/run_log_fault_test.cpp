@@ -160,6 +160,8 @@ TEST_F(RunLogFault, ADiskFullBeforeTheRunIsAnIoErrorAtStart) {
   EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
   EXPECT_NE(r.err.find("--log: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+  // No run, so no report: the one created before the log failed is removed again.
+  EXPECT_FALSE(fs::exists(Path("out/r.json")));
 }
 
 TEST_F(RunLogFault, ALogPathThatIsASymbolicLinkIsRefusedAndItsTargetStaysUntouched) {
