@@ -211,6 +211,14 @@ std::string VerdictLine(const RunReport& r) {
                 ? " (stopped at the first violation; outputs put in their safe state)"
                 : " (stopped at the first violation; the safe outputs could NOT be written)";
   }
+  // The verdict judges timing only. A run that a fault ended did not do what was asked: say so
+  // on the verdict's own line, so a PASS is never read as "the run is good".
+  if (r.fault) {
+    line += std::string(" for the timing of the ") + std::to_string(r.cycles_run) +
+            " cycles run; the run did NOT finish: " +
+            (r.fault->kind == StopReason::kIoFault ? "I/O" : "model") + " fault at cycle " +
+            std::to_string(r.fault->cycle);
+  }
   return line + "\n";
 }
 
@@ -253,6 +261,11 @@ std::vector<std::string> Problems(const RunReport& r) {
   if (r.fault) {
     lines.push_back(std::string(r.fault->kind == StopReason::kIoFault ? "I/O" : "model") +
                     " fault at cycle " + std::to_string(r.fault->cycle) + ": " + r.fault->reason);
+  }
+  if (r.link.io_errors > 0) {
+    lines.push_back("warning: " + std::to_string(r.link.io_errors) +
+                    " frames on the link were corrupted or missed; the inputs were held over "
+                    "those cycles, so the results there rest on stale inputs");
   }
   if (r.link.peer_absent_cycles > 0) {
     lines.push_back("warning: no " + r.link.peer_name + " was attached to " + r.io + " in " +

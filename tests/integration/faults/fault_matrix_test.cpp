@@ -209,6 +209,9 @@ TEST_P(FaultMatrixLink, M05_M08_BrokenFramesAreCountedAndTheInputsHeld) {
   EXPECT_EQ(report["link faults"], kind + ",at=4000,count=3");
   EXPECT_EQ(report["stop_reason"], "finished");
   EXPECT_NE(r.out.find("3 frames corrupted or missed (inputs held)"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("warning: 3 frames on the link were corrupted or missed"),
+            std::string::npos)
+      << r.err;
   const LogFile with = ReadLog(Path("m05.csv"));
   const LogFile without = ReadLog(Path("clean.csv"));
   const std::size_t duty = Column(with, "duty_left");
@@ -260,6 +263,11 @@ TEST_F(FaultMatrix, M15_AModelProducingNaNIsAModelFaultWithEveryEarlierRowKept) 
   ASSERT_EQ(log.rows.size(), 2000U);
   for (const double value : log.rows.back()) EXPECT_TRUE(std::isfinite(value));
   EXPECT_NE(r.err.find("model fault at cycle 2000"), std::string::npos) << r.err;
+  // The verdict judges timing only; its line says the run did not finish.
+  EXPECT_NE(r.out.find("verdict    PASS for the timing of the 2001 cycles run; the run did NOT "
+                       "finish: model fault at cycle 2000"),
+            std::string::npos)
+      << r.out;
 }
 
 // --- Wall clock: the machine, the peer, the signals -----------------------------------------------

@@ -96,6 +96,29 @@ TEST(ToJson, KeepsTheContractKeysFirstAndInOrder) {
   EXPECT_TRUE(json["rt_setup"].is_null());  // virtual clock: no RT set-up was made
 }
 
+TEST(FormatSummary, AFaultedRunsVerdictSaysItJudgesOnlyTheTimingOfAnUnfinishedRun) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  EXPECT_NE(FormatSummary(r).find("verdict    PASS\n"), std::string::npos);  // a full run: plain
+  r.stop_reason = StopReason::kModelFault;
+  r.cycles_run = 2001;
+  r.fault = RunFault{StopReason::kModelFault, 2000, "the plant's output became non-finite"};
+  EXPECT_NE(FormatSummary(r).find("verdict    PASS for the timing of the 2001 cycles run; the "
+                                  "run did NOT finish: model fault at cycle 2000\n"),
+            std::string::npos)
+      << FormatSummary(r);
+  r.fault->kind = StopReason::kIoFault;
+  EXPECT_NE(FormatSummary(r).find("did NOT finish: I/O fault at cycle 2000"), std::string::npos);
+}
+
+TEST(Problems, LinkErrorsAreAWarningThatTheInputsWereHeld) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  r.link.io_errors = 3;
+  const auto lines = Problems(r);
+  ASSERT_EQ(lines.size(), 1U);
+  EXPECT_EQ(lines[0], "warning: 3 frames on the link were corrupted or missed; the inputs were "
+                      "held over those cycles, so the results there rest on stale inputs");
+}
+
 TEST(Problems, NameTheFaultTheAbsentPeerAndTheIncompleteLog) {
   RunReport r = Finished(qos::Verdict::kPass);
   EXPECT_TRUE(Problems(r).empty());
