@@ -68,11 +68,15 @@ void Overwrite(const std::uint8_t* data, std::size_t size) {
   auto* target = static_cast<std::uint8_t*>(map);
   std::memset(target, 0, bytes);
   std::memcpy(target, data, std::min(size, bytes));
-  // The first word is the layout state; 1 ("being laid out") makes an attaching side wait a
-  // bounded second for the other to finish, which only slows the fuzzer down: call it fresh.
+  // The first word is the layout state: anything but 0 (fresh) or 2 (ready) makes an attaching
+  // side wait a bounded second for a layout that never finishes, which only slows the fuzzer
+  // down (every random word would), so the others are folded onto those two.
   std::uint32_t state = 0;
   std::memcpy(&state, target, sizeof state);
-  if (state == 1) std::memset(target, 0, sizeof state);
+  if (state != 0 && state != 2) {
+    state = (state & 1U) != 0 ? 0U : 2U;
+    std::memcpy(target, &state, sizeof state);
+  }
   ::munmap(map, bytes);
 }
 
