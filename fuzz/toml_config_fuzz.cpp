@@ -5,16 +5,19 @@
 // but the validator refuses would reach the model unchecked elsewhere).
 //
 // Input: byte 0 chooses the reader (0: RELbot parameters, 1: ECS gains, 2 and 3: plant map);
-// the rest is the TOML text.
+// the rest is the TOML text. A map that parses is then bound to a plant with the RELbot's and
+// msd20sim's ports (BindPlantMap, also documenting PlantMapError).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <span>
 
 #include "fuzz_util.h"
 #include "hiltwin/app_relbot/ecs_gains.h"
 #include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/plant/plant.h"
 #include "hiltwin/plant/plant_map.h"
 
 namespace {
@@ -27,6 +30,29 @@ void Require(bool ok, const char* what) {
     std::abort();
   }
 }
+
+/// The ports of the RELbot and msd20sim plants, so maps written for either bind (BindPlantMap
+/// is the second half of reading a map: names, causality and units against a plant).
+class PortsOnlyPlant final : public plant::Plant {
+ public:
+  PortsOnlyPlant() {
+    info_.name = "fuzz";
+    info_.kind = "ports only";
+    info_.inputs = {{"duty_left", "1"}, {"duty_right", "1"}, {"force_n", "N"}};
+    info_.outputs = {{"wheel_left_m", "m"}, {"wheel_right_m", "m"}, {"x_m", "m"}, {"y_m", "m"},
+                     {"theta_rad", "rad"}, {"position_m", "m"}, {"angle", ""}};
+  }
+  [[nodiscard]] const plant::PlantInfo& Info() const noexcept override { return info_; }
+  void Start(double, std::span<double>) override {}
+  [[nodiscard]] plant::PlantStatus Step(std::span<const double>,
+                                        std::span<double>) noexcept override {
+    return plant::PlantStatus::Ok();
+  }
+  void Reset(std::span<double>) override {}
+
+ private:
+  plant::PlantInfo info_;
+};
 
 void CheckPlantMap(const plant::PlantMap& map) {
   for (const auto& route : map.pwm) {
@@ -70,7 +96,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     HILTWIN_FUZZ_UNDOCUMENTED("ParseEcsGains")
   } else {
     try {
-      CheckPlantMap(plant::ParsePlantMap(text, "fuzz.toml"));
+      const plant::PlantMap map = plant::ParsePlantMap(text, "fuzz.toml");
+      CheckPlantMap(map);
+      static const PortsOnlyPlant ports;
+      (void)plant::BindPlantMap(map, ports);
     } catch (const plant::PlantMapError&) {
     }
     HILTWIN_FUZZ_UNDOCUMENTED("ParsePlantMap")
