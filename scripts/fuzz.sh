@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/, clang only) and runs each on a copy of its seed corpus
-# fuzz/corpus/<target>/, one after the other, with a fixed seed: by default 6 s each, under a
+# fuzz/corpus/<target>/, one after the other, with a fixed seed: by default 5 s each, under a
 # minute for all. Fails when any target finds a crash, a leak, undefined behaviour, a timeout
 # or an undocumented exception; the input that did it is kept and its path printed.
 # The repository's corpus is never written to: new inputs go to a temporary copy.
@@ -16,7 +16,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 all_targets=(spi_frame wire_layout csv_profile csv_log toml_config cli fmu_model_description
              fmu_archive)
-seconds=6
+seconds=5
 build_dir="$root/build-fuzz"
 keep_dir=""
 targets=()
