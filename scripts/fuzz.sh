@@ -67,6 +67,8 @@ for target in "${targets[@]}"; do
     result=FINDING
     failed+=("$target")
   fi
+  # A wire_layout run that stops on a finding leaves its segment (hiltwin-wire-fuzz-<pid>) behind.
+  if [[ $target == wire_layout ]]; then rm -f /dev/shm/hiltwin-wire-fuzz-*; fi
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
   ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
