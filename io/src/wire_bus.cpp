@@ -154,7 +154,8 @@ class WireBus::PwmWire final : public PwmSignalSource {
 /// Twin side: publishes the board's emulator periods into the ring. ECS side: reads them.
 class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSource {
  public:
-  EncoderWire(WireSegment& seg, WireGuard& guard) noexcept : seg_(seg), guard_(guard) {}
+  EncoderWire(WireSegment& seg, WireGuard& guard, const kernel_glue::MonotonicClock& clock) noexcept
+      : seg_(seg), guard_(guard), clock_(clock) {}
 
   void OnPeriod(const std::array<PulseSegment, kChannels>& channels) noexcept override {
     // Only this twin writes encoder_newest: another value there was written by someone else,
@@ -186,9 +187,13 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
     // after the ECS read its own, so it cannot cancel edges the ECS replays now.
     const std::int64_t until_ns = seg_.twin_sampling_ns.load(std::memory_order_seq_cst);
     const std::uint64_t newest = seg_.encoder_newest.load(std::memory_order_acquire);
-    if (until_ns != kNotSampling && (until_ns < 0 || until_ns > t_ns + kFutureSlackNs)) {
+    // The loads may come long after t_ns was read (this thread preempted): before calling a
+    // time "in the future", look at the clock again (only then: the usual path reads it once).
+    std::int64_t now_ns = t_ns;
+    if (until_ns != kNotSampling && until_ns > now_ns + kFutureSlackNs) now_ns = clock_.NowNs();
+    if (until_ns != kNotSampling && (until_ns < 0 || until_ns > now_ns + kFutureSlackNs)) {
       guard_.Fail("wire: the twin's sampling moment %lld ns is not a time of this clock (now %lld)",
-                  static_cast<long long>(until_ns), static_cast<long long>(t_ns));
+                  static_cast<long long>(until_ns), static_cast<long long>(now_ns));
       return view;
     }
     if (!CheckNewest(newest, t_ns)) return view;
@@ -204,6 +209,7 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
     // encoder_newest named it, so a refusal is a loss (a resync), never a reason to wait.
     std::array<std::uint64_t, kPeriodWords> words{};
     if (!SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) return false;
+    if (static_cast<std::int64_t>(words[0]) > now_ns_ + kFutureSlackNs) now_ns_ = clock_.NowNs();
     return DecodePeriod(words, index, now_ns_, out, &guard_);
   }
 
@@ -227,10 +233,15 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
                   static_cast<unsigned long long>(seen), static_cast<unsigned long long>(newest));
       return false;
     }
-    const std::int64_t elapsed_ns = t_ns > guard_.newest_seen_ns ? t_ns - guard_.newest_seen_ns : 0;
-    const std::uint64_t reachable =
-        kEncoderLineHistory + static_cast<std::uint64_t>(elapsed_ns / kMinTwinExchangeNs);
-    if (newest - seen > reachable) {
+    // From the clock reading before the last load to one after this load (the usual path uses
+    // t_ns, read before it, and reads the clock again only when that bound is exceeded).
+    const auto reachable = [&](std::int64_t until_ns) {
+      const std::int64_t elapsed_ns =
+          until_ns > guard_.newest_seen_ns ? until_ns - guard_.newest_seen_ns : 0;
+      return kEncoderLineHistory + static_cast<std::uint64_t>(elapsed_ns / kMinTwinExchangeNs);
+    };
+    if (newest - seen > reachable(t_ns) && newest - seen > reachable(clock_.NowNs())) {
+      const std::int64_t elapsed_ns = clock_.NowNs() - guard_.newest_seen_ns;
       guard_.Fail("wire: the ring's newest index jumped from %llu to %llu within %lld ns",
                   static_cast<unsigned long long>(seen), static_cast<unsigned long long>(newest),
                   static_cast<long long>(elapsed_ns));
@@ -243,6 +254,7 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
 
   WireSegment& seg_;
   WireGuard& guard_;
+  const kernel_glue::MonotonicClock& clock_;
   std::int64_t now_ns_ = 0;  ///< the ECS board's time at its current read of the lines
 };
 
@@ -484,7 +496,7 @@ WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board
   }
   Attach();
   pwm_wire_ = std::make_unique<PwmWire>(*segment_, *guard_);
-  encoder_wire_ = std::make_unique<EncoderWire>(*segment_, *guard_);
+  encoder_wire_ = std::make_unique<EncoderWire>(*segment_, *guard_, clock_);
   const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
   guard_->peer_sessions = peer.sessions.load();
   guard_->peer_pid = peer.pid.load();
@@ -616,6 +628,7 @@ bool WireBus::CheckSegment(std::int64_t now_ns) noexcept {
   const std::uint32_t attached = peer.attached.load(std::memory_order_relaxed);
   const std::int64_t step_ns = peer.step_ns.load(std::memory_order_relaxed);
   const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_relaxed);
+  if (beat_ns > now_ns + kFutureSlackNs) now_ns = clock_.NowNs();  // preempted since now_ns?
   if (cause > kLastStopCause || attached > 1 || step_ns < 0 || step_ns > kMaxStepNs ||
       beat_ns < 0 || beat_ns > now_ns + kFutureSlackNs) {
     guard.Fail("wire: the %s's entry holds impossible values (stop cause %u, attached %u, step "

@@ -22,7 +22,7 @@
 /// bits, the ring's newest index and every encoder period's fields); an impossible value latches
 /// BusResult::kWireCorrupted with a message naming the field, after which this side reads
 /// nothing more from the wire (idle PWM, held encoder lines) and the run stops on an I/O fault
-/// with safe outputs (this side's own board still answers). docs/lifecycle.md, "The wire".
+/// with safe outputs (this side's own board still answers). docs/spi-protocol.md, wire:NAME.
 
 #include <cstdint>
 #include <memory>
