@@ -10,13 +10,17 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cstring>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
@@ -104,9 +108,11 @@ TEST(WireSegmentAccess, AForgedLivePidInThisSidesEntryRefusesTheAttach) {
 class WireVandal : public ::testing::Test {
  protected:
   void SetUp() override {
-    name_ = FreshName(std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())
-                          .substr(0, 24)
-                          .c_str());
+    std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    for (char& ch : test) {
+      if (ch == '/') ch = '-';  // parameterised tests: "Name/3"
+    }
+    name_ = FreshName(test.substr(test.size() > 24 ? test.size() - 24 : 0).c_str());
     twin_bus_.emplace(name_, Image::kIcoboardInverse);
     ecs_bus_.emplace(name_, Image::kIcoboard);
     twin_.emplace(*twin_bus_);
@@ -188,27 +194,32 @@ TEST_F(WireVandal, AnImpossibleEncoderPeriodStopsTheEcs) {
                  "uses 4..65535)");
 }
 
-TEST_F(WireVandal, EachImpossiblePeriodFieldIsNamed) {
-  const std::vector<std::pair<std::function<void(std::array<std::uint64_t, 5>&)>, std::string>>
-      cases = {
-          {[](auto& w) { w[1] = (std::uint64_t{70000} << 32U) | 100U; }, "70000 sub-ticks"},
-          {[](auto& w) { w[3] = 9000; }, "9000 pulses on channel 0"},
-          {[](auto& w) { w[4] = 0x05; }, "direction 5 on channel 0"},
-          {[](auto& w) { w[2] = 0x3000; }, "start position 12288 on channel 0"},
-          {[](auto& w) { w[0] = 0x7FFF'FFFF'FFFF'0000ULL; }, "start 9223372036854710272 ns"},
-          {[](auto& w) { w[4] |= 0xFF'0000'0000ULL; }, "reserved direction bits"},
-      };
-  for (const auto& [edit, what] : cases) {
-    TearDown();
-    twin_.reset();
-    ecs_.reset();
-    ecs_bus_.reset();
-    twin_bus_.reset();
-    SetUp();
-    ForgeNewestPeriod(edit);
-    ExpectEcsFault(what);
-  }
+/// One impossible encoder period: how the vandal edits its words, and what the fault names.
+struct PeriodCase {
+  std::function<void(std::array<std::uint64_t, 5>&)> edit;
+  std::string what;
+};
+
+class WireVandalPeriod : public WireVandal, public ::testing::WithParamInterface<PeriodCase> {};
+
+TEST_P(WireVandalPeriod, EachImpossibleFieldIsNamed) {
+  ForgeNewestPeriod(GetParam().edit);
+  ExpectEcsFault(GetParam().what);
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Fields, WireVandalPeriod,
+    ::testing::Values(
+        PeriodCase{[](auto& w) { w[1] = (std::uint64_t{70000} << 32U) | 100U; },
+                   "70000 sub-ticks (a board uses 1..65535)"},
+        PeriodCase{[](auto& w) { w[3] = 9000; },
+                   "9000 pulses on channel 0 (at most 8192 in one period)"},
+        PeriodCase{[](auto& w) { w[4] = 0x05; }, "direction 5 on channel 0 (-1, 0 or 1)"},
+        PeriodCase{[](auto& w) { w[2] = 0x3000; }, "start position 12288 on channel 0"},
+        PeriodCase{[](auto& w) { w[0] = 0x7FFF'FFFF'FFFF'0000ULL; },
+                   "start 9223372036854710272 ns (this clock reads"},
+        PeriodCase{[](auto& w) { w[4] |= 0xFF'0000'0000ULL; },
+                   "reserved direction bits 0xff set"}));
 
 TEST_F(WireVandal, ARingIndexFarAheadOrBackStopsTheEcs) {
   const std::uint64_t newest = vandal_->encoder_newest.load();
