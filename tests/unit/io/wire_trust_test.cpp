@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "fakes/alloc_counter.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/io/wire_segment.h"
@@ -282,6 +283,29 @@ TEST_F(WireVandal, ImpossiblePeerEntriesAndPinBitsStopTheReader) {
   ExpectEcsFault("the twin's pin bits are 0xf0");
   vandal_->ecs.last_beat_ns.store(std::numeric_limits<std::int64_t>::max());  // "alive" forever
   ExpectTwinFault("the ECS's entry holds impossible values");
+}
+
+TEST_F(WireVandal, ExchangesAllocateNothingCleanOrCorrupted) {
+  // The checks and the latched message (formatted into the bus's own buffer) run on the loop's
+  // path: clean exchanges, the one that finds the garbage and the ones after it.
+  std::uint64_t allocations = 0;
+  bool faulted = false;
+  {
+    test::ScopedAllocationCount count;
+    for (int i = 0; i < 100; ++i) {
+      (void)ecs_->Exchange({1000, 0, 0, 0}, ecs_in_);
+      (void)twin_->Exchange({100, 0, 0, 0}, twin_in_);
+    }
+    for (int i = 0; i < 10; ++i) {  // each side overwrites its own field: garbage every time
+      vandal_->twin_pins.store(0xF0);
+      const bool ecs_faulted = !ecs_->Exchange({0, 0, 0, 0}, ecs_in_).ok();
+      vandal_->pwm_words.store(0x0FFF);
+      faulted = ecs_faulted && !twin_->Exchange({0, 0, 0, 0}, twin_in_).ok();
+    }
+    allocations = count.count();
+  }
+  EXPECT_TRUE(faulted);
+  EXPECT_EQ(allocations, 0U);
 }
 
 TEST_F(WireVandal, RandomBytesOverEverythingStopBothSidesWithoutACrash) {
