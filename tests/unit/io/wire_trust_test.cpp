@@ -102,6 +102,7 @@ TEST(WireSegmentAccess, AForgedLivePidInThisSidesEntryRefusesTheAttach) {
   segment->ecs.attached.store(1);
   const std::string refusal = RefusalOf([&] { WireBus ecs(name, Image::kIcoboard); });
   EXPECT_NE(refusal.find("already has an ECS attached (pid 1)"), std::string::npos) << refusal;
+  segment->ecs.attached.store(0);  // else the twin, seeing a live ECS, leaves the segment behind
   ::munmap(map, sizeof(WireSegment));
 }
 
