@@ -286,6 +286,18 @@ TEST_F(WireVandal, ImpossiblePeerEntriesAndPinBitsStopTheReader) {
   ExpectTwinFault("the ECS's entry holds impossible values");
 }
 
+// Fuzz findings (fuzz/corpus/wire_layout/regression_peer_*_overflow.bin): PeerStatus, which a
+// side may ask without a transfer, computed 20 x step and now - heartbeat on garbage and
+// overflowed (undefined behaviour; the sanitizer build stops on it). Garbage is a lost peer.
+TEST_F(WireVandal, AnAbsurdPeerStepOrHeartbeatIsALostPeerWithoutOverflow) {
+  vandal_->twin.step_ns.store(std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(ecs_bus_->PeerStatus().result, BusResult::kOk);  // a fresh beat: alive
+  vandal_->twin.last_beat_ns.store(std::numeric_limits<std::int64_t>::min());
+  EXPECT_EQ(ecs_bus_->PeerStatus().result, BusResult::kPeerLost);
+  vandal_->twin.step_ns.store(std::numeric_limits<std::int64_t>::min());
+  EXPECT_EQ(ecs_bus_->PeerStatus().result, BusResult::kPeerLost);
+}
+
 TEST_F(WireVandal, ExchangesAllocateNothingCleanOrCorrupted) {
   // The checks and the latched message (formatted into the bus's own buffer) run on the loop's
   // path: clean exchanges, the one that finds the garbage and the ones after it.
