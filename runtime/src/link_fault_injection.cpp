@@ -48,12 +48,7 @@ void SetKind(std::string_view spec, std::string_view item, LinkFaultInjection& i
 }
 
 std::uint64_t Whole(std::string_view spec, std::string_view key, std::string_view text) {
-  std::uint64_t value = 0;
-  if (!spec_items::ParseWhole(text, value)) {
-    Fail(spec,
-         "'" + std::string(key) + "' needs a whole number ≥ 0, got '" + std::string(text) + "'");
-  }
-  return value;
+  return spec_items::WholeOf(key, text, [&](const std::string& what) { Fail(spec, what); });
 }
 
 }  // namespace

@@ -29,4 +29,14 @@ inline bool ParseWhole(std::string_view text, std::uint64_t& value) {
   return ec == std::errc() && end == text.data() + text.size();
 }
 
+/// The whole number ≥ 0 in `text`, the value of `key`; else calls `fail(what)`, which throws.
+template <typename Fail>
+std::uint64_t WholeOf(std::string_view key, std::string_view text, Fail&& fail) {
+  std::uint64_t value = 0;
+  if (!ParseWhole(text, value)) {
+    fail("'" + std::string(key) + "' needs a whole number ≥ 0, got '" + std::string(text) + "'");
+  }
+  return value;
+}
+
 }  // namespace hiltwin::runtime::spec_items
