@@ -87,6 +87,12 @@ function(hiltwin_add_gtest name)
   if(ARG_RESOURCE_LOCK)
     set(extra_properties RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
   endif()
+  if(HILTWIN_TSAN)
+    # A report fails the test at once (and in every hiltwin process it starts, which inherit
+    # the variable); tests/tsan.supp names the uninstrumented libraries whose reports are noise.
+    list(APPEND extra_properties ENVIRONMENT
+         "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/tsan.supp:halt_on_error=1:second_deadlock_stack=1")
+  endif()
   gtest_discover_tests(${name}
     DISCOVERY_TIMEOUT 60
     TEST_LIST ${name}_TESTS
