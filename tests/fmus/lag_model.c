@@ -32,7 +32,7 @@ fmi2Status ModelDoStep(FmuInstance* instance, double h_s) {
 #ifdef HILTWIN_FMU_NAN_AFTER_STEPS
   /* A model that diverges: its output turns NaN and it still reports fmi2OK, as a broken
    * model does; the twin must catch it (the fault matrix's "model producing NaN"). */
-  if (instance->steps >= HILTWIN_FMU_NAN_AFTER_STEPS) r[kY] = NAN;
+  if (instance->steps >= HILTWIN_FMU_NAN_AFTER_STEPS) r[kY] = nan("");
 #endif
   return fmi2OK;
 }
