@@ -14,8 +14,26 @@ function(hiltwin_target_warnings target)
 endfunction()
 
 # Sanitizers are global so that every object, including GoogleTest's main, agrees.
+# HILTWIN_FUZZ: every object gets libFuzzer's coverage instrumentation (fuzzer-no-link) with
+# ASan + UBSan, so a fuzz target sees the edges of the parsers it calls; only the fuzz targets
+# link libFuzzer itself (-fsanitize=fuzzer, fuzz/CMakeLists.txt), as it brings its own main.
 macro(hiltwin_apply_sanitizers)
-  if(HILTWIN_SANITIZE)
+  if(HILTWIN_FUZZ)
+    if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang" OR NOT CMAKE_C_COMPILER_ID STREQUAL "Clang")
+      message(FATAL_ERROR "HILTWIN_FUZZ needs clang's libFuzzer, but the compilers are "
+                          "${CMAKE_C_COMPILER_ID}/${CMAKE_CXX_COMPILER_ID}: configure a fresh build "
+                          "folder with CC=clang CXX=clang++ (scripts/fuzz.sh does; Debian: "
+                          "apt-get install clang libclang-rt-14-dev)")
+    endif()
+    if(HILTWIN_SANITIZE OR HILTWIN_TSAN)
+      message(FATAL_ERROR "HILTWIN_FUZZ already builds with ASan + UBSan: drop HILTWIN_SANITIZE "
+                          "and HILTWIN_TSAN")
+    endif()
+    add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+                        -fno-sanitize-recover=all)
+    add_link_options(-fsanitize=address,undefined)
+    add_compile_definitions(HILTWIN_UNDER_SANITIZER=1 HILTWIN_FUZZING=1)
+  elseif(HILTWIN_SANITIZE)
     add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
     add_link_options(-fsanitize=address,undefined)
     add_compile_definitions(HILTWIN_UNDER_SANITIZER=1)
@@ -68,6 +86,12 @@ function(hiltwin_add_gtest name)
   set(extra_properties)
   if(ARG_RESOURCE_LOCK)
     set(extra_properties RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
+  endif()
+  if(HILTWIN_TSAN)
+    # A report fails the test at once (and in every hiltwin process it starts, which inherit
+    # the variable); tests/tsan.supp names the uninstrumented libraries whose reports are noise.
+    list(APPEND extra_properties ENVIRONMENT
+         "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/tsan.supp:halt_on_error=1:second_deadlock_stack=1")
   endif()
   gtest_discover_tests(${name}
     DISCOVERY_TIMEOUT 60

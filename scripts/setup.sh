@@ -22,6 +22,8 @@ packages=(
   chromium                                      # the web page test (headless)
   libzip-dev libxml2-dev                        # FMI 2.0 FMUs: unpacking, modelDescription.xml
   yosys nextpnr-ice40 fpga-icestorm verilator   # the IcoBoard gateware (fpga/, docs/fpga.md)
+  clang libclang-rt-14-dev                      # libFuzzer targets (fuzz/; the runtime is only recommended)
+  stress-ng                                     # the fault matrix's CPU hog (docs/reliability.md)
 )
 
 # One dpkg-query for all: names it does not know at all are missing too.

@@ -17,6 +17,7 @@
 #include "hiltwin/app_relbot/relbot_params.h"
 #include "hiltwin/app_relbot/session_options.h"
 #include "hiltwin/app_relbot/setpoint_profile.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
@@ -112,7 +113,8 @@ int RunEcs(EcsOptions o) {
     ValidateSessionOptions(o.session);  // the rate first: the period depends on it
     return kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   }();
-  std::ofstream report_file = OpenReport(o.session.report_path);
+  kernel_glue::InstallStopSignalHandlers();  // before any output exists: as `run` does
+  ReportFile report_file(o.session.report_path);
   const std::unique_ptr<Ecs> ecs = BuildEcs(o, period_ns);
   // By default the run lasts as long as its profile: the setpoints end settled.
   if (!o.duration_given) o.session.duration_s = ecs->task->length_s();
@@ -129,7 +131,7 @@ int RunEcs(EcsOptions o) {
   const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
   const EcsFigures figures =
       EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
-  PrintOutcome(o.session, role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
+  PrintOutcome(role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
                report_file);
   return static_cast<int>(runtime::ExitCodeFor(report));
 }

@@ -301,9 +301,11 @@ int RunHil(HilOptions o) {
   } catch (const std::invalid_argument& e) {
     Usage(std::string("--wire: ") + e.what());
   }
-  const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
-  std::ofstream report_file = OpenReport(o.report_path);
+  // Before anything is created: a stop signal from here on ends the pair cleanly, never
+  // leaving a half-made report or work folder (docs/reliability.md, row M13).
   kernel_glue::InstallStopSignalHandlers();
+  const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
+  ReportFile report_file(o.report_path);
   std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s\n",
               Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(), wire.c_str(),
               Num(o.duration_s).c_str());
@@ -319,12 +321,7 @@ int RunHil(HilOptions o) {
                  HilSide{"ecs", *ecs.status, ReadReport(dir->path / "ecs.json")});
   std::fputs(FormatHilSummary(result).c_str(), stdout);
   std::fflush(stdout);
-  if (report_file.is_open()) {
-    report_file << ToJson(result).dump(2) << '\n';
-    if (!report_file.flush()) {
-      throw CommandError(ExitCode::kIo, "--report " + o.report_path + ": cannot write it");
-    }
-  }
+  report_file.Write(ToJson(result).dump(2) + '\n');
   return result.exit_code;
 }
 

@@ -1,17 +1,21 @@
 #include "hiltwin/app_relbot/session_options.h"
 
+#include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/scheduler/executive.h"
+#include "hiltwin/tracing/csv_logger.h"
 
 namespace hiltwin::app {
 namespace {
@@ -279,10 +283,19 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
     };
   }
   std::optional<runtime::RunSession> session;
-  // Only the two logs can fail to open; the message quotes the path of the one that did.
-  const std::string timing_log_quoted = "'" + config.timing_log_path + "'";
+  // Only the two logs can fail to open; the message names the flag of the one that did.
+  const std::string timing_log_path = config.timing_log_path;
+  const std::string timing_log_quoted = "'" + timing_log_path + "'";
   try {
     session.emplace(std::move(config), task);
+  } catch (const kernel_glue::OutputFileError& e) {
+    Usage(e.MessageFor(!timing_log_path.empty() && e.path() == timing_log_path ? "--timing-log"
+                                                                                : "--log"));
+  } catch (const tracing::LogWriteError& e) {
+    // The path was fine, the disk is not (already full, an I/O error): exit 5, not usage.
+    const bool timing = timing_log_quoted != "''" &&
+                        std::string(e.what()).find(timing_log_quoted) != std::string::npos;
+    throw CommandError(ExitCode::kIo, std::string(timing ? "--timing-log: " : "--log: ") + e.what());
   } catch (const std::invalid_argument& e) {
     Usage(e.what());
   } catch (const runtime::TelemetryError& e) {
@@ -295,30 +308,54 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
   return session->Run();
 }
 
-std::ofstream OpenReport(const std::string& path) {
-  std::ofstream file;
-  if (path.empty()) return file;
-  file.open(path, std::ios::out | std::ios::trunc);
-  if (!file) {
-    Usage("--report " + path + ": cannot create the file (" + std::strerror(errno) +
-          "); check that the folder exists and is writable");
+ReportFile::ReportFile(std::string path) : path_(std::move(path)) {
+  if (path_.empty()) return;
+  try {
+    fd_ = kernel_glue::OpenOutputFile(path_, "--report");  // a link or a missing folder: exit 2
+  } catch (const kernel_glue::OutputFileError& e) {
+    Usage(e.what());
   }
-  return file;
 }
 
-void PrintOutcome(const SessionOptions& o, const SessionRole& role,
-                  const runtime::RunReport& report, const nlohmann::ordered_json& json,
-                  const std::string& extra_summary, std::ofstream& report_file) {
-  if (report_file.is_open()) {
-    report_file << json.dump(2) << '\n';
-    report_file.flush();
-    if (!report_file) {
-      throw CommandError(
-          ExitCode::kIo,
-          "--report " + o.report_path +
-              ": cannot write the run report; check the folder exists and is writable");
+ReportFile::ReportFile(ReportFile&& other) noexcept
+    : path_(std::move(other.path_)), fd_(std::exchange(other.fd_, -1)) {}
+
+ReportFile::~ReportFile() {
+  if (fd_ < 0) return;
+  // Never written: remove it, but only if the path still names the file this created.
+  struct stat ours {};
+  struct stat named {};
+  if (::fstat(fd_, &ours) == 0 && ::lstat(path_.c_str(), &named) == 0 &&
+      ours.st_dev == named.st_dev && ours.st_ino == named.st_ino) {
+    ::unlink(path_.c_str());
+  }
+  ::close(fd_);
+}
+
+void ReportFile::Write(const std::string& text) {
+  if (fd_ < 0) return;
+  std::size_t done = 0;
+  int error = 0;
+  while (done < text.size() && error == 0) {
+    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno != EINTR) {
+      error = errno;
     }
   }
+  if (::close(std::exchange(fd_, -1)) != 0 && error == 0) error = errno;
+  if (error != 0) {
+    throw CommandError(ExitCode::kIo, "--report " + path_ + ": cannot write the run report (" +
+                                          std::strerror(error) +
+                                          "); check the disk has space and the folder is writable");
+  }
+}
+
+void PrintOutcome(const SessionRole& role,
+                  const runtime::RunReport& report, const nlohmann::ordered_json& json,
+                  const std::string& extra_summary, ReportFile& report_file) {
+  report_file.Write(json.dump(2) + '\n');
   std::fputs(extra_summary.c_str(), stdout);
   std::fputs(runtime::FormatSummary(report).c_str(), stdout);
   std::fflush(stdout);

@@ -18,6 +18,8 @@
 #include "hiltwin/io/backend.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/runtime/link_fault_injection.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
@@ -67,6 +69,33 @@ std::vector<std::pair<std::string, std::string>> PlantDetails(const Twin& twin) 
   return details;
 }
 
+/// --inject-link-fault's SPECs, checked against the backend and the run's length (exit 2).
+runtime::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
+  runtime::LinkFaultSchedule schedule;
+  if (o.inject_link_faults.empty()) return schedule;
+  if (o.session.io != "mock" && o.session.io.rfind("wire:", 0) != 0) {
+    Usage("--inject-link-fault needs an emulated board (--io mock or wire:NAME), not --io " +
+          o.session.io);
+  }
+  try {
+    for (const std::string& spec : o.inject_link_faults)
+      schedule.Add(runtime::ParseLinkFaultInjection(spec));
+    schedule.CheckFiresWithin(PlannedCycles(o.session));
+  } catch (const std::exception& e) {
+    Usage(std::string("--inject-link-fault ") + e.what());
+  }
+  return schedule;
+}
+
+/// The report's line naming the injected link faults, e.g. "drop-answer,at=4000,count=3".
+std::string DescribeAll(const runtime::LinkFaultSchedule& schedule) {
+  std::string text;
+  for (const runtime::LinkFaultInjection& injection : schedule.injections()) {
+    text += (text.empty() ? "" : "; ") + runtime::Describe(injection);
+  }
+  return text;
+}
+
 /// --input-rate, or its documented default.
 double ControllerRateOf(const TwinRunOptions& o) {
   return o.controller_rate_hz == 0.0 ? std::min(1000.0, o.session.rate_hz) : o.controller_rate_hz;
@@ -78,13 +107,19 @@ void CheckTwinRunOptions(const TwinRunOptions& o) {
   TwinRunOptions checked = o;
   checked.controller_rate_hz = ControllerRateOf(o);
   Validate(checked);
+  static_cast<void>(LinkFaultsOf(checked));
 }
 
 TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   o.controller_rate_hz = ControllerRateOf(o);
   Validate(o);
+  const runtime::LinkFaultSchedule link_faults = LinkFaultsOf(o);
   const std::uint64_t planned = PlannedCycles(o.session);
-  std::ofstream report_file = OpenReport(o.session.report_path);
+  // Before the first output exists: a stop signal during start-up (building the plant, INIT)
+  // then ends the run at its first cycle with a report, instead of killing the process with
+  // an empty report behind (docs/reliability.md, row M13).
+  kernel_glue::InstallStopSignalHandlers();
+  ReportFile report_file(o.session.report_path);
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(o, period_ns);
   const SessionRole role{command, "controller", "hiltwin ecs", o.controller_rate_hz, "twin"};
@@ -92,12 +127,17 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   const std::string task_name = TaskNameOf(twin->plant->Info());
   config.task_name = task_name + " twin";
   config.details = PlantDetails(*twin);
+  if (!link_faults.empty()) config.details.emplace_back("link faults", DescribeAll(link_faults));
   config.on_ready = [command, s = o.session, planned, task_name,
                      input = twin->input_name](const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(command, s, planned, task_name, input, rt);
   };
-  const runtime::RunReport report = RunSessionOf(std::move(config), *twin->task);
-  PrintOutcome(o.session, role, report, runtime::ToJson(report), "", report_file);
+  // The emulated board exists: LinkFaultsOf accepted only mock and wire.
+  std::optional<runtime::LinkFaultingTask> faulting;
+  if (!link_faults.empty()) faulting.emplace(*twin->task, *twin->backend->emulated_board(), link_faults);
+  runtime::RunTask& task = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
+  const runtime::RunReport report = RunSessionOf(std::move(config), task);
+  PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
   if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault &&
       o.plant == kRelbotPlantName) {
     std::fprintf(
@@ -128,6 +168,10 @@ void AddTwinRunOptions(CLI::App& app, TwinRunOptions& o) {
   app.add_option("--config", o.config_path,
                  "RELbot parameter file (TOML, see app_relbot/relbot.toml)");
   app.add_option("--integrator", o.integrator, "RELbot integrator: euler | rk2 | rk4 (default rk4)");
+  app.add_option("--inject-link-fault", o.inject_link_faults,
+                 "fault injection (mock and wire): break the link at exchange K, e.g. "
+                 "drop-answer,at=4000,count=3; KIND corrupt-request, corrupt-answer, drop-answer, "
+                 "delay-answer or stuck-encoder (to the end without count) (repeatable)");
 }
 
 }  // namespace hiltwin::app

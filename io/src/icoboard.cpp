@@ -87,7 +87,9 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
       transfer.result == BusResult::kPeerLost && request.opcode == Opcode::kInit;
   // A lost wire peer is a fault, but this side's own board still took the request: the
   // answer is checked all the same, so a caller can tell that its safe outputs arrived.
-  const bool peer_lost = transfer.result == BusResult::kPeerLost && !peer_lost_at_init;
+  // A corrupted wire is the same kind of fault, at INIT too: nothing read from it is trusted.
+  const bool peer_lost = (transfer.result == BusResult::kPeerLost && !peer_lost_at_init) ||
+                         transfer.result == BusResult::kWireCorrupted;
   if (transfer.result == BusResult::kIoError) {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;

@@ -11,6 +11,7 @@ const char* ToString(BusResult result) noexcept {
     case BusResult::kPeerLost: return "peer lost";
     case BusResult::kPeerAbsent: return "peer absent";
     case BusResult::kPeerStopped: return "peer stopped";
+    case BusResult::kWireCorrupted: return "wire corrupted";
   }
   return "?";
 }

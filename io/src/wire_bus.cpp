@@ -6,9 +6,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cstdarg>
+#include <cstdio>
 #include <cstring>
 #include <iterator>
 #include <limits>
@@ -16,64 +20,28 @@
 #include <thread>
 
 #include "hiltwin/io/conversions.h"
+#include "hiltwin/io/seqlock.h"
+#include "hiltwin/io/wire_segment.h"
 
 namespace hiltwin::io {
 
 namespace {
-constexpr std::uint64_t kMagic = 0x6869'6C74'7769'7265ULL;  // "hiltwire"
-constexpr std::uint32_t kLayoutVersion = 3;  // 2: encoder periods in a ring; 3: stop causes
-constexpr std::uint32_t kFresh = 0;
-constexpr std::uint32_t kInitialising = 1;
-constexpr std::uint32_t kReady = 2;
-/// twin_sampling_ns when the twin is not inside a transfer.
-constexpr std::int64_t kNotSampling = std::numeric_limits<std::int64_t>::max();
+using namespace wire;
+/// Times the peer publishes (a period's start, its heartbeat, its sampling moment) are its
+/// CLOCK_MONOTONIC readings, so never later than this side's clock by more than the moment
+/// between its reading and this side's: anything a second ahead was not written by a peer.
+constexpr std::int64_t kFutureSlackNs = 1'000'000'000;
+/// A twin exchange (clock reads, board model, wire) takes longer than this, so the ring's
+/// newest index cannot advance faster; used, with a ring's worth of slack, to tell an absurd
+/// index from a fast twin.
+constexpr std::int64_t kMinTwinExchangeNs = 200;
+/// INIT's step is a 32-bit count of ns: a published step beyond it is not a board's.
+constexpr std::int64_t kMaxStepNs = 0xFFFF'FFFFLL;
+/// A pid that changed while the peer's session count did not is accepted for this long: a
+/// new peer stores its pid a few stores before it bumps the session count.
+constexpr std::int64_t kIdentitySettleNs = 250'000'000;
+constexpr std::uint32_t kLastStopCause = static_cast<std::uint32_t>(StopCause::kPeerStopped);
 }  // namespace
-
-/// One process's presence on the wire.
-struct WireSide {
-  std::atomic<std::uint64_t> heartbeat;
-  std::atomic<std::int64_t> last_beat_ns;
-  std::atomic<std::int64_t> step_ns;
-  std::atomic<std::int32_t> pid;
-  std::atomic<std::uint32_t> attached;
-  std::atomic<std::uint32_t> sessions;
-  std::atomic<std::uint32_t> stop_cause;  ///< a StopCause; kNone while running
-};
-
-/// One encoder period in the ring; each slot is a single-writer seqlock of its own.
-struct WirePeriod {
-  std::atomic<std::uint64_t> sequence;  ///< 2·index when complete, 2·index + 1 while written
-  std::atomic<std::int64_t> start_ns;
-  std::atomic<std::uint32_t> subticks;
-  std::atomic<std::uint32_t> divider;
-  std::atomic<std::uint64_t> start_counts;  ///< 4 × 16-bit two's complement
-  std::atomic<std::uint64_t> pulses;        ///< 4 × 16 bits (at most 8192 each)
-  std::atomic<std::uint32_t> directions;    ///< 4 × 8-bit two's complement
-};
-
-/// The shared segment. Zero-filled memory is a valid initial state of every field.
-struct WireSegment {
-  std::atomic<std::uint32_t> init_state;
-  std::atomic<std::uint32_t> attach_count;
-  std::atomic<std::uint64_t> magic;
-  std::atomic<std::uint32_t> version;
-  std::atomic<std::uint32_t> size;
-  WireSide ecs;
-  WireSide twin;
-  /// ECS -> twin: four packed PWM words (direction, pin, magnitude), 16 bits each.
-  std::atomic<std::uint64_t> pwm_words;
-  std::atomic<std::uint32_t> twin_pins;  ///< bit c = digital output c of the twin
-  /// Twin -> ECS encoder lines: the twin's emulator periods, newest index last published.
-  std::atomic<std::uint64_t> encoder_newest;
-  /// The twin's clock when it began the transfer in progress (kNotSampling outside one): a
-  /// period it is about to publish starts no earlier, so the ECS replays edges only up to here.
-  std::atomic<std::int64_t> twin_sampling_ns;
-  WirePeriod encoder_periods[kEncoderLineHistory];
-};
-static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&
-                  std::atomic<std::int64_t>::is_always_lock_free &&
-                  std::atomic<std::uint32_t>::is_always_lock_free,
-              "the wire needs address-free (lock-free) atomics to work across processes");
 
 namespace {
 
@@ -108,11 +76,71 @@ const char* PeerStopMessage(bool ecs_side, std::uint32_t cause) noexcept {
 
 }  // namespace
 
+/// The first impossible value this side read from the segment, latched: once set, the side
+/// reads nothing more from the wire and every transfer reports it. The message lives in this
+/// object (the bus outlives the run that reports it), formatted without allocating.
+class WireGuard {
+ public:
+  explicit WireGuard(std::string path) : path_(std::move(path)) {}
+  [[nodiscard]] bool ok() const noexcept { return reason_ == nullptr; }
+  [[nodiscard]] const char* reason() const noexcept { return reason_; }
+  [[nodiscard]] const std::string& path() const noexcept { return path_; }
+
+  /// Latches "wire: <what>: the segment is corrupted (...)" unless a reason is latched already.
+  __attribute__((format(printf, 2, 3))) void Fail(const char* format, ...) noexcept {
+    if (reason_ != nullptr) return;
+    va_list args;
+    va_start(args, format);
+    const int used = std::vsnprintf(text_.data(), text_.size(), format, args);
+    va_end(args);
+    if (used >= 0 && static_cast<std::size_t>(used) < text_.size()) {
+      std::snprintf(text_.data() + used, text_.size() - static_cast<std::size_t>(used),
+                    ": the segment is corrupted (another process writes into %s); outputs go "
+                    "safe: stop that process, then restart both sides",
+                    path_.c_str());
+    }
+    reason_ = text_.data();
+  }
+
+  // The ECS's view of the ring's newest index: the last value read and when.
+  std::uint64_t newest_seen = 0;
+  std::int64_t newest_seen_ns = 0;
+  // The twin's own count of the periods it published.
+  std::uint64_t published = 0;
+  // The peer's identity as last seen, and since when a changed pid awaits its new session.
+  std::uint32_t peer_sessions = 0;
+  std::int32_t peer_pid = 0;
+  std::int64_t pid_changed_ns = -1;
+  // What this side last stored in its own stop_cause.
+  std::uint32_t own_stop_cause = 0;
+
+ private:
+  std::string path_;
+  const char* reason_ = nullptr;
+  std::array<char, 512> text_{};
+};
+
+namespace {
+
+/// Whether `words` (4 × 16-bit PWM words) could come from an ECS board: magnitude at most full
+/// scale, and no "negative zero" (PwmWordFromValue never makes one). Names the first bad one.
+bool CheckPwmWords(std::uint64_t words, WireGuard* guard) noexcept;
+
+/// Decodes period `index` from its words, checking each field against what a twin board can
+/// publish (INIT's ranges, the pulse limit, directions -1/0/+1, a start not in the future).
+bool DecodePeriod(const std::array<std::uint64_t, kPeriodWords>& words, std::uint64_t index,
+                  std::int64_t now_ns, EncoderPeriod& out, WireGuard* guard) noexcept;
+
+}  // namespace
+
 class WireBus::PwmWire final : public PwmSignalSource {
  public:
-  explicit PwmWire(const WireSegment& seg) noexcept : seg_(seg) {}
+  PwmWire(const WireSegment& seg, WireGuard& guard) noexcept : seg_(seg), guard_(guard) {}
   void DutyAt(std::int64_t /*t_ns*/, std::array<double, kChannels>& duty_out) noexcept override {
+    duty_out.fill(0.0);  // idle when the wire is corrupted: nothing read from it is used
+    if (!guard_.ok()) return;
     const std::uint64_t words = seg_.pwm_words.load(std::memory_order_acquire);
+    if (!CheckPwmWords(words, &guard_)) return;
     for (std::size_t c = 0; c < kChannels; ++c) {
       duty_out[c] = PwmToDuty(PwmValueFromWord(UnpackPwm(Unpack16(words, c))));
     }
@@ -120,77 +148,201 @@ class WireBus::PwmWire final : public PwmSignalSource {
 
  private:
   const WireSegment& seg_;
+  WireGuard& guard_;
 };
 
 /// Twin side: publishes the board's emulator periods into the ring. ECS side: reads them.
 class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSource {
  public:
-  explicit EncoderWire(WireSegment& seg) noexcept : seg_(seg) {}
+  EncoderWire(WireSegment& seg, WireGuard& guard, const kernel_glue::MonotonicClock& clock) noexcept
+      : seg_(seg), guard_(guard), clock_(clock) {}
 
   void OnPeriod(const std::array<PulseSegment, kChannels>& channels) noexcept override {
-    const std::uint64_t index = seg_.encoder_newest.load(std::memory_order_relaxed) + 1;
-    WirePeriod& slot = seg_.encoder_periods[index % kEncoderLineHistory];
-    std::uint64_t starts = 0;
-    std::uint64_t pulses = 0;
-    std::uint32_t directions = 0;
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      starts |= Pack16(c, static_cast<std::uint16_t>(channels[c].start_counts));
-      pulses |= Pack16(c, static_cast<std::uint16_t>(channels[c].pulses));
-      directions |= static_cast<std::uint32_t>(static_cast<std::uint8_t>(channels[c].direction))
-                    << (8U * c);
+    // Only this twin writes encoder_newest: another value there was written by someone else,
+    // and numbering on from it would publish under an index the ECS must refuse.
+    const std::uint64_t found = seg_.encoder_newest.load(std::memory_order_relaxed);
+    if (found != guard_.published) {
+      guard_.Fail("wire: the ring's newest index is %llu, but this twin published up to %llu",
+                  static_cast<unsigned long long>(found),
+                  static_cast<unsigned long long>(guard_.published));
     }
-    slot.sequence.store(2 * index + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
-    slot.start_ns.store(channels[0].start_ns, std::memory_order_relaxed);
-    slot.subticks.store(channels[0].subticks, std::memory_order_relaxed);
-    slot.divider.store(channels[0].divider, std::memory_order_relaxed);
-    slot.start_counts.store(starts, std::memory_order_relaxed);
-    slot.pulses.store(pulses, std::memory_order_relaxed);
-    slot.directions.store(directions, std::memory_order_relaxed);
-    slot.sequence.store(2 * index, std::memory_order_release);
+    const std::uint64_t index = ++guard_.published;
+    std::array<std::uint64_t, kPeriodWords> words{};
+    words[0] = static_cast<std::uint64_t>(channels[0].start_ns);
+    words[1] = std::uint64_t{channels[0].subticks} << 32U | channels[0].divider;
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      words[2] |= Pack16(c, static_cast<std::uint16_t>(channels[c].start_counts));
+      words[3] |= Pack16(c, static_cast<std::uint16_t>(channels[c].pulses));
+      words[4] |= std::uint64_t{static_cast<std::uint8_t>(channels[c].direction)} << (8U * c);
+    }
+    SeqlockWrite(seg_.encoder_periods[index % kEncoderLineHistory], index, words);
     seg_.encoder_newest.store(index, std::memory_order_release);
   }
 
-  LineView Lines(std::int64_t /*t_ns*/) noexcept override {
-    LineView view;
+  LineView Lines(std::int64_t t_ns) noexcept override {
+    LineView view;  // newest 0: the lines rest where they are (and so after a corruption)
+    now_ns_ = t_ns;
+    if (!guard_.ok()) return view;
     // seq_cst pairs with the twin's store: a sample that begins after this load reads its clock
     // after the ECS read its own, so it cannot cancel edges the ECS replays now.
-    view.known_until_ns = seg_.twin_sampling_ns.load(std::memory_order_seq_cst);
-    view.newest = seg_.encoder_newest.load(std::memory_order_acquire);
+    const std::int64_t until_ns = seg_.twin_sampling_ns.load(std::memory_order_seq_cst);
+    const std::uint64_t newest = seg_.encoder_newest.load(std::memory_order_acquire);
+    // The loads may come long after t_ns was read (this thread preempted): before calling a
+    // time "in the future", look at the clock again (only then: the usual path reads it once).
+    std::int64_t now_ns = t_ns;
+    if (until_ns != kNotSampling && until_ns > now_ns + kFutureSlackNs) now_ns = clock_.NowNs();
+    if (until_ns != kNotSampling && (until_ns < 0 || until_ns > now_ns + kFutureSlackNs)) {
+      guard_.Fail("wire: the twin's sampling moment %lld ns is not a time of this clock (now %lld)",
+                  static_cast<long long>(until_ns), static_cast<long long>(now_ns));
+      return view;
+    }
+    if (!CheckNewest(newest, t_ns)) return view;
+    view.known_until_ns = until_ns;
+    view.newest = newest;
     return view;
   }
 
   bool Period(std::uint64_t index, EncoderPeriod& out) noexcept override {
-    if (index == 0) return false;
-    const WirePeriod& slot = seg_.encoder_periods[index % kEncoderLineHistory];
-    // Not 2·index: overwritten by a newer period (or being overwritten). No retry needed: an
-    // index the reader asks for was complete before encoder_newest named it.
-    const std::uint64_t before = slot.sequence.load(std::memory_order_acquire);
-    if (before != 2 * index) return false;
-    const std::int64_t start_ns = slot.start_ns.load(std::memory_order_relaxed);
-    const std::uint32_t subticks = slot.subticks.load(std::memory_order_relaxed);
-    const std::uint32_t divider = slot.divider.load(std::memory_order_relaxed);
-    const std::uint64_t starts = slot.start_counts.load(std::memory_order_relaxed);
-    const std::uint64_t pulses = slot.pulses.load(std::memory_order_relaxed);
-    const std::uint32_t directions = slot.directions.load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
-    if (slot.sequence.load(std::memory_order_relaxed) != before) return false;
-    out.index = index;
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      PulseSegment& s = out.channels[c];
-      s.start_counts = static_cast<std::int16_t>(Unpack16(starts, c));
-      s.pulses = Unpack16(pulses, c);
-      s.direction = static_cast<std::int8_t>((directions >> (8U * c)) & 0xFFU);
-      s.start_ns = start_ns;
-      s.subticks = subticks;
-      s.divider = divider;
+    if (index == 0 || !guard_.ok()) return false;
+    // Refused when not version 2·index: overwritten by a newer period, being overwritten, or
+    // torn for good. No retry: an index the reader asks for was complete before
+    // encoder_newest named it, so a refusal is a loss (a resync), never a reason to wait.
+    std::array<std::uint64_t, kPeriodWords> words{};
+    if (!SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) return false;
+    if (static_cast<std::int64_t>(words[0]) > now_ns_ + kFutureSlackNs) now_ns_ = clock_.NowNs();
+    return DecodePeriod(words, index, now_ns_, out, &guard_);
+  }
+
+  /// Period() for diagnostics: checked against `now_ns`, nothing latched.
+  bool Peek(std::uint64_t index, std::int64_t now_ns, EncoderPeriod& out) const noexcept {
+    std::array<std::uint64_t, kPeriodWords> words{};
+    if (index == 0 ||
+        !SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) {
+      return false;
     }
-    return true;
+    return DecodePeriod(words, index, now_ns, out, nullptr);
   }
 
  private:
+  /// The newest index never goes back (a restarted twin numbers on) and cannot run further
+  /// ahead than a twin exchanging flat out since the last read, plus a ring's worth.
+  bool CheckNewest(std::uint64_t newest, std::int64_t t_ns) noexcept {
+    const std::uint64_t seen = guard_.newest_seen;
+    if (newest < seen) {
+      guard_.Fail("wire: the ring's newest index went back from %llu to %llu",
+                  static_cast<unsigned long long>(seen), static_cast<unsigned long long>(newest));
+      return false;
+    }
+    // From the clock reading before the last load to one after this load (the usual path uses
+    // t_ns, read before it, and reads the clock again only when that bound is exceeded).
+    const auto reachable = [&](std::int64_t until_ns) {
+      const std::int64_t elapsed_ns =
+          until_ns > guard_.newest_seen_ns ? until_ns - guard_.newest_seen_ns : 0;
+      return kEncoderLineHistory + static_cast<std::uint64_t>(elapsed_ns / kMinTwinExchangeNs);
+    };
+    if (newest - seen > reachable(t_ns) && newest - seen > reachable(clock_.NowNs())) {
+      const std::int64_t elapsed_ns = clock_.NowNs() - guard_.newest_seen_ns;
+      guard_.Fail("wire: the ring's newest index jumped from %llu to %llu within %lld ns",
+                  static_cast<unsigned long long>(seen), static_cast<unsigned long long>(newest),
+                  static_cast<long long>(elapsed_ns));
+      return false;
+    }
+    guard_.newest_seen = newest;
+    guard_.newest_seen_ns = t_ns;
+    return true;
+  }
+
   WireSegment& seg_;
+  WireGuard& guard_;
+  const kernel_glue::MonotonicClock& clock_;
+  std::int64_t now_ns_ = 0;  ///< the ECS board's time at its current read of the lines
 };
+
+namespace {
+
+bool CheckPwmWords(std::uint64_t words, WireGuard* guard) noexcept {
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const PwmWord word = UnpackPwm(Unpack16(words, c));
+    if (word.magnitude > kPwmMagnitudeMax || (word.negative && word.magnitude == 0)) {
+      if (guard != nullptr) {
+        guard->Fail("wire: PWM word %zu is 0x%04x (magnitude %u, largest %u, sign %s)", c,
+                    unsigned{Unpack16(words, c)}, unsigned{word.magnitude},
+                    unsigned{kPwmMagnitudeMax}, word.negative ? "negative" : "positive");
+      }
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The first field of `period` no twin board publishes, as "has <field> <value> (<allowed>)"
+/// into `what`; true when there is none.
+bool PeriodFieldsPossible(const EncoderPeriod& period, std::int64_t now_ns, char* what,
+                          std::size_t size) noexcept {
+  const PulseSegment& first = period.channels[0];
+  if (first.divider < kMinClockDivider || first.divider > kMaxClockDivider) {
+    std::snprintf(what, size, "divider %u (a board uses %u..%u)", first.divider, kMinClockDivider,
+                  kMaxClockDivider);
+    return false;
+  }
+  if (first.subticks < 1 || first.subticks > kMaxSubticksPerStep) {
+    std::snprintf(what, size, "%u sub-ticks (a board uses 1..%u)", first.subticks,
+                  kMaxSubticksPerStep);
+    return false;
+  }
+  if (first.start_ns < 0 || first.start_ns > now_ns + kFutureSlackNs) {
+    std::snprintf(what, size, "start %lld ns (this clock reads %lld ns)",
+                  static_cast<long long>(first.start_ns), static_cast<long long>(now_ns));
+    return false;
+  }
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const PulseSegment& s = period.channels[c];
+    const std::uint32_t limit = std::min(first.subticks, kMaxRepresentablePulses);
+    if (s.pulses > limit) {
+      std::snprintf(what, size, "%u pulses on channel %zu (at most %u in one period)", s.pulses, c,
+                    limit);
+      return false;
+    }
+    if (s.direction < -1 || s.direction > 1) {
+      std::snprintf(what, size, "direction %d on channel %zu (-1, 0 or 1)", s.direction, c);
+      return false;
+    }
+    if (s.start_counts < kEncoderFieldMin || s.start_counts > kEncoderFieldMax) {
+      std::snprintf(what, size, "start position %d on channel %zu (%d..%d)", s.start_counts, c,
+                    kEncoderFieldMin, kEncoderFieldMax);
+      return false;
+    }
+  }
+  return true;
+}
+
+bool DecodePeriod(const std::array<std::uint64_t, kPeriodWords>& words, std::uint64_t index,
+                  std::int64_t now_ns, EncoderPeriod& out, WireGuard* guard) noexcept {
+  out.index = index;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    PulseSegment& s = out.channels[c];
+    s.start_counts = static_cast<std::int16_t>(Unpack16(words[2], c));
+    s.pulses = Unpack16(words[3], c);
+    s.direction = static_cast<std::int8_t>((words[4] >> (8U * c)) & 0xFFU);
+    s.start_ns = static_cast<std::int64_t>(words[0]);
+    s.subticks = static_cast<std::uint32_t>(words[1] >> 32U);
+    s.divider = static_cast<std::uint32_t>(words[1] & 0xFFFF'FFFFU);
+  }
+  std::array<char, 128> what{};
+  bool possible = PeriodFieldsPossible(out, now_ns, what.data(), what.size());
+  if (possible && (words[4] >> 32U) != 0) {
+    std::snprintf(what.data(), what.size(), "reserved direction bits 0x%llx set",
+                  static_cast<unsigned long long>(words[4] >> 32U));
+    possible = false;
+  }
+  if (!possible && guard != nullptr) {
+    guard->Fail("wire: encoder period %llu has %s", static_cast<unsigned long long>(index),
+                what.data());
+  }
+  return possible;
+}
+
+}  // namespace
 
 std::string WireBus::SegmentName(const std::string& name) {
   bool ok = !name.empty() && name.size() <= 64 && name[0] != '.';
@@ -209,31 +361,104 @@ std::string WireBus::SegmentName(const std::string& name) {
 
 void WireBus::Unlink(const std::string& name) { ::shm_unlink(SegmentName(name).c_str()); }
 
+std::string WireBus::SegmentPath(const std::string& name) { return "/dev/shm" + SegmentName(name); }
+
 namespace {
 
-/// Opens (creating if needed), sizes and maps the named segment.
-WireSegment* MapSegment(const std::string& segment_name, const std::string& label) {
-  const int fd = ::shm_open(segment_name.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0660);
-  if (fd < 0) {
-    throw std::runtime_error("cannot open shared memory " + segment_name + " for " + label +
-                             ": " + std::strerror(errno) + "; check /dev/shm is mounted and writable");
+std::string OctalMode(unsigned mode) {
+  char text[8];
+  std::snprintf(text, sizeof text, "%04o", mode & 07777U);
+  return text;
+}
+
+/// Refuses a segment another user could have written (or can write): it must be a regular file
+/// of this effective user with mode 0600 exactly. Empty when it is fine, else why not.
+std::string OwnerOnlyProblem(const struct stat& info) {
+  const auto mode = static_cast<unsigned>(info.st_mode) & 0777U;
+  if (!S_ISREG(info.st_mode)) return "is not a regular file";
+  if (info.st_uid != ::geteuid()) {
+    return "belongs to uid " + std::to_string(info.st_uid) + ", not to this process's uid " +
+           std::to_string(::geteuid());
   }
+  if (mode != kWireSegmentMode) {
+    return "has mode " + OctalMode(mode) + ", not " + OctalMode(kWireSegmentMode) +
+           " (owner-only)";
+  }
+  return {};
+}
+
+[[noreturn]] void RefuseSegment(const std::string& segment_name, const std::string& problem) {
+  const std::string path = "/dev/shm" + segment_name;
+  throw std::runtime_error(
+      "shared memory " + path + " " + problem + ": the wire only uses a segment no other user " +
+      "can write into. If it is a stale segment of yours or of another user, remove it (rm " +
+      path + ") and retry; otherwise use another wire name");
+}
+
+/// Creates the segment owner-only, or opens the existing one and checks it is owner-only.
+int OpenOwnerOnly(const std::string& segment_name, const std::string& label) {
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    int fd = ::shm_open(segment_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC,
+                        kWireSegmentMode);
+    if (fd >= 0) {
+      ::fchmod(fd, kWireSegmentMode);  // the umask may have taken bits off
+      return fd;
+    }
+    if (errno == EEXIST) fd = ::shm_open(segment_name.c_str(), O_RDWR | O_CLOEXEC, 0);
+    if (fd < 0 && errno == ENOENT) continue;  // removed between the two calls: create it
+    if (fd < 0 && errno == EACCES) {
+      struct stat info {};
+      if (::stat(("/dev/shm" + segment_name).c_str(), &info) == 0) {
+        RefuseSegment(segment_name, OwnerOnlyProblem(info) + " and cannot be opened");
+      }
+    }
+    if (fd < 0) {
+      throw std::runtime_error("cannot open shared memory /dev/shm" + segment_name + " for " +
+                               label + ": " + std::strerror(errno) +
+                               "; check /dev/shm is mounted and writable");
+    }
+    struct stat info {};
+    std::string problem = ::fstat(fd, &info) != 0 ? std::strerror(errno) : OwnerOnlyProblem(info);
+    // Its creator may be between shm_open and fchmod (an unusual umask): give it a moment.
+    for (int i = 0; i < 100 && !problem.empty() && info.st_size == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      problem = ::fstat(fd, &info) != 0 ? std::strerror(errno) : OwnerOnlyProblem(info);
+    }
+    if (problem.empty()) return fd;
+    ::close(fd);
+    RefuseSegment(segment_name, problem);
+  }
+  throw std::runtime_error("cannot create shared memory /dev/shm" + segment_name +
+                           ": it keeps being removed and re-created; retry");
+}
+
+/// Opens (creating if needed) owner-only, sizes and maps the named segment.
+WireSegment* MapSegment(const std::string& segment_name, const std::string& label) {
+  const int fd = OpenOwnerOnly(segment_name, label);
   struct stat info {};
   const auto size = static_cast<off_t>(sizeof(WireSegment));
   if (::fstat(fd, &info) != 0 || (info.st_size != 0 && info.st_size != size) ||
       (info.st_size == 0 && ::ftruncate(fd, size) != 0)) {
     const int error = errno;
     ::close(fd);
-    throw std::runtime_error("shared memory " + segment_name + " has the wrong size or cannot " +
-                             "be sized (" + std::strerror(error) + "); it may be from another " +
-                             "hiltwin version: remove /dev/shm" + segment_name + " and retry");
+    throw std::runtime_error("shared memory /dev/shm" + segment_name + " has the wrong size or " +
+                             "cannot be sized (" + std::strerror(error) + "); it may be from " +
+                             "another hiltwin version: remove /dev/shm" + segment_name +
+                             " and retry");
   }
   void* map = ::mmap(nullptr, sizeof(WireSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   ::close(fd);
   if (map == MAP_FAILED) {
-    throw std::runtime_error("cannot map " + segment_name + ": " + std::strerror(errno));
+    throw std::runtime_error("cannot map /dev/shm" + segment_name + ": " + std::strerror(errno));
   }
   return static_cast<WireSegment*>(map);
+}
+
+bool HeaderValid(const WireSegment& segment) noexcept {
+  return segment.init_state.load(std::memory_order_acquire) == kReady &&
+         segment.magic.load(std::memory_order_relaxed) == kMagic &&
+         segment.version.load(std::memory_order_relaxed) == kLayoutVersion &&
+         segment.size.load(std::memory_order_relaxed) == sizeof(WireSegment);
 }
 
 /// Whoever comes first lays the segment out; the other waits (start-up only, bounded). False
@@ -250,9 +475,7 @@ bool LayOutOrCheck(WireSegment& segment) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   }
-  return segment.init_state.load(std::memory_order_acquire) == kReady &&
-         segment.magic.load() == kMagic && segment.version.load() == kLayoutVersion &&
-         segment.size.load() == sizeof(WireSegment);
+  return HeaderValid(segment);
 }
 
 }  // namespace
@@ -261,17 +484,25 @@ WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board
     : label_("wire:" + name),
       segment_name_(SegmentName(name)),
       side_(side),
-      board_(board_image.value_or(side), &clock_) {
+      board_(board_image.value_or(side), &clock_),
+      pid_(static_cast<std::int32_t>(::getpid())),
+      guard_(std::make_unique<WireGuard>(SegmentPath(name))) {
   segment_ = MapSegment(segment_name_, label_);
   if (!LayOutOrCheck(*segment_)) {
     ::munmap(segment_, sizeof(WireSegment));
     segment_ = nullptr;
-    throw std::runtime_error("shared memory " + segment_name_ + " is not a hiltwin wire of this " +
-                             "version; remove /dev/shm" + segment_name_ + " and retry");
+    throw std::runtime_error("shared memory /dev/shm" + segment_name_ + " is not a hiltwin wire " +
+                             "of this version; remove /dev/shm" + segment_name_ + " and retry");
   }
   Attach();
-  pwm_wire_ = std::make_unique<PwmWire>(*segment_);
-  encoder_wire_ = std::make_unique<EncoderWire>(*segment_);
+  pwm_wire_ = std::make_unique<PwmWire>(*segment_, *guard_);
+  encoder_wire_ = std::make_unique<EncoderWire>(*segment_, *guard_, clock_);
+  const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
+  guard_->peer_sessions = peer.sessions.load();
+  guard_->peer_pid = peer.pid.load();
+  guard_->newest_seen = segment_->encoder_newest.load();
+  guard_->newest_seen_ns = clock_.NowNs();
+  guard_->published = guard_->newest_seen;
   if (side_ == Image::kIcoboardInverse) {
     segment_->twin_sampling_ns.store(kNotSampling);  // a crashed twin may have left it set
     board_.SetPwmSource(pwm_wire_.get());
@@ -307,7 +538,7 @@ void WireBus::Attach() {
       peer.sessions.fetch_add(1);
     }
   }
-  self.pid.store(::getpid());
+  self.pid.store(pid_);
   self.stop_cause.store(static_cast<std::uint32_t>(StopCause::kNone));
   self.step_ns.store(0);
   self.last_beat_ns.store(clock_.NowNs());
@@ -357,13 +588,96 @@ void WireBus::Beat(std::int64_t now_ns) noexcept {
 }
 
 BusStatus WireBus::Poll() noexcept {
-  Beat(clock_.NowNs());
-  return PeerStatus();
+  const std::int64_t now_ns = clock_.NowNs();
+  CheckSegment(now_ns);
+  Beat(now_ns);
+  return Status();
 }
 
 void WireBus::AnnounceStop(StopCause cause) noexcept {
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
+  guard_->own_stop_cause = static_cast<std::uint32_t>(cause);
   self.stop_cause.store(static_cast<std::uint32_t>(cause), std::memory_order_release);
+}
+
+bool WireBus::CheckSegment(std::int64_t now_ns) noexcept {
+  WireGuard& guard = *guard_;
+  if (!guard.ok()) return false;
+  const WireSegment& seg = *segment_;
+  const bool ecs_side = side_ == Image::kIcoboard;
+  const WireSide& self = ecs_side ? seg.ecs : seg.twin;
+  const WireSide& peer = ecs_side ? seg.twin : seg.ecs;
+  const char* const peer_name = ecs_side ? "twin" : "ECS";
+  if (!HeaderValid(seg)) {
+    guard.Fail("wire: the segment's header (state %u, magic 0x%llx, version %u, size %u) changed "
+               "under this running side",
+               seg.init_state.load(), static_cast<unsigned long long>(seg.magic.load()),
+               seg.version.load(), seg.size.load());
+    return false;
+  }
+  const std::int32_t own_pid = self.pid.load(std::memory_order_relaxed);
+  const std::uint32_t own_cause = self.stop_cause.load(std::memory_order_relaxed);
+  if (own_pid != pid_ || self.attached.load(std::memory_order_relaxed) != 1 ||
+      own_cause != guard.own_stop_cause) {
+    guard.Fail("wire: this side's own entry was overwritten (pid %d, expected %d; stop cause %u, "
+               "expected %u)",
+               own_pid, pid_, own_cause, guard.own_stop_cause);
+    return false;
+  }
+  const std::uint32_t cause = peer.stop_cause.load(std::memory_order_relaxed);
+  const std::uint32_t attached = peer.attached.load(std::memory_order_relaxed);
+  const std::int64_t step_ns = peer.step_ns.load(std::memory_order_relaxed);
+  const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_relaxed);
+  if (beat_ns > now_ns + kFutureSlackNs) now_ns = clock_.NowNs();  // preempted since now_ns?
+  if (cause > kLastStopCause || attached > 1 || step_ns < 0 || step_ns > kMaxStepNs ||
+      beat_ns < 0 || beat_ns > now_ns + kFutureSlackNs) {
+    guard.Fail("wire: the %s's entry holds impossible values (stop cause %u, attached %u, step "
+               "%lld ns, heartbeat at %lld ns with this clock at %lld ns)",
+               peer_name, cause, attached, static_cast<long long>(step_ns),
+               static_cast<long long>(beat_ns), static_cast<long long>(now_ns));
+    return false;
+  }
+  return CheckPeerIdentity(now_ns);
+}
+
+bool WireBus::CheckPeerIdentity(std::int64_t now_ns) noexcept {
+  WireGuard& guard = *guard_;
+  const bool ecs_side = side_ == Image::kIcoboard;
+  const WireSide& peer = ecs_side ? segment_->twin : segment_->ecs;
+  const char* const peer_name = ecs_side ? "twin" : "ECS";
+  const std::uint32_t sessions = peer.sessions.load(std::memory_order_acquire);
+  const std::int32_t pid = peer.pid.load(std::memory_order_relaxed);
+  if (sessions < guard.peer_sessions) {
+    guard.Fail("wire: the %s's session count went back from %u to %u", peer_name,
+               guard.peer_sessions, sessions);
+    return false;
+  }
+  if (sessions > guard.peer_sessions) {  // a new peer process (it stored its pid first)
+    guard.peer_sessions = sessions;
+    guard.peer_pid = pid;
+    guard.pid_changed_ns = -1;
+  }
+  if (sessions > 0 && pid <= 0) {
+    guard.Fail("wire: the %s's pid is %d while it has a session", peer_name, pid);
+    return false;
+  }
+  if (pid == guard.peer_pid) {
+    guard.pid_changed_ns = -1;
+    return true;
+  }
+  // A new process stores its pid a few stores before it counts its session: wait for that.
+  if (guard.pid_changed_ns < 0) guard.pid_changed_ns = now_ns;
+  if (now_ns - guard.pid_changed_ns > kIdentitySettleNs) {
+    guard.Fail("wire: the %s's pid changed from %d to %d without a new session (a forged pid)",
+               peer_name, guard.peer_pid, pid);
+    return false;
+  }
+  return true;
+}
+
+BusStatus WireBus::Status() const noexcept {
+  if (!guard_->ok()) return {BusResult::kWireCorrupted, guard_->reason()};
+  return PeerStatus();
 }
 
 BusStatus WireBus::PeerStatus() const noexcept {
@@ -382,11 +696,13 @@ BusStatus WireBus::PeerStatus() const noexcept {
                                            : "wire: the ECS process detached (it stopped); "
                                              "restart it, either side may start first"};
   }
-  const std::int64_t step_ns = peer.step_ns.load(std::memory_order_relaxed);
+  std::int64_t step_ns = peer.step_ns.load(std::memory_order_relaxed);
+  if (step_ns < 0 || step_ns > kMaxStepNs) step_ns = 0;  // garbage: CheckSegment reports it
   std::int64_t timeout_ns = 20 * step_ns;
   if (timeout_ns < kWireMinHeartbeatTimeoutNs) timeout_ns = kWireMinHeartbeatTimeoutNs;
-  const std::int64_t age_ns = clock_.NowNs() - peer.last_beat_ns.load(std::memory_order_acquire);
-  if (age_ns > timeout_ns) {
+  // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
+  const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_acquire);
+  if (beat_ns < 0 || clock_.NowNs() - beat_ns > timeout_ns) {
     return {BusResult::kPeerLost,
             ecs_side ? "wire: the twin process stopped updating its heartbeat (crashed, hung or "
                        "killed); restart it, either side may start first"
@@ -399,23 +715,32 @@ BusStatus WireBus::PeerStatus() const noexcept {
 template <typename Transfers>
 BusStatus WireBus::RunOnBoard(Transfers&& transfers) noexcept {
   WireSegment& seg = *segment_;
+  const bool twin = side_ == Image::kIcoboardInverse;
+  // Nothing read from a segment that failed a check is used: no pins, idle PWM, held lines.
   std::array<bool, kChannels> pins{};
-  if (side_ == Image::kIcoboardInverse) {
+  const bool clean = CheckSegment(clock_.NowNs());
+  if (clean && twin) {
     const std::uint64_t words = seg.pwm_words.load(std::memory_order_acquire);
-    for (std::size_t c = 0; c < kChannels; ++c) pins[c] = UnpackPwm(Unpack16(words, c)).pin;
-  } else {
+    if (CheckPwmWords(words, guard_.get())) {
+      for (std::size_t c = 0; c < kChannels; ++c) pins[c] = UnpackPwm(Unpack16(words, c)).pin;
+    }
+  } else if (clean) {
     const std::uint32_t bits = seg.twin_pins.load(std::memory_order_acquire);
-    for (std::size_t c = 0; c < kChannels; ++c) pins[c] = ((bits >> c) & 1U) != 0;
+    if ((bits >> kChannels) != 0) {
+      guard_->Fail("wire: the twin's pin bits are 0x%x (only the low %zu are used)", bits,
+                   kChannels);
+    } else {
+      for (std::size_t c = 0; c < kChannels; ++c) pins[c] = ((bits >> c) & 1U) != 0;
+    }
   }
   board_.SetDigitalInputs(pins);
-  const bool twin = side_ == Image::kIcoboardInverse;
   // The board samples (and publishes its period) while acting on the request; the fetch's NOOP
   // changes nothing on the wire, so one window around both keeps the ECS's replay bound valid.
   if (twin) seg.twin_sampling_ns.store(clock_.NowNs(), std::memory_order_seq_cst);
   transfers();
   if (twin) seg.twin_sampling_ns.store(kNotSampling, std::memory_order_seq_cst);
   Publish(clock_.NowNs());
-  return PeerStatus();
+  return Status();
 }
 
 BusStatus WireBus::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
@@ -431,7 +756,7 @@ BusStatus WireBus::TransferPair(const FrameBytes& request, FrameBytes& request_m
 }
 
 bool WireBus::ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept {
-  return encoder_wire_->Period(index, out);
+  return encoder_wire_->Peek(index, clock_.NowNs(), out);
 }
 
 }  // namespace hiltwin::io

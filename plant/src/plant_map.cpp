@@ -57,7 +57,9 @@ class Entry {
   [[nodiscard]] int Channel() const {
     const toml::node* node = table_.get("channel");
     if (node == nullptr) Fail(source_, table_, name_ + " has no 'channel' (a board channel 1..4)");
-    const std::optional<std::int64_t> value = node->value<std::int64_t>();
+    // value_exact: toml++'s value<int64_t>() converts a float by a cast that is undefined for
+    // one outside int64_t (channel = 3e75, found by fuzz/toml_config); a channel is an integer.
+    const std::optional<std::int64_t> value = node->value_exact<std::int64_t>();
     if (!value || *value < 1 || *value > kChannels) {
       Fail(source_, *node, name_ + ": channel must be an integer 1..4 (board channel n, as in "
                                     "thesis appendix G's channel1..channel4)");

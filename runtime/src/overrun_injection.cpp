@@ -1,7 +1,8 @@
 #include "hiltwin/runtime/overrun_injection.h"
 
-#include <charconv>
 #include <stdexcept>
+
+#include "spec_items.h"
 
 namespace hiltwin::runtime {
 namespace {
@@ -15,13 +16,7 @@ constexpr const char* kForms =
 }
 
 std::uint64_t ParseCount(std::string_view spec, std::string_view key, std::string_view text) {
-  std::uint64_t value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
-    Fail(spec,
-         "'" + std::string(key) + "' needs a whole number ≥ 0, got '" + std::string(text) + "'");
-  }
-  return value;
+  return spec_items::WholeOf(key, text, [&](const std::string& what) { Fail(spec, what); });
 }
 
 }  // namespace
@@ -30,11 +25,7 @@ OverrunInjection ParseOverrunInjection(std::string_view spec) {
   OverrunInjection injection;
   bool have_at = false, have_every = false, have_extra = false, have_count = false,
        have_offset = false;
-  std::string_view rest = spec;
-  while (!rest.empty()) {
-    const std::size_t comma = rest.find(',');
-    const std::string_view item = rest.substr(0, comma);
-    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+  spec_items::ForEachItem(spec, [&](std::string_view item) {
     const std::size_t eq = item.find('=');
     if (eq == std::string_view::npos) Fail(spec, "'" + std::string(item) + "' is not key=value");
     const std::string_view key = item.substr(0, eq);
@@ -59,7 +50,7 @@ OverrunInjection ParseOverrunInjection(std::string_view spec) {
     } else {
       Fail(spec, "unknown key '" + std::string(key) + "'");
     }
-  }
+  });
   if (have_at == have_every) Fail(spec, "give exactly one of 'at=' and 'every='");
   if (!have_extra) Fail(spec, "'extra-us=' is required");
   if (have_at && have_offset) Fail(spec, "'offset=' goes with 'every='");

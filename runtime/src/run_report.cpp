@@ -111,11 +111,15 @@ Json ToJson(const RunReport& r) {
   json["peer_stopped"] = r.link.peer_stopped.empty() ? Json(nullptr) : Json(r.link.peer_stopped);
   for (const auto& [key, value] : r.details) json[key] = value;
   json["log_path"] = r.log ? Json(r.log->path) : Json(nullptr);
+  // Every row the log should hold is one of written, dropped (log_rows_dropped, a contract
+  // key) or lost to a write error (disk full, file-size limit): the three add up.
+  json["log_rows_lost"] = r.log ? r.log->rows_lost : 0;
   if (r.log && !r.log->error.empty()) json["log_error"] = r.log->error;
   json["timing_log_path"] = r.timing_log ? Json(r.timing_log->path) : Json(nullptr);
   if (r.timing_log) {
     json["timing_log_rows_written"] = r.timing_log->rows_written;
     json["timing_log_rows_dropped"] = r.timing_log->rows_dropped;
+    json["timing_log_rows_lost"] = r.timing_log->rows_lost;
     if (!r.timing_log->error.empty()) json["timing_log_error"] = r.timing_log->error;
   }
   json["final_state"] = statemachine::ToString(r.final_state);
@@ -175,6 +179,29 @@ void AppendRules(std::string& out, const RunReport& r) {
   }
 }
 
+// "run.csv: 4900 rows written, 0 dropped, 75062 lost (No space left on device)"; the lost
+// part only when the file refused rows.
+void AppendLog(std::string& out, const char* label, const LogFigures& log) {
+  Append(out, "%s %s: %llu rows written, %llu dropped", label, log.path.c_str(),
+         static_cast<ull>(log.rows_written), static_cast<ull>(log.rows_dropped));
+  if (log.rows_lost > 0 || !log.lost_reason.empty()) {
+    Append(out, ", %llu lost (%s)", static_cast<ull>(log.rows_lost),
+           log.lost_reason.empty() ? "write error" : log.lost_reason.c_str());
+  }
+  out += "\n";
+}
+
+// Why a log is incomplete and what is in it: "the log run.csv is incomplete: write 'run.csv':
+// No space left on device; it ends with its last whole row: 4900 rows written, 75062 lost".
+std::string IncompleteLogLine(const char* what, const LogFigures& log) {
+  std::string line = std::string(what) + " " + log.path + " is incomplete: " + log.error;
+  if (log.rows_lost > 0) {
+    line += "; it ends with its last whole row: " + std::to_string(log.rows_written) +
+            " rows written, " + std::to_string(log.rows_lost) + " lost";
+  }
+  return line;
+}
+
 std::string VerdictLine(const RunReport& r) {
   std::string line = std::string("verdict    ") + qos::ToString(r.verdict);
   if (r.verdict == qos::Verdict::kFlagged)
@@ -183,6 +210,14 @@ std::string VerdictLine(const RunReport& r) {
     line += r.outputs_safe
                 ? " (stopped at the first violation; outputs put in their safe state)"
                 : " (stopped at the first violation; the safe outputs could NOT be written)";
+  }
+  // The verdict judges timing only. A run that a fault ended did not do what was asked: say so
+  // on the verdict's own line, so a PASS is never read as "the run is good".
+  if (r.fault) {
+    line += std::string(" for the timing of the ") + std::to_string(r.cycles_run) +
+            " cycles run; the run did NOT finish: " +
+            (r.fault->kind == StopReason::kIoFault ? "I/O" : "model") + " fault at cycle " +
+            std::to_string(r.fault->cycle);
   }
   return line + "\n";
 }
@@ -210,15 +245,8 @@ std::string FormatSummary(const RunReport& r) {
            static_cast<ull>(l.io_errors), static_cast<ull>(l.pulse_limit_cycles),
            l.peer_name.c_str(), static_cast<ull>(l.peer_absent_cycles));
   }
-  if (r.log) {
-    Append(out, "log        %s: %llu rows written, %llu dropped\n", r.log->path.c_str(),
-           static_cast<ull>(r.log->rows_written), static_cast<ull>(r.log->rows_dropped));
-  }
-  if (r.timing_log) {
-    Append(out, "timing log %s: %llu rows written, %llu dropped\n", r.timing_log->path.c_str(),
-           static_cast<ull>(r.timing_log->rows_written),
-           static_cast<ull>(r.timing_log->rows_dropped));
-  }
+  if (r.log) AppendLog(out, "log       ", *r.log);
+  if (r.timing_log) AppendLog(out, "timing log", *r.timing_log);
   if (!l.peer_stopped.empty()) Append(out, "peer       %s\n", l.peer_stopped.c_str());
   if (r.fault) {
     Append(out, "fault      %s at cycle %llu: %s\n", statemachine::ToString(r.fault->kind),
@@ -234,6 +262,11 @@ std::vector<std::string> Problems(const RunReport& r) {
     lines.push_back(std::string(r.fault->kind == StopReason::kIoFault ? "I/O" : "model") +
                     " fault at cycle " + std::to_string(r.fault->cycle) + ": " + r.fault->reason);
   }
+  if (r.link.io_errors > 0) {
+    lines.push_back("warning: " + std::to_string(r.link.io_errors) +
+                    " frames on the link were corrupted or missed; the inputs were held over "
+                    "those cycles, so the results there rest on stale inputs");
+  }
   if (r.link.peer_absent_cycles > 0) {
     lines.push_back("warning: no " + r.link.peer_name + " was attached to " + r.io + " in " +
                     std::to_string(r.link.peer_absent_cycles) + " of " +
@@ -241,12 +274,9 @@ std::vector<std::string> Problems(const RunReport& r) {
                     " cycles; the inputs were idle then. Start the " + r.link.peer_name +
                     " process on the same wire before or during the run.");
   }
-  if (r.log && !r.log->error.empty()) {
-    lines.push_back("the log " + r.log->path + " is incomplete: " + r.log->error);
-  }
+  if (r.log && !r.log->error.empty()) lines.push_back(IncompleteLogLine("the log", *r.log));
   if (r.timing_log && !r.timing_log->error.empty()) {
-    lines.push_back("the timing log " + r.timing_log->path + " is incomplete: " +
-                    r.timing_log->error);
+    lines.push_back(IncompleteLogLine("the timing log", *r.timing_log));
   } else if (r.timing_log && r.timing_log->rows_dropped > 0) {
     lines.push_back("warning: the timing log " + r.timing_log->path + " lost " +
                     std::to_string(r.timing_log->rows_dropped) +

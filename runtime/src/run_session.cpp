@@ -427,6 +427,11 @@ MissLedger LedgerOf(const qos::QosMonitor& m) {
   return ledger;
 }
 
+LogFigures LogFiguresOf(const tracing::CsvLogger& log) {
+  return LogFigures{log.path(),  log.rows_written(), log.rows_dropped(),
+                    log.rows_lost(), log.error(),    log.error_reason()};
+}
+
 }  // namespace
 
 RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) const {
@@ -466,14 +471,8 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
     r.fault = wait_fault_;
   }
   r.outputs_safe = result.outputs_safe;
-  if (logger_) {
-    r.log = LogFigures{logger_->path(), logger_->rows_written(), logger_->rows_dropped(),
-                       logger_->error()};
-  }
-  if (timing_log_) {
-    r.timing_log = LogFigures{timing_log_->path(), timing_log_->rows_written(),
-                              timing_log_->rows_dropped(), timing_log_->error()};
-  }
+  if (logger_) r.log = LogFiguresOf(*logger_);
+  if (timing_log_) r.timing_log = LogFiguresOf(*timing_log_);
   r.wall_time_s = wall_time_s;
   if (result.rt) r.rt_setup = result.rt->record();
   return r;

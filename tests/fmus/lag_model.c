@@ -29,5 +29,10 @@ fmi2Status ModelDoStep(FmuInstance* instance, double h_s) {
   double* r = instance->r;
   const double target = r[kK] * r[kU];
   r[kY] = target + (r[kY] - target) * exp(-h_s / r[kTau]);
+#ifdef HILTWIN_FMU_NAN_AFTER_STEPS
+  /* A model that diverges: its output turns NaN and it still reports fmi2OK, as a broken
+   * model does; the twin must catch it (the fault matrix's "model producing NaN"). */
+  if (instance->steps >= HILTWIN_FMU_NAN_AFTER_STEPS) r[kY] = nan("");
+#endif
   return fmi2OK;
 }

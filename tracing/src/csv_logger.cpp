@@ -4,6 +4,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -16,12 +17,18 @@
 #include <system_error>
 #include <utility>
 
+#include "hiltwin/kernel_glue/output_file.h"
+
 namespace hiltwin::tracing {
 namespace {
 
 // Large enough that the writer makes one write() per few hundred rows, small enough to stay
 // out of the way of the loop's locked memory budget.
 constexpr std::size_t kFileBufferBytes = std::size_t{256} * 1024;
+// Room for the longest row: a cell is at most 24 characters (to_chars' shortest double; the
+// fixed-point shortcuts print fewer) plus its comma, rounded up to 32, and the newline. The
+// buffer is written out before a row might not fit.
+constexpr std::size_t kMaxLineBytes = (kMaxLogColumns + 1) * 32 + 2;
 // Keeps the preallocated queue below ~8 GiB even at the widest row; a larger request is a
 // typo, not a plan.
 constexpr std::size_t kMaxQueueCapacityRows = std::size_t{1} << 24;
@@ -106,6 +113,24 @@ std::int64_t SteadyNowNs() {
       .count();
 }
 
+/// write(2) until all of `data` is accepted or the kernel refuses more: the bytes accepted and
+/// the errno that stopped it (0 when all were). A write that accepts nothing without an error
+/// counts as EIO, so the loop always ends.
+std::pair<std::size_t, int> WriteAll(int fd, const char* data, std::size_t size) noexcept {
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else {
+      return {done, n < 0 ? errno : EIO};
+    }
+  }
+  return {done, 0};
+}
+
 /// Prints `units` · 10^-decimals (units < 10^18) with its trailing zeros and a bare decimal
 /// point removed, e.g. 4.99975, 12, -0.5, -0.
 char* FormatFixed(char* first, char* last, bool negative, std::uint64_t units, int decimals) noexcept {
@@ -167,26 +192,21 @@ CsvLogger::CsvLogger(CsvLoggerConfig config)
       // Value-initialised, so every page is touched now rather than in the loop.
       rows_(std::make_unique<double[]>(config_.queue_capacity_rows * row_stride_)),
       file_buffer_(std::make_unique<char[]>(kFileBufferBytes)) {
-  file_ = std::fopen(config_.path.c_str(), "we");
-  if (file_ == nullptr) {
-    const int err = errno;
-    throw std::runtime_error("CsvLogger: cannot open '" + config_.path + "' for writing: " +
-                             ErrnoText(err) + "; check that the directory exists and is writable");
-  }
-  std::setvbuf(file_, file_buffer_.get(), _IOFBF, kFileBufferBytes);
+  fd_ = kernel_glue::OpenOutputFile(config_.path, "the log file");
   std::string header;
   for (const std::string& line : config_.preamble) header.append("# ").append(line).append("\n");
   header += "time_s";
   for (const std::string& name : config_.columns) header.append(",").append(name);
   header += "\n";
-  if (std::fwrite(header.data(), 1, header.size(), file_) != header.size() ||
-      std::fflush(file_) != 0) {
-    const int err = errno;
-    std::fclose(file_);
-    file_ = nullptr;
-    throw std::runtime_error("CsvLogger: cannot write the header of '" + config_.path +
-                             "': " + ErrnoText(err));
+  const auto [accepted, err] = WriteAll(fd_, header.data(), header.size());
+  if (err != 0) {
+    (void)::ftruncate(fd_, 0);  // no torn header: an empty file is plainly unfinished
+    ::close(fd_);
+    fd_ = -1;
+    throw LogWriteError("CsvLogger: cannot write the header of '" + config_.path + "': " +
+                        ErrnoText(err) + "; free space or choose another folder");
   }
+  file_bytes_ = accepted;
   last_flush_ns_ = SteadyNowNs();
 }
 
@@ -253,7 +273,7 @@ void CsvLogger::Flush() {
   }
   lock.unlock();
   DrainAvailable();
-  FlushFile();
+  WriteBuffer();
 }
 
 void CsvLogger::Stop() {
@@ -270,10 +290,12 @@ void CsvLogger::Stop() {
   }
   // The writer drained after seeing the stop request; this catches a writer that never ran.
   DrainAvailable();
-  if (file_ != nullptr) {
-    FlushFile();
-    if (std::fclose(file_) != 0) RecordIoError("close", errno);
-    file_ = nullptr;
+  if (fd_ >= 0) {
+    WriteBuffer();
+    // A close error (a network file system's delayed write) comes too late to say which rows
+    // are missing: the log is reported incomplete, the counts are those of the writes.
+    if (::close(fd_) != 0) RecordIoError("close", errno);
+    fd_ = -1;
   }
 }
 
@@ -291,7 +313,7 @@ void CsvLogger::WriterMain() {
     const std::int64_t now_ns = SteadyNowNs();
     if (stop || flush_target != flush_completed_ ||
         now_ns - last_flush_ns_ >= config_.file_flush_period_ns) {
-      FlushFile();
+      WriteBuffer();
       last_flush_ns_ = now_ns;
     }
     lock.lock();
@@ -318,9 +340,16 @@ void CsvLogger::DrainAvailable() {
   std::size_t available = ring_.Available();
   while (available != 0) {
     for (; available != 0; --available) {
+      if (!write_failed_ && kFileBufferBytes - buffered_bytes_ < kMaxLineBytes) WriteBuffer();
+      if (write_failed_ || fd_ < 0) {
+        // The log has ended (see the header): the row is counted, not written.
+        ring_.Release(1);
+        lost_.store(lost_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+        continue;
+      }
       const double* row = rows_.get() + ring_.ReadSlot(0) * row_stride_;
-      char* const first = line_.data();
-      char* const last = first + line_.size();
+      char* const first = file_buffer_.get() + buffered_bytes_;
+      char* const last = first + kMaxLineBytes;
       char* out = FormatDouble(first, last, row[0]);
       for (std::size_t c = 1; c < row_stride_; ++c) {
         *out++ = ',';
@@ -329,26 +358,60 @@ void CsvLogger::DrainAvailable() {
       *out++ = '\n';
       // Release per row: frees space for the producer as early as possible (a plain store).
       ring_.Release(1);
-      const auto length = static_cast<std::size_t>(out - first);
-      if (file_ != nullptr && std::fwrite(first, 1, length, file_) == length) {
-        written_.store(written_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-      } else {
-        if (file_ != nullptr) RecordIoError("write", errno);
-        write_failed_.store(write_failed_.load(std::memory_order_relaxed) + 1,
-                            std::memory_order_relaxed);
-      }
+      buffered_bytes_ += static_cast<std::size_t>(out - first);
+      ++buffered_rows_;
     }
     available = ring_.Available();
   }
 }
 
-void CsvLogger::FlushFile() {
-  if (file_ != nullptr && std::fflush(file_) != 0) RecordIoError("flush", errno);
+void CsvLogger::WriteBuffer() {
+  if (buffered_bytes_ == 0 || write_failed_ || fd_ < 0) return;
+  const auto [accepted, err] = WriteAll(fd_, file_buffer_.get(), buffered_bytes_);
+  if (err != 0) {
+    EndAfterFailedWrite(accepted, err);
+    return;
+  }
+  written_.store(written_.load(std::memory_order_relaxed) + buffered_rows_,
+                 std::memory_order_relaxed);
+  file_bytes_ += accepted;
+  buffered_bytes_ = 0;
+  buffered_rows_ = 0;
 }
 
-void CsvLogger::RecordIoError(const char* what, int err) {
+void CsvLogger::EndAfterFailedWrite(std::size_t accepted_bytes, int err) {
+  // The rows whose newline reached the file are whole; a torn one after them is cut off, so
+  // the file ends with a whole row and every line parses.
+  const char* const data = file_buffer_.get();
+  std::uint64_t whole_rows = 0;
+  std::size_t whole_bytes = 0;
+  for (const char* p = data; p != data + accepted_bytes; ++p) {
+    if (*p == '\n') {
+      ++whole_rows;
+      whole_bytes = static_cast<std::size_t>(p - data) + 1;
+    }
+  }
+  std::string note;
+  if (whole_bytes != accepted_bytes &&
+      ::ftruncate(fd_, static_cast<off_t>(file_bytes_ + whole_bytes)) != 0) {
+    note = "; its last row is torn (cutting it off failed: " + ErrnoText(errno) + ")";
+  }
+  written_.store(written_.load(std::memory_order_relaxed) + whole_rows,
+                 std::memory_order_relaxed);
+  lost_.store(lost_.load(std::memory_order_relaxed) + (buffered_rows_ - whole_rows),
+              std::memory_order_relaxed);
+  file_bytes_ += whole_bytes;
+  buffered_bytes_ = 0;
+  buffered_rows_ = 0;
+  write_failed_ = true;
+  RecordIoError("write", err, note);
+}
+
+void CsvLogger::RecordIoError(const char* what, int err, const std::string& note) {
   std::lock_guard lock(mutex_);
-  if (error_.empty()) error_ = std::string(what) + " '" + config_.path + "': " + ErrnoText(err);
+  if (!error_.empty()) return;
+  error_reason_ = ErrnoText(err);
+  error_ = std::string(what) + " '" + config_.path + "': " + error_reason_ + note;
 }
 
 std::uint64_t CsvLogger::rows_written() const noexcept {
@@ -356,8 +419,17 @@ std::uint64_t CsvLogger::rows_written() const noexcept {
 }
 
 std::uint64_t CsvLogger::rows_dropped() const noexcept {
-  return producer_dropped_.load(std::memory_order_relaxed) +
-         write_failed_.load(std::memory_order_relaxed);
+  return producer_dropped_.load(std::memory_order_relaxed);
+}
+
+std::uint64_t CsvLogger::rows_lost() const noexcept {
+  return lost_.load(std::memory_order_relaxed);
+}
+
+std::uint64_t CsvLogger::rows_selected() const noexcept {
+  // The first offer is selected, then every `decimation`-th (TryLog's countdown starts at 0).
+  const std::uint64_t offered = offered_.load(std::memory_order_relaxed);
+  return (offered + config_.decimation - 1) / config_.decimation;
 }
 
 std::uint64_t CsvLogger::rows_offered() const noexcept {
@@ -367,6 +439,11 @@ std::uint64_t CsvLogger::rows_offered() const noexcept {
 std::string CsvLogger::error() const {
   std::lock_guard lock(mutex_);
   return error_;
+}
+
+std::string CsvLogger::error_reason() const {
+  std::lock_guard lock(mutex_);
+  return error_reason_;
 }
 
 int CsvLogger::writer_sched_policy() const noexcept {

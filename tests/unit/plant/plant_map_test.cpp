@@ -127,6 +127,17 @@ TEST(PlantMap, MistakesAreRefusedWithTheLineAndAFix) {
   EXPECT_THAT(ParseError("[inputs]\nload = \"high\"\n"), HasSubstr("finite number"));
 }
 
+// Found by fuzz/toml_config (fuzz/corpus/toml_config/regression_float_channel.toml): a float
+// channel far outside int64_t reached toml++'s float-to-integer cast, undefined behaviour.
+// A channel is an integer; a float one, big or not, is refused with the line.
+TEST(PlantMap, AFloatChannelIsRefusedAsNotAnInteger) {
+  for (const char* channel : {"3.3333333333333333333333333e75", "1e300", "-1e300", "2.0", "nan"}) {
+    EXPECT_THAT(ParseError(std::string("[[pwm]]\nchannel = ") + channel + "\ninput = \"u\"\n"),
+                AllOf(HasSubstr("map.toml:2"), HasSubstr("channel must be an integer 1..4")))
+        << channel;
+  }
+}
+
 TEST(PlantMap, AMissingFileSaysWhichAndWhy) {
   try {
     static_cast<void>(LoadPlantMap("/nonexistent/map.toml"));

@@ -41,7 +41,8 @@ TEST(ExitCodeFor, FaultsAndAnIncompleteLogOutrankTheVerdict) {
   model.stop_reason = StopReason::kModelFault;
   EXPECT_EQ(ExitCodeFor(model), ExitCode::kInternal);
   RunReport log = Finished(qos::Verdict::kPass);
-  log.log = LogFigures{"run.csv", 10, 0, "write failed: No space left on device"};
+  log.log = LogFigures{"run.csv", 10, 0, 5, "write 'run.csv': No space left on device",
+                       "No space left on device"};
   EXPECT_EQ(ExitCodeFor(log), ExitCode::kIo);
   log.log->error.clear();
   EXPECT_EQ(ExitCodeFor(log), ExitCode::kPass);
@@ -95,6 +96,29 @@ TEST(ToJson, KeepsTheContractKeysFirstAndInOrder) {
   EXPECT_TRUE(json["rt_setup"].is_null());  // virtual clock: no RT set-up was made
 }
 
+TEST(FormatSummary, AFaultedRunsVerdictSaysItJudgesOnlyTheTimingOfAnUnfinishedRun) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  EXPECT_NE(FormatSummary(r).find("verdict    PASS\n"), std::string::npos);  // a full run: plain
+  r.stop_reason = StopReason::kModelFault;
+  r.cycles_run = 2001;
+  r.fault = RunFault{StopReason::kModelFault, 2000, "the plant's output became non-finite"};
+  EXPECT_NE(FormatSummary(r).find("verdict    PASS for the timing of the 2001 cycles run; the "
+                                  "run did NOT finish: model fault at cycle 2000\n"),
+            std::string::npos)
+      << FormatSummary(r);
+  r.fault->kind = StopReason::kIoFault;
+  EXPECT_NE(FormatSummary(r).find("did NOT finish: I/O fault at cycle 2000"), std::string::npos);
+}
+
+TEST(Problems, LinkErrorsAreAWarningThatTheInputsWereHeld) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  r.link.io_errors = 3;
+  const auto lines = Problems(r);
+  ASSERT_EQ(lines.size(), 1U);
+  EXPECT_EQ(lines[0], "warning: 3 frames on the link were corrupted or missed; the inputs were "
+                      "held over those cycles, so the results there rest on stale inputs");
+}
+
 TEST(Problems, NameTheFaultTheAbsentPeerAndTheIncompleteLog) {
   RunReport r = Finished(qos::Verdict::kPass);
   EXPECT_TRUE(Problems(r).empty());
@@ -102,13 +126,49 @@ TEST(Problems, NameTheFaultTheAbsentPeerAndTheIncompleteLog) {
   r.link.peer_name = "controller";
   r.link.peer_absent_cycles = 400;
   r.io = "wire:lab";
-  r.log = LogFigures{"run.csv", 1, 0, "disk full"};
+  r.log = LogFigures{"run.csv", 1, 0, 0, "disk full", ""};
   const auto lines = Problems(r);
   ASSERT_EQ(lines.size(), 3U);
   EXPECT_EQ(lines[0], "I/O fault at cycle 12: wire peer lost");
   EXPECT_NE(lines[1].find("no controller was attached to wire:lab in 400 of 40000 cycles"),
             std::string::npos);
   EXPECT_EQ(lines[2], "the log run.csv is incomplete: disk full");
+}
+
+TEST(Problems, ALogEndedByAFullDiskSaysWhatIsInItAndWhatWasLost) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  r.log = LogFigures{"run.csv", 4'900, 3, 75'062, "write 'run.csv': No space left on device",
+                     "No space left on device"};
+  const std::string summary = FormatSummary(r);
+  EXPECT_NE(summary.find("log        run.csv: 4900 rows written, 3 dropped, 75062 lost (No space "
+                         "left on device)\n"),
+            std::string::npos)
+      << summary;
+  const auto lines = Problems(r);
+  ASSERT_EQ(lines.size(), 1U);
+  EXPECT_EQ(lines[0],
+            "the log run.csv is incomplete: write 'run.csv': No space left on device; it ends "
+            "with its last whole row: 4900 rows written, 75062 lost");
+  const auto json = ToJson(r);
+  EXPECT_EQ(json["log_rows_written"], 4'900);
+  EXPECT_EQ(json["log_rows_dropped"], 3);
+  EXPECT_EQ(json["log_rows_lost"], 75'062);
+  EXPECT_EQ(json["log_error"], "write 'run.csv': No space left on device");
+  EXPECT_EQ(ExitCodeFor(r), ExitCode::kIo);
+}
+
+TEST(FormatSummary, ACompleteLogNamesNoLoss) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  r.log = LogFigures{"run.csv", 80'000, 0, 0, "", ""};
+  r.timing_log = LogFigures{"t.csv", 80'000, 2, 0, "", ""};
+  const std::string summary = FormatSummary(r);
+  EXPECT_NE(summary.find("log        run.csv: 80000 rows written, 0 dropped\n"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("timing log t.csv: 80000 rows written, 2 dropped\n"), std::string::npos)
+      << summary;
+  EXPECT_EQ(summary.find("lost"), std::string::npos) << summary;
+  EXPECT_EQ(ToJson(r)["log_rows_lost"], 0);
+  EXPECT_EQ(ToJson(r)["timing_log_rows_lost"], 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "hiltwin/app_relbot/session_options.h"
 #include "hiltwin/runtime/run_report.h"
@@ -20,6 +21,7 @@ struct TwinRunOptions {
   std::string plant_map_path;     ///< --plant-map ("" = the plant's own map)
   std::string config_path;
   std::string integrator;  ///< "" = the plant's default (the RELbot's is rk4)
+  std::vector<std::string> inject_link_faults;  ///< --inject-link-fault SPECs (mock and wire)
 };
 
 /// Adds every `run` flag (shared and own) to `app`.

@@ -19,6 +19,9 @@ enum class BusResult : std::uint8_t {
   kPeerLost,    ///< wire: the other process stopped updating its heartbeat
   kPeerAbsent,  ///< wire: no peer has attached yet (the local board still answered)
   kPeerStopped, ///< wire: the peer announced the end of its run (the local board still answered)
+  /// wire: the shared segment held a value no hiltwin process writes (another process writes
+  /// into it); nothing more is read from it. An I/O fault, but the local board still answered.
+  kWireCorrupted,
 };
 [[nodiscard]] const char* ToString(BusResult result) noexcept;
 

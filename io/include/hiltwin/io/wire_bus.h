@@ -15,6 +15,14 @@
 /// then reported as kPeerStopped, so the other side can stop cleanly rather than as a fault.
 /// While a side waits to start it keeps its heartbeat fresh with PeerLink::Poll. A peer that
 /// crashed is forgotten when a new process attaches.
+///
+/// Trust: the segment is created owner-only (0600) and refused when it exists with another
+/// mode or owner, but any process of the same user can still write into it. So everything read
+/// from it is checked before it is acted on (header, both sides' identities, PWM words, pin
+/// bits, the ring's newest index and every encoder period's fields); an impossible value latches
+/// BusResult::kWireCorrupted with a message naming the field, after which this side reads
+/// nothing more from the wire (idle PWM, held encoder lines) and the run stops on an I/O fault
+/// with safe outputs (this side's own board still answers). docs/spi-protocol.md, wire:NAME.
 
 #include <cstdint>
 #include <memory>
@@ -29,17 +37,22 @@
 namespace hiltwin::io {
 
 struct WireSegment;
+class WireGuard;
 
 /// A peer counts as lost when its heartbeat is older than max(this, 20 peer steps): long enough
 /// that a SCHED_OTHER process on a loaded machine is not declared dead by a scheduling delay,
 /// short enough that a crash ends the other side well within a second.
 constexpr std::int64_t kWireMinHeartbeatTimeoutNs = 250'000'000;
 
+/// Owner-only: the mode the segment is created with and must have when it exists.
+constexpr unsigned kWireSegmentMode = 0600;
+
 class WireBus final : public SpiBus, public PeerLink {
  public:
   /// Attaches to (or creates) the segment of `name` as the side that owns a board of `side`
   /// (icoboard = ECS, icoboard_inverse = twin). Throws std::invalid_argument for a bad name
-  /// and std::runtime_error when the segment cannot be used or that side is already attached
+  /// and std::runtime_error when the segment cannot be used (not a regular file owned by this
+  /// user with mode 0600, another layout, impossible contents) or that side is already attached
   /// by a live process. `board_image` (fault injection) is the image this side's emulated
   /// board carries, the side's own image when empty: the wrong one fails INIT's identity check.
   WireBus(const std::string& name, Image side, std::optional<Image> board_image = {});
@@ -64,6 +77,8 @@ class WireBus final : public SpiBus, public PeerLink {
   /// when it is not, or no longer, in the ring.
   [[nodiscard]] bool ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept;
 
+  /// "/dev/shm/hiltwin-wire-NAME" (messages, tests).
+  [[nodiscard]] static std::string SegmentPath(const std::string& name);
   /// "/hiltwin-wire-NAME". Throws std::invalid_argument unless NAME is 1–64 of [A-Za-z0-9_.-].
   static std::string SegmentName(const std::string& name);
   /// Removes the segment (tests, clean-up after crashes). No error when absent.
@@ -76,6 +91,13 @@ class WireBus final : public SpiBus, public PeerLink {
   /// the flags of a peer that crashed without detaching.
   void Attach();
   void Publish(std::int64_t now_ns) noexcept;
+  /// Checks the header and both sides' identity fields at `now_ns`; false (and the guard
+  /// latched) when the segment holds what no hiltwin process writes.
+  bool CheckSegment(std::int64_t now_ns) noexcept;
+  /// The peer's pid may change only with a new session (after a short settling time).
+  bool CheckPeerIdentity(std::int64_t now_ns) noexcept;
+  /// This side's result: the latched corruption, else the peer's status.
+  [[nodiscard]] BusStatus Status() const noexcept;
   void Beat(std::int64_t now_ns) noexcept;
   /// Reads the digital inputs off the wire into the board, runs `transfers` (callable) inside
   /// the twin's sampling window, publishes and returns the peer's status.
@@ -88,6 +110,8 @@ class WireBus final : public SpiBus, public PeerLink {
   kernel_glue::MonotonicClock clock_;
   EmulatedFpga board_;
   WireSegment* segment_ = nullptr;
+  std::int32_t pid_ = 0;
+  std::unique_ptr<WireGuard> guard_;
   std::unique_ptr<PwmWire> pwm_wire_;
   std::unique_ptr<EncoderWire> encoder_wire_;
 };

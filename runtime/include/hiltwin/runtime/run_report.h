@@ -57,12 +57,15 @@ struct RunFault {
   std::string reason;
 };
 
-/// The CSV log's accounting.
+/// The CSV log's accounting (tracing::CsvLogger): each row the log should hold is counted
+/// once, as written, dropped or lost.
 struct LogFigures {
   std::string path;
-  std::uint64_t rows_written = 0;
-  std::uint64_t rows_dropped = 0;
-  std::string error;  ///< empty while the log is complete
+  std::uint64_t rows_written = 0;  ///< in the file (the kernel took their bytes)
+  std::uint64_t rows_dropped = 0;  ///< never reached the writer: its queue was full
+  std::uint64_t rows_lost = 0;     ///< the file did not take them (disk full, size limit, ...)
+  std::string error;               ///< empty while the log is complete
+  std::string lost_reason;         ///< the errno text alone, e.g. "No space left on device"
 };
 
 /// Everything a run's outputs say.

@@ -1,0 +1,69 @@
+#pragma once
+/// The wire backend's shared segment (/dev/shm/hiltwin-wire-NAME), as both processes map it.
+/// Only wire_bus.cpp reads and writes it in a run; it is public so that tests (and the vandal
+/// process of the hostile-memory tests) can write exactly the field they mean to damage.
+/// Zero-filled memory is a valid initial state of every field.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "hiltwin/io/encoder_lines.h"
+#include "hiltwin/io/seqlock.h"
+
+namespace hiltwin::io {
+
+namespace wire {
+constexpr std::uint64_t kMagic = 0x6869'6C74'7769'7265ULL;  // "hiltwire"
+// 2: encoder periods in a ring; 3: stop causes; 4: seqlock slots of 64-bit words (no fences)
+constexpr std::uint32_t kLayoutVersion = 4;
+constexpr std::uint32_t kFresh = 0;
+constexpr std::uint32_t kInitialising = 1;
+constexpr std::uint32_t kReady = 2;
+/// twin_sampling_ns when the twin is not inside a transfer.
+constexpr std::int64_t kNotSampling = std::numeric_limits<std::int64_t>::max();
+/// Words of one encoder period: start_ns, subticks << 32 | divider, start_counts (4 × 16),
+/// pulses (4 × 16), directions (4 × 8).
+constexpr std::size_t kPeriodWords = 5;
+}  // namespace wire
+
+/// One process's presence on the wire.
+struct WireSide {
+  std::atomic<std::uint64_t> heartbeat;
+  std::atomic<std::int64_t> last_beat_ns;
+  std::atomic<std::int64_t> step_ns;
+  std::atomic<std::int32_t> pid;
+  std::atomic<std::uint32_t> attached;
+  std::atomic<std::uint32_t> sessions;
+  std::atomic<std::uint32_t> stop_cause;  ///< a StopCause; kNone while running
+};
+
+/// One encoder period in the ring: a single-writer seqlock whose tag is the period's index.
+using WirePeriod = SeqlockSlot<wire::kPeriodWords>;
+
+/// The shared segment. Zero-filled memory is a valid initial state of every field.
+struct WireSegment {
+  std::atomic<std::uint32_t> init_state;
+  std::atomic<std::uint32_t> attach_count;
+  std::atomic<std::uint64_t> magic;
+  std::atomic<std::uint32_t> version;
+  std::atomic<std::uint32_t> size;
+  WireSide ecs;
+  WireSide twin;
+  /// ECS -> twin: four packed PWM words (direction, pin, magnitude), 16 bits each.
+  std::atomic<std::uint64_t> pwm_words;
+  std::atomic<std::uint32_t> twin_pins;  ///< bit c = digital output c of the twin
+  /// Twin -> ECS encoder lines: the twin's emulator periods, newest index last published.
+  std::atomic<std::uint64_t> encoder_newest;
+  /// The twin's clock when it began the transfer in progress (kNotSampling outside one): a
+  /// period it is about to publish starts no earlier, so the ECS replays edges only up to here.
+  std::atomic<std::int64_t> twin_sampling_ns;
+  WirePeriod encoder_periods[kEncoderLineHistory];
+};
+static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&
+                  std::atomic<std::int64_t>::is_always_lock_free &&
+                  std::atomic<std::uint32_t>::is_always_lock_free,
+              "the wire needs address-free (lock-free) atomics to work across processes");
+
+}  // namespace hiltwin::io
