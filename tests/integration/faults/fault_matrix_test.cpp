@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/wire_scratch.h"
 
 namespace {
 
@@ -93,21 +94,13 @@ bool AnyRuleViolated(const Json& report) {
 
 class FaultMatrix : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    wire_ = "fm-" + std::to_string(getpid()) + "-" + test.substr(0, 24);
-    dir_ = fs::temp_directory_path() / ("hiltwin_faults_" + std::to_string(getpid()) + "_" + test);
-    fs::create_directories(dir_);
-  }
   void TearDown() override {
-    EXPECT_FALSE(fs::exists(SegmentPath())) << "shared memory left behind: " << SegmentPath();
-    fs::remove(SegmentPath());
-    fs::remove_all(dir_);
+    EXPECT_FALSE(fs::exists(scratch_.SegmentPath())) << "shared memory left behind: "
+                                                     << scratch_.SegmentPath();
   }
 
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string Wire() const { return "wire:" + wire_; }
-  std::string SegmentPath() const { return "/dev/shm/hiltwin-wire-" + wire_; }
+  std::string Path(const std::string& name) const { return scratch_.Path(name); }
+  std::string Wire() const { return scratch_.Wire(); }
 
   /// `hiltwin run` with a log and a report in this test's folder, plus `extra`.
   std::vector<std::string> RunArgs(const std::string& name, std::vector<std::string> extra) const {
@@ -151,8 +144,7 @@ class FaultMatrix : public ::testing::Test {
     return 0;
   }
 
-  std::string wire_;
-  fs::path dir_;
+  hiltwin::test::WireScratch scratch_{"fm"};
 };
 
 // --- Overruns (virtual clock: exact) -----------------------------------------------------------

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/wire_scratch.h"
 
 namespace {
 
@@ -27,21 +28,13 @@ using Clock = std::chrono::steady_clock;
 
 class HilCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    wire_ = "hiltest-" + std::to_string(getpid()) + "-" + test.substr(0, 24);
-    dir_ = fs::temp_directory_path() / ("hiltwin_hil_" + std::to_string(getpid()) + "_" + test);
-    fs::create_directories(dir_);
-  }
   void TearDown() override {
-    EXPECT_FALSE(fs::exists(SegmentPath())) << "shared memory left behind: " << SegmentPath();
-    fs::remove(SegmentPath());
-    fs::remove_all(dir_);
+    EXPECT_FALSE(fs::exists(scratch_.SegmentPath())) << "shared memory left behind: "
+                                                     << scratch_.SegmentPath();
   }
 
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string Wire() const { return "wire:" + wire_; }
-  std::string SegmentPath() const { return "/dev/shm/hiltwin-wire-" + wire_; }
+  std::string Path(const std::string& name) const { return scratch_.Path(name); }
+  std::string Wire() const { return scratch_.Wire(); }
 
   static hiltwin::test::RunResult Hiltwin(std::vector<std::string> args) {
     args.insert(args.begin(), HILTWIN_BINARY);
@@ -91,8 +84,7 @@ class HilCli : public ::testing::Test {
     return {status.value_or(hiltwin::kernel_glue::ExitStatus{}), after_s};
   }
 
-  std::string wire_;
-  fs::path dir_;
+  hiltwin::test::WireScratch scratch_{"hiltest"};
   std::optional<hiltwin::kernel_glue::Process> twin_;
   std::optional<hiltwin::kernel_glue::Process> ecs_;
 };
@@ -100,7 +92,7 @@ class HilCli : public ::testing::Test {
 // Thesis §7.2 and appendix E: the 2.5 m setpoint; each wheel's error stays below 3 mm and the
 // run ends without steady-state error.
 TEST_F(HilCli, ClosedLoopTracksTheThesisSetpointWithinThreeMillimetres) {
-  const auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--report", Path("hil.json"),
+  const auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--report", Path("hil.json"),
                           "--log-dir", Path("logs")});
   ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
   const auto hil = ReadJson(Path("hil.json"));
@@ -142,7 +134,7 @@ TEST_F(HilCli, ClosedLoopTracksTheThesisSetpointWithinThreeMillimetres) {
 // the logged duty replayed into the reference (virtual time, same model) must match the
 // twin's positions, with the twin's delay (below 2 ms) estimated and compensated.
 TEST_F(HilCli, OpenLoopTwinMatchesTheReferenceReplayOfTheLoggedDuty) {
-  auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--mode", "openloop", "--duration",
+  auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--mode", "openloop", "--duration",
                     "12", "--log-dir", Path("logs")});
   ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
   r = Hiltwin({"run", "--clock", "virtual", "--io", "mock", "--input", Path("logs/ecs.csv"),
@@ -215,7 +207,7 @@ TEST_F(HilCli, EitherSideMayStartFirst) {
 }
 
 TEST_F(HilCli, AQosAbortOnTheTwinEndsThePairWithExitFour) {
-  const auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--duration", "4",
+  const auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--duration", "4",
                           "--twin-arg=--on-violation", "--twin-arg=abort",
                           "--twin-arg=--inject-overrun",
                           "--twin-arg=at=4000,count=20,extra-us=600", "--report",
@@ -228,7 +220,7 @@ TEST_F(HilCli, AQosAbortOnTheTwinEndsThePairWithExitFour) {
 }
 
 TEST_F(HilCli, MismatchedImagesStopAtInitWithTheThesisMessage) {
-  const auto r = Hiltwin({"hil", "--wire", wire_, "--no-progress", "--duration", "2",
+  const auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--duration", "2",
                           "--ecs-arg=--board-image", "--ecs-arg=icoboard_inverse", "--report",
                           Path("hil.json")});
   EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
