@@ -34,8 +34,10 @@ class WireVandalCli : public ::testing::Test {
     text << in.rdbuf();
     return text.str();
   }
+  // Long enough for two sanitizer-built processes on a busy 2-core machine to meet (the
+  // sides' own wait for each other is 30 s).
   static bool WaitForText(const std::string& path, const std::string& text) {
-    const auto end = Clock::now() + std::chrono::seconds(10);
+    const auto end = Clock::now() + std::chrono::seconds(30);
     while (Clock::now() < end) {
       if (ReadFile(path).find(text) != std::string::npos) return true;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -54,7 +56,10 @@ class WireVandalCli : public ::testing::Test {
       (std::string(side) == "twin" ? twin_ : ecs_).emplace(hiltwin::test::Spawn(args, Path(side)));
     }
     for (const char* side : {"twin", "ecs"}) {
-      ASSERT_TRUE(WaitForText(Path(side) + ".err", "is up; starting")) << ReadFile(Path(side) + ".err");
+      ASSERT_TRUE(WaitForText(Path(side) + ".err", "is up; starting"))
+          << side << " never started; twin said:\n"
+          << ReadFile(Path("twin.err")) << "ecs said:\n"
+          << ReadFile(Path("ecs.err"));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
   }
@@ -140,7 +145,7 @@ class WireVandalCli : public ::testing::Test {
 };
 
 TEST_F(WireVandalCli, RandomBytesStopBothSidesOnAnIoFault) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("random");
   const auto twin = End(*twin_);
   const auto ecs = End(*ecs_);
@@ -149,7 +154,7 @@ TEST_F(WireVandalCli, RandomBytesStopBothSidesOnAnIoFault) {
 }
 
 TEST_F(WireVandalCli, AChangedMagicStopsBothSides) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("magic");
   const auto twin = End(*twin_);
   const auto ecs = End(*ecs_);
@@ -158,7 +163,7 @@ TEST_F(WireVandalCli, AChangedMagicStopsBothSides) {
 }
 
 TEST_F(WireVandalCli, AnAbsurdRingIndexFaultsTheSideThatReadsIt) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("index");
   const auto twin = End(*twin_);
   const auto ecs = End(*ecs_);
@@ -170,7 +175,7 @@ TEST_F(WireVandalCli, AnAbsurdRingIndexFaultsTheSideThatReadsIt) {
 }
 
 TEST_F(WireVandalCli, AnImpossibleEncoderPeriodStopsTheController) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("period");
   const auto ecs = End(*ecs_);
   const auto twin = End(*twin_);
@@ -180,7 +185,7 @@ TEST_F(WireVandalCli, AnImpossibleEncoderPeriodStopsTheController) {
 }
 
 TEST_F(WireVandalCli, APwmWordOverFullScaleStopsTheTwin) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("pwm");
   const auto twin = End(*twin_);
   const auto ecs = End(*ecs_);
@@ -190,7 +195,7 @@ TEST_F(WireVandalCli, APwmWordOverFullScaleStopsTheTwin) {
 }
 
 TEST_F(WireVandalCli, AForgedPidStopsTheSideWhoseEntryItIs) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("pid");
   const auto twin = End(*twin_);
   const auto ecs = End(*ecs_);
@@ -206,7 +211,7 @@ TEST_F(WireVandalCli, AForgedPidStopsTheSideWhoseEntryItIs) {
 }
 
 TEST_F(WireVandalCli, ASeqlockTornForGoodIsALossNotAFault) {
-  StartPair();
+  ASSERT_NO_FATAL_FAILURE(StartPair());  // no vandal on a pair that never met
   Vandalise("torn");
   // Both run to their end: nothing was acted on, nothing hung.
   const auto twin = End(*twin_);
