@@ -31,6 +31,25 @@ Words WordsOf(std::uint64_t tag) {
   return {tag, ~tag, tag * 0x9E37'79B9'7F4A'7C15ULL, tag ^ 0x5555'5555'5555'5555ULL, tag + 7};
 }
 
+/// Keeps a producer and a consumer thread overlapping on a busy machine: every kPace items the
+/// producer waits until the consumer has looked twice more, so a consumer that was not
+/// scheduled yet cannot find the producer done before it ever ran (the second look began while
+/// the producer waited: it reads a quiet slot). In between the two race freely. Relaxed: this
+/// adds no synchronisation TSan would count, the seqlock's own stays the only one.
+class Overlap {
+ public:
+  static constexpr std::uint64_t kPace = 1000;
+  void ConsumerLooked() noexcept { looks_.fetch_add(1, std::memory_order_relaxed); }
+  void ProducerPaces(std::uint64_t item) noexcept {
+    if (item % kPace != 1) return;
+    const std::uint64_t seen = looks_.load(std::memory_order_relaxed);
+    while (looks_.load(std::memory_order_relaxed) < seen + 2) std::this_thread::yield();
+  }
+
+ private:
+  std::atomic<std::uint64_t> looks_{0};
+};
+
 #ifdef HILTWIN_UNDER_SANITIZER
 constexpr std::uint64_t kTags = 100'000;  // TSan runs ~10x slower
 #else
@@ -46,8 +65,10 @@ TEST(Seqlock, ConcurrentReadsAreOneWritesWordsOrRefused) {
   // Written plainly before each tag is published: an accepted read of tag t must see side[t]
   // (the read synchronises with the write), which TSan checks.
   std::vector<std::uint64_t> side(kTags + 1, 0);
+  Overlap overlap;
   std::thread writer([&] {
     for (std::uint64_t tag = 1; tag <= kTags; ++tag) {
+      overlap.ProducerPaces(tag);
       side[tag] = tag * 3;
       SeqlockWrite(slots[tag % 2], tag, WordsOf(tag));
       newest.store(tag, std::memory_order_relaxed);
@@ -74,6 +95,7 @@ TEST(Seqlock, ConcurrentReadsAreOneWritesWordsOrRefused) {
       if (out != WordsOf(tag)) ++inconsistent;
       if (side[tag] != tag * 3) ++side_wrong;
     }
+    overlap.ConsumerLooked();
   }
   writer.join();
   std::printf("seqlock race: %llu reads accepted, %llu refused (overwritten before or while read)\n",
@@ -122,9 +144,11 @@ TEST(WireRace, TheTwinPublishesWhileTheEcsReadsOnAnotherThread) {
 
   std::atomic<bool> done{false};
   std::uint64_t twin_faults = 0;
+  Overlap overlap;
   std::thread twin_thread([&] {
     TwinInputs in;
     for (std::uint64_t n = 1; n <= kTwinExchanges; ++n) {
+      overlap.ProducerPaces(n);
       std::array<std::int32_t, kChannels> out{};
       for (std::size_t c = 0; c < kChannels; ++c) out[c] = Target(n, c);
       if (!twin.Exchange(out, in).ok()) ++twin_faults;
@@ -150,6 +174,7 @@ TEST(WireRace, TheTwinPublishesWhileTheEcsReadsOnAnotherThread) {
       ++periods_read;
       if (period.index != index || previous.start_ns() > period.start_ns()) ++out_of_order;
     }
+    overlap.ConsumerLooked();
   }
   twin_thread.join();
   // The twin is done: once its last period has run out, the ECS counts where it left them.
