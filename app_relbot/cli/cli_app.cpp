@@ -5,6 +5,8 @@
 
 #include <algorithm>
 
+#include "version.h"
+
 namespace hiltwin::app {
 
 std::vector<CommandEntry>& CommandRegistry() {
@@ -28,7 +30,7 @@ std::unique_ptr<CliApp> BuildCliApp() {
   CLI::App& app = cli->app;
   app.require_subcommand(1);
   app.fallthrough();  // --log-level may also follow the command
-  app.set_version_flag("--version", "hiltwin 0.1.0");
+  app.set_version_flag("--version", kVersionText);
   app.footer("Run 'hiltwin <command> --help' for the flags of one command.");
 
   std::string& log_level = cli->log_level;
