@@ -47,70 +47,95 @@ endmacro()
 # hiltwin_add_module(<name> [DEPS <targets...>] [PRIVATE_DEPS <targets...>])
 # One static library per module folder: sources src/*.cpp, public headers
 # include/hiltwin/<name>/, alias hiltwin::<name>.
+# Installable (cmake/HiltwinInstall.cmake): exported under the same name hiltwin::<name>, the
+# headers come from the source tree only while building (the install rules add
+# <prefix>/include), and users are asked for C++20, which the headers need (std::span).
 function(hiltwin_add_module name)
   cmake_parse_arguments(ARG "" "" "DEPS;PRIVATE_DEPS" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp"
        "${CMAKE_CURRENT_SOURCE_DIR}/src/*.c")
+  set(target hiltwin_${name})
+  set(public_include "$<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>")
   if(sources)
-    add_library(hiltwin_${name} STATIC ${sources})
-    target_include_directories(hiltwin_${name} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/include"
+    add_library(${target} STATIC ${sources})
+    target_include_directories(${target} PUBLIC "${public_include}"
                                PRIVATE "${CMAKE_CURRENT_SOURCE_DIR}/src")
-    target_link_libraries(hiltwin_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
-    hiltwin_target_warnings(hiltwin_${name})
+    target_link_libraries(${target} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+    target_compile_features(${target} PUBLIC cxx_std_20)
+    hiltwin_target_warnings(${target})
   else()
-    add_library(hiltwin_${name} INTERFACE)
-    target_include_directories(hiltwin_${name} INTERFACE "${CMAKE_CURRENT_SOURCE_DIR}/include")
-    target_link_libraries(hiltwin_${name} INTERFACE ${ARG_DEPS})
+    add_library(${target} INTERFACE)
+    target_include_directories(${target} INTERFACE "${public_include}")
+    target_link_libraries(${target} INTERFACE ${ARG_DEPS})
+    target_compile_features(${target} INTERFACE cxx_std_20)
   endif()
-  add_library(hiltwin::${name} ALIAS hiltwin_${name})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
+  add_library(hiltwin::${name} ALIAS ${target})
 endfunction()
 
 # hiltwin_add_gtest(<name> SOURCES <files...> LIBS <targets...> LABELS <labels...>
-#                   [RT_TESTS <regex>] [TIMEOUT s] [RESOURCE_LOCK name])
+#                   [RT_TESTS <regex>] [TIMEOUT s] [RESOURCE_LOCK <names...>])
 # A GoogleTest executable whose tests CTest discovers one by one, with labels
 # (unit, integration, rt, soak) so suites can be chosen with `ctest -L`.
-# RESOURCE_LOCK: a name CTest never runs two holders of at once (`lttng`: the one session
-# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer).
+# RESOURCE_LOCK: names CTest never runs two holders of at once (`lttng`: the one session
+# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer). Each
+# name is a label too, so a stage that has no such thing leaves those tests out by name
+# (`-LE lttng`: the arm64 suite under qemu, whose emulated processes cannot reach the host's
+# session daemon).
 # RT_TESTS: the tests (Suite.Name) that depend on the wall clock also get the label `rt`, so
-# `ctest -L rt` selects exactly the tests a noisy machine can disturb. gtest_discover_tests
-# flattens a list given to PROPERTIES, so the second label is set by a CTest include file that
-# runs after discovery, over the discovered list.
+# `ctest -L rt` selects exactly the tests a noisy machine can disturb.
+# gtest_discover_tests flattens a list given to PROPERTIES, so the labels and locks are set by
+# a CTest include file that runs after discovery, over the discovered list.
+# Cross-compiled (arm64), discovery runs the test binary at test time, under the emulator,
+# not at build time: the build then needs no emulator at all.
 function(hiltwin_add_gtest name)
-  cmake_parse_arguments(ARG "" "TIMEOUT;RT_TESTS;RESOURCE_LOCK" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;RT_TESTS" "SOURCES;LIBS;LABELS;RESOURCE_LOCK" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
+  endif()
+  if(CMAKE_CROSSCOMPILING_EMULATOR)
+    # Under qemu every instruction is translated: the same test takes several times as long.
+    math(EXPR ARG_TIMEOUT "${ARG_TIMEOUT} * ${HILTWIN_EMULATOR_TIME_FACTOR}")
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
   hiltwin_target_warnings(${name})
   set(extra_properties)
-  if(ARG_RESOURCE_LOCK)
-    set(extra_properties RESOURCE_LOCK ${ARG_RESOURCE_LOCK})
-  endif()
   if(HILTWIN_TSAN)
     # A report fails the test at once (and in every hiltwin process it starts, which inherit
     # the variable); tests/tsan.supp names the uninstrumented libraries whose reports are noise.
     list(APPEND extra_properties ENVIRONMENT
          "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/tsan.supp:halt_on_error=1:second_deadlock_stack=1")
   endif()
+  set(discovery_mode POST_BUILD)
+  if(CMAKE_CROSSCOMPILING)
+    set(discovery_mode PRE_TEST)
+  endif()
   gtest_discover_tests(${name}
-    DISCOVERY_TIMEOUT 60
+    DISCOVERY_TIMEOUT 120
+    DISCOVERY_MODE ${discovery_mode}
     TEST_LIST ${name}_TESTS
     # A test that skips (GTEST_SKIP: no daemon, no privilege) shows as skipped, not passed.
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT} ${extra_properties}
+    PROPERTIES TIMEOUT ${ARG_TIMEOUT} ${extra_properties}
                SKIP_REGULAR_EXPRESSION "\\[  SKIPPED \\]"
     EXTRA_ARGS --gtest_color=no)
+  set(labels ${ARG_LABELS} ${ARG_RESOURCE_LOCK})
+  set(script "${CMAKE_CURRENT_BINARY_DIR}/${name}_labels.cmake")
+  # One string built with APPEND: a list here would lose the ';' inside the label list.
+  set(content "# Generated by hiltwin_add_gtest: labels and locks of every discovered test.\n")
+  string(APPEND content "foreach(test IN LISTS ${name}_TESTS)\n  set(labels \"${labels}\")\n")
   if(ARG_RT_TESTS)
-    set(rt_labels ${ARG_LABELS} rt)
-    set(script "${CMAKE_CURRENT_BINARY_DIR}/${name}_rt_labels.cmake")
-    file(WRITE "${script}"
-      "# Generated by hiltwin_add_gtest: adds the rt label to the wall-clock tests.\n"
-      "foreach(test IN LISTS ${name}_TESTS)\n"
+    string(APPEND content
       "  if(test MATCHES [=[${ARG_RT_TESTS}]=])\n"
-      "    set_tests_properties(\"\${test}\" PROPERTIES LABELS \"${rt_labels}\")\n"
-      "  endif()\n"
-      "endforeach()\n")
-    # Appended after gtest_discover_tests's own include file, so it runs after discovery.
-    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
+      "    list(APPEND labels rt)\n"
+      "  endif()\n")
   endif()
+  string(APPEND content "  set_tests_properties(\"\${test}\" PROPERTIES LABELS \"\${labels}\"")
+  if(ARG_RESOURCE_LOCK)
+    string(APPEND content " RESOURCE_LOCK \"${ARG_RESOURCE_LOCK}\"")
+  endif()
+  string(APPEND content ")\nendforeach()\n")
+  file(WRITE "${script}" "${content}")
+  # Appended after gtest_discover_tests's own include file, so it runs after discovery.
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
 endfunction()

@@ -1,0 +1,79 @@
+# `cmake --install`: what hiltwin installs, in two components that cmake/HiltwinPackage.cmake
+# turns into the Debian packages hiltwin and hiltwin-dev:
+#   runtime  bin/hiltwin, its example configuration files (share/hiltwin) and the documents
+#   dev      the headers, static libraries and CMake package of the modules a user's plant or
+#            controller builds on: find_package(hiltwin) gives hiltwin::<module>
+# Included from the top-level CMakeLists.txt once every module exists.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+# The reusable layers (DESIGN.md "Modules"). The application layers (app_relbot, telemetry,
+# analysis, trace_capture) stay inside the binary: they would pull Cyclone DDS, FFTW and
+# babeltrace into every user's link for nothing a plant or controller needs.
+set(HILTWIN_EXPORTED_MODULES kernel_glue scheduler qos statemachine io tracing runtime plant fmi)
+set(HILTWIN_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/hiltwin")
+set(HILTWIN_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/hiltwin")
+
+set(exported_targets)
+foreach(module IN LISTS HILTWIN_EXPORTED_MODULES)
+  list(APPEND exported_targets hiltwin_${module})
+  # Each module's headers sit under <module>/include/hiltwin/<module>/, so they all merge into
+  # one <prefix>/include/hiltwin/ and keep their #include "hiltwin/<module>/..." paths.
+  get_target_property(module_dir hiltwin_${module} SOURCE_DIR)
+  install(DIRECTORY "${module_dir}/include/" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
+          COMPONENT dev)
+endforeach()
+install(TARGETS ${exported_targets} EXPORT hiltwinTargets
+        ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}" COMPONENT dev
+        INCLUDES DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
+install(EXPORT hiltwinTargets NAMESPACE hiltwin:: DESTINATION "${HILTWIN_INSTALL_CMAKEDIR}"
+        COMPONENT dev)
+
+configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/hiltwinConfig.cmake.in"
+                              "${PROJECT_BINARY_DIR}/hiltwinConfig.cmake"
+                              INSTALL_DESTINATION "${HILTWIN_INSTALL_CMAKEDIR}")
+# 0.x: a minor release may change the modules' interfaces, so only patch releases are taken as
+# compatible. The file also refuses a hiltwin built for another pointer size (static libraries).
+write_basic_package_version_file("${PROJECT_BINARY_DIR}/hiltwinConfigVersion.cmake"
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES "${PROJECT_BINARY_DIR}/hiltwinConfig.cmake"
+              "${PROJECT_BINARY_DIR}/hiltwinConfigVersion.cmake"
+        DESTINATION "${HILTWIN_INSTALL_CMAKEDIR}" COMPONENT dev)
+
+install(TARGETS hiltwin RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}" COMPONENT runtime)
+
+# The documented starting points for --config, --gains and --plant-map, and the Cyclone DDS
+# configuration for machines without multicast (its messages name <hiltwin>/config/).
+file(GLOB relbot_configs "${PROJECT_SOURCE_DIR}/app_relbot/*.toml")
+install(FILES ${relbot_configs} DESTINATION "${HILTWIN_INSTALL_DATADIR}" COMPONENT runtime)
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/config/" DESTINATION "${HILTWIN_INSTALL_DATADIR}/config"
+        COMPONENT runtime)
+
+# The man page and the bash completion, made by the built binary (cmake/GenerateManPage.cmake
+# names them <binary>.<ext> in the build folder). A cross build makes them only when asked for
+# (scripts/package.sh asks), so there they may be missing.
+set(optional_when_cross "")
+if(CMAKE_CROSSCOMPILING)
+  set(optional_when_cross OPTIONAL)
+endif()
+if(TARGET hiltwin_man_page)
+  install(FILES "${PROJECT_BINARY_DIR}/hiltwin.1" DESTINATION "${CMAKE_INSTALL_MANDIR}/man1"
+          COMPONENT runtime ${optional_when_cross})
+endif()
+if(TARGET hiltwin_bash_completion)
+  # bash-completion loads completions/<command> the first time <command> is completed.
+  install(FILES "${PROJECT_BINARY_DIR}/hiltwin.bash" RENAME hiltwin
+          DESTINATION "${CMAKE_INSTALL_DATADIR}/bash-completion/completions"
+          COMPONENT runtime ${optional_when_cross})
+endif()
+
+# LICENSE and CHANGELOG.md are optional here, so a tree without them still installs. docs/
+# goes beside README.md, whose links name docs/<file>.md.
+foreach(document README.md LICENSE CHANGELOG.md)
+  if(EXISTS "${PROJECT_SOURCE_DIR}/${document}")
+    install(FILES "${PROJECT_SOURCE_DIR}/${document}" DESTINATION "${CMAKE_INSTALL_DOCDIR}"
+            COMPONENT runtime)
+  endif()
+endforeach()
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/docs" DESTINATION "${CMAKE_INSTALL_DOCDIR}"
+        COMPONENT runtime FILES_MATCHING PATTERN "*.md")

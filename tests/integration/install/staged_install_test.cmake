@@ -1,0 +1,106 @@
+# Install.StagedPrefixBuildsAnOutOfTreeTwin (cmake -P; CMakeLists.txt here passes the -D values):
+# `cmake --install` of this build folder into an empty prefix, then tests/install/example
+# configured, built and run against that prefix with find_package(hiltwin), as a user's own
+# project would be. The example is a plant stepped by the run assembly on the emulated board.
+# In: BUILD_DIR, SOURCE_DIR, WORK_DIR, VERSION, GENERATOR, CXX_COMPILER; TOOLCHAIN_FILE and
+# EMULATOR when cross-compiling.
+cmake_minimum_required(VERSION 3.25)
+include("${CMAKE_CURRENT_LIST_DIR}/test_steps.cmake")
+hiltwin_test_require_vars(BUILD_DIR SOURCE_DIR WORK_DIR VERSION GENERATOR)
+
+# The targets a plant or controller needs (the issue's contract, cmake/HiltwinInstall.cmake).
+set(required_targets kernel_glue scheduler qos statemachine io tracing runtime plant fmi)
+
+file(REMOVE_RECURSE "${WORK_DIR}")
+file(MAKE_DIRECTORY "${WORK_DIR}")
+set(stage "${WORK_DIR}/stage")
+hiltwin_test_run("install into a staging prefix" out
+  COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${stage}"
+  HINT "build the tree first (cmake --build ${BUILD_DIR}), then see "
+       "cmake/HiltwinInstall.cmake")
+set(installed bin/hiltwin include/hiltwin/runtime/run_session.h include/hiltwin/io/backend.h
+    include/hiltwin/plant/plant.h share/hiltwin/relbot.toml
+    share/hiltwin/config/cyclonedds-loopback.xml share/doc/hiltwin/README.md
+    share/bash-completion/completions/hiltwin)
+if(EXISTS "${BUILD_DIR}/hiltwin.1")  # only where help2man is (cmake/GenerateManPage.cmake)
+  list(APPEND installed share/man/man1/hiltwin.1)
+endif()
+hiltwin_test_require_files("the staged install" "install it in cmake/HiltwinInstall.cmake"
+                           "${stage}" ${installed})
+
+# The CMake package: every required target exported, and nothing pointing back into the tree
+# (a path of the source or build folder would break on any other machine).
+file(GLOB_RECURSE package_files "${stage}/*/hiltwinConfig.cmake"
+     "${stage}/*/hiltwinTargets*.cmake")
+list(FILTER package_files INCLUDE REGEX "/cmake/hiltwin/")
+if(NOT package_files)
+  hiltwin_test_fail("the staged install"
+                    WHY "no <libdir>/cmake/hiltwin/hiltwinConfig.cmake under ${stage}"
+                    HINT "install the package files in cmake/HiltwinInstall.cmake")
+endif()
+set(exported "")
+foreach(file IN LISTS package_files)
+  file(READ "${file}" text)
+  foreach(tree "${SOURCE_DIR}" "${BUILD_DIR}")
+    string(FIND "${text}" "${tree}" at)
+    if(NOT at EQUAL -1)
+      hiltwin_test_fail("the installed CMake package" WHY "${file} names ${tree}"
+                        HINT "wrap tree paths in $<BUILD_INTERFACE:...> "
+                             "(hiltwin_add_module in cmake/HiltwinTargets.cmake)")
+    endif()
+  endforeach()
+  string(REGEX MATCHALL "add_library\\(hiltwin::[a-z_0-9]+" added "${text}")
+  list(APPEND exported ${added})
+endforeach()
+foreach(name IN LISTS required_targets)
+  if(NOT "add_library(hiltwin::${name}" IN_LIST exported)
+    hiltwin_test_fail("the installed CMake package" WHY "it does not export hiltwin::${name}"
+                      HINT "add ${name} to HILTWIN_EXPORTED_MODULES (cmake/HiltwinInstall.cmake)")
+  endif()
+endforeach()
+
+hiltwin_test_check_version("the installed hiltwin --version" "${stage}/bin/hiltwin")
+
+# The example as a user builds it: only CMAKE_PREFIX_PATH says where hiltwin is.
+set(example "${WORK_DIR}/example")
+set(configure_args -S "${SOURCE_DIR}/tests/install/example" -B "${example}" -G "${GENERATOR}"
+    "-DCMAKE_PREFIX_PATH=${stage}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
+    "-DCMAKE_CXX_FLAGS=-Werror")  # the example's own warnings (hiltwin's headers are SYSTEM)
+if(TOOLCHAIN_FILE)
+  list(APPEND configure_args "--toolchain" "${TOOLCHAIN_FILE}")
+elseif(CXX_COMPILER)
+  list(APPEND configure_args "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}")
+endif()
+hiltwin_test_run("configure the out-of-tree example" out
+  COMMAND "${CMAKE_COMMAND}" ${configure_args}
+  HINT "if find_package(hiltwin) failed: its dependencies are found by "
+       "cmake/hiltwinConfig.cmake.in")
+file(STRINGS "${example}/CMakeCache.txt" found_dir REGEX "^hiltwin_DIR:")
+if(NOT found_dir MATCHES "=${stage}/")
+  hiltwin_test_fail("configure the out-of-tree example" WHY "it found ${found_dir}, not ${stage}"
+                    HINT "remove the other hiltwin from CMAKE_PREFIX_PATH")
+endif()
+hiltwin_test_run("build the out-of-tree example" out
+  COMMAND "${CMAKE_COMMAND}" --build "${example}"
+  HINT "the installed headers or libraries do not build a user's twin")
+
+hiltwin_test_run("run the out-of-tree example" out EXIT_CODES 0 3
+  COMMAND ${EMULATOR} "${example}/lag_twin")
+hiltwin_test_check_verdict("run the out-of-tree example" "${out}" "${out_EXIT}")
+# tests/install/example/lag_twin.cpp: y = 0.5 (1 - 0.99^1000) after 1000 Euler steps, 499 counts.
+set(result_line "lag_twin: y = ([0-9.]+) m after ([0-9]+) steps, encoder 1 at (-?[0-9]+) counts")
+if(NOT out MATCHES "${result_line}")
+  hiltwin_test_fail("run the out-of-tree example" WHY "no result line in:\n${out}"
+                    HINT "see tests/install/example/lag_twin.cpp")
+endif()
+set(y "${CMAKE_MATCH_1}")
+set(steps "${CMAKE_MATCH_2}")
+set(counts "${CMAKE_MATCH_3}")
+if(NOT steps EQUAL 1000 OR NOT counts EQUAL 499 OR y LESS 0.4999 OR y GREATER 0.5)
+  hiltwin_test_fail("run the out-of-tree example"
+    WHY "y = ${y} m after ${steps} steps at ${counts} counts; expected y in [0.4999, 0.5] "
+        "after 1000 steps at 499 counts"
+    HINT "the plant map, the emulated board or RunSession no longer behave as "
+         "tests/install/example/lag_twin.cpp says")
+endif()
+message(STATUS "out-of-tree example: y = ${y} m after ${steps} steps, ${counts} counts")
