@@ -7,6 +7,7 @@
 #include <string>
 #include <system_error>
 
+#include "hiltwin/fmi/fmu_platform.h"
 #include "hiltwin/plant/plant.h"
 
 namespace hiltwin::fmi {
@@ -14,7 +15,7 @@ namespace {
 
 using plant::PlantError;
 
-// The platforms the archive does have binaries for, to say why linux64 matters.
+// The platforms the archive does have binaries for, to say why this machine's one matters.
 std::string PlatformsPresent(const std::filesystem::path& unpacked) {
   std::string platforms;
   std::error_code error;
@@ -44,21 +45,24 @@ void LookUp(void* handle, const char* symbol, Function*& out, const std::string&
 
 FmuLibrary::FmuLibrary(const std::filesystem::path& unpacked, std::string_view model_identifier,
                        std::string_view fmu_name)
-    : entry_("binaries/linux64/" + std::string(model_identifier) + ".so") {
+    : entry_("binaries/" + std::string(kFmuPlatform) + "/" + std::string(model_identifier) +
+             ".so") {
   const std::filesystem::path file = unpacked / entry_;
   std::error_code error;
   if (!std::filesystem::is_regular_file(file, error)) {
     throw PlantError(std::string(fmu_name) + ": no " + entry_ + " in the archive (binaries " +
-                     "for: " + PlatformsPresent(unpacked) + "); hiltwin needs the Linux " +
-                     "x86-64 binary named after <CoSimulation modelIdentifier>: export the " +
-                     "FMU with linux64 binaries");
+                     "for: " + PlatformsPresent(unpacked) + "); hiltwin needs the " +
+                     std::string(kFmuPlatformName) + " binary named after <CoSimulation " +
+                     "modelIdentifier>: export the FMU with " + std::string(kFmuPlatform) +
+                     " binaries");
   }
   handle_ = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle_ == nullptr) {
     const char* why = dlerror();  // NOLINT(concurrency-mt-unsafe): per thread in glibc
     throw PlantError(std::string(fmu_name) + ": " + entry_ + " cannot be loaded (" +
-                     (why != nullptr ? why : "dlopen failed") + "): it must be a Linux " +
-                     "x86-64 shared library whose dependencies are installed");
+                     (why != nullptr ? why : "dlopen failed") + "): it must be a " +
+                     std::string(kFmuPlatformName) + " shared library whose dependencies are " +
+                     "installed");
   }
   try {
     LookUpAll(fmu_name);

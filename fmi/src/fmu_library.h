@@ -27,8 +27,8 @@ struct Fmi2Functions {
 
 class FmuLibrary {
  public:
-  /// dlopens `<unpacked>/binaries/linux64/<model_identifier>.so` (RTLD_NOW | RTLD_LOCAL: every
-  /// undefined symbol is found now, before the run, and two FMUs never see each other's
+  /// dlopens `<unpacked>/binaries/<kFmuPlatform>/<model_identifier>.so` (RTLD_NOW | RTLD_LOCAL:
+  /// every undefined symbol is found now, before the run, and two FMUs never see each other's
   /// symbols), looks up every function and checks fmi2GetVersion is "2.0". Throws
   /// plant::PlantError naming the file and the symbol.
   FmuLibrary(const std::filesystem::path& unpacked, std::string_view model_identifier,
@@ -44,7 +44,7 @@ class FmuLibrary {
   void LookUpAll(std::string_view fmu_name);
 
   void* handle_ = nullptr;
-  std::string entry_;  ///< "binaries/linux64/<id>.so", as named in messages
+  std::string entry_;  ///< "binaries/linux64/<id>.so" (fmu_platform.h), as named in messages
   Fmi2Functions functions_;
 };
 

@@ -40,8 +40,9 @@ SpidevBus::SpidevBus(const std::string& path, const SpidevConfig& config, FileOp
   if (fd_ < 0) {
     throw std::runtime_error(
         "cannot open " + path + ": " + std::strerror(error) +
-        "; enable SPI (Raspberry Pi: dtparam=spi=on in /boot/config.txt, then reboot), check "
-        "that the device exists (ls /dev/spidev*) and that you may use it (group spi)");
+        "; enable SPI (Raspberry Pi OS: dtparam=spi=on in /boot/firmware/config.txt, then "
+        "reboot), check that the device exists (ls /dev/spidev*) and that you may use it "
+        "(group spi)");
   }
   auto set = [&](unsigned long request, void* value, const char* what) {
     int err = 0;

@@ -184,7 +184,10 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
     now_ns_ = t_ns;
     if (!guard_.ok()) return view;
     // seq_cst pairs with the twin's store: a sample that begins after this load reads its clock
-    // after the ECS read its own, so it cannot cancel edges the ECS replays now.
+    // after the ECS read its own, so it cannot cancel edges the ECS replays now. The fence keeps
+    // the load after the caller's clock read (t_ns): a clock read is no memory access, and on
+    // arm64's weaker ordering the load could otherwise be satisfied first.
+    std::atomic_thread_fence(std::memory_order_seq_cst);
     const std::int64_t until_ns = seg_.twin_sampling_ns.load(std::memory_order_seq_cst);
     const std::uint64_t newest = seg_.encoder_newest.load(std::memory_order_acquire);
     // The loads may come long after t_ns was read (this thread preempted): before calling a
@@ -736,7 +739,12 @@ BusStatus WireBus::RunOnBoard(Transfers&& transfers) noexcept {
   board_.SetDigitalInputs(pins);
   // The board samples (and publishes its period) while acting on the request; the fetch's NOOP
   // changes nothing on the wire, so one window around both keeps the ECS's replay bound valid.
-  if (twin) seg.twin_sampling_ns.store(clock_.NowNs(), std::memory_order_seq_cst);
+  if (twin) {
+    seg.twin_sampling_ns.store(clock_.NowNs(), std::memory_order_seq_cst);
+    // The board's clock reads in transfers() come after the store is visible (arm64 may
+    // otherwise read the clock while the store still waits in its buffer).
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+  }
   transfers();
   if (twin) seg.twin_sampling_ns.store(kNotSampling, std::memory_order_seq_cst);
   Publish(clock_.NowNs());

@@ -4,13 +4,16 @@
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <string_view>
 #include <system_error>
 #include <thread>
 #include <utility>
@@ -31,7 +34,7 @@ constexpr int kPollTickMs = 50;
 std::string ErrnoMessage(int error_number) { return std::strerror(error_number); }
 
 // File descriptors that exist only while a child is being started: the child's ends are
-// closed in the parent once posix_spawnp returned, whatever happened.
+// closed in the parent once posix_spawn returned, whatever happened.
 class SpawnFds {
  public:
   SpawnFds() = default;
@@ -89,7 +92,7 @@ class SpawnFds {
 
  private:
   // Opened here rather than by the child, so a bad path is reported as the path's problem
-  // and a missing program is the only ENOENT posix_spawnp can return.
+  // and a missing program is the only ENOENT posix_spawn can return.
   int Open(const std::string& program, const std::filesystem::path& path) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) {
@@ -112,6 +115,43 @@ std::string SpawnMessage(const std::string& program, int error) {
   }
   if (error == EACCES) return "cannot start " + program + ": permission denied (not executable?)";
   return "cannot start " + program + ": " + ErrnoMessage(error);
+}
+
+// The program's file, looked up as execvp would (a name with a slash is taken as it is), and
+// checked before the spawn: posix_spawn reports a failed exec only where the C library's
+// vfork-style clone lets the child report back, which an emulated arm64 process under
+// qemu-user does not (there a missing program "starts" and exits 127). Checking first gives
+// the same SpawnError on every machine. Returns the errno of the failure, or 0.
+// 0 when `path` is a file this process may execute; otherwise the errno execve would give
+// (EACCES for a directory, which access(X_OK) alone lets through).
+int ExecutableFile(const std::string& path) {
+  if (::access(path.c_str(), X_OK) != 0) return errno;
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) return errno;
+  return S_ISREG(info.st_mode) ? 0 : EACCES;
+}
+
+int ResolveProgram(const std::string& program, std::string& file) {
+  if (program.find('/') != std::string::npos) {
+    file = program;
+    return ExecutableFile(file);
+  }
+  const char* path = std::getenv("PATH");  // NOLINT(concurrency-mt-unsafe): read only
+  std::string_view dirs = path != nullptr ? path : "/usr/local/bin:/usr/bin:/bin";
+  int error = ENOENT;
+  while (true) {
+    const auto colon = dirs.find(':');
+    const std::string_view dir = dirs.substr(0, colon);  // empty: the current folder
+    const std::string candidate = std::string(dir.empty() ? "." : dir) + "/" + program;
+    const int why = ExecutableFile(candidate);
+    if (why == 0) {
+      file = candidate;
+      return 0;
+    }
+    if (why == EACCES) error = EACCES;  // found but not executable: say so, as execvp does
+    if (colon == std::string_view::npos) return error;
+    dirs.remove_prefix(colon + 1);
+  }
 }
 
 // Reads what is available on `fd` into `text`; closes it and sets -1 at end of file.
@@ -205,6 +245,12 @@ Process Process::Start(const std::vector<std::string>& argv, const ProcessOption
   posix_spawnattr_setsigdefault(&attributes, &signals);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
 
+  std::string file;
+  if (const int missing = ResolveProgram(program, file); missing != 0) {
+    posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attributes);
+    throw SpawnError(program, missing, SpawnMessage(program, missing), missing == ENOENT);
+  }
   SpawnFds fds;
   int error = 0;
   pid_t pid = -1;
@@ -215,7 +261,7 @@ Process Process::Start(const std::vector<std::string>& argv, const ProcessOption
     args.reserve(argv.size() + 1);
     for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
     args.push_back(nullptr);
-    error = posix_spawnp(&pid, args[0], &actions, &attributes, args.data(), environ);
+    error = posix_spawn(&pid, file.c_str(), &actions, &attributes, args.data(), environ);
   } catch (...) {
     posix_spawn_file_actions_destroy(&actions);
     posix_spawnattr_destroy(&attributes);
@@ -224,7 +270,7 @@ Process Process::Start(const std::vector<std::string>& argv, const ProcessOption
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   // Output files were opened before the spawn (SpawnFds::Open), so an ENOENT from
-  // posix_spawnp itself can only be the program.
+  // posix_spawn itself can only be the program (removed since ResolveProgram looked).
   if (error != 0) throw SpawnError(program, error, SpawnMessage(program, error), error == ENOENT);
   const auto [out_fd, err_fd] = fds.TakeParentFds();
   return Process(pid, out_fd, err_fd);

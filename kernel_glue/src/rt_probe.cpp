@@ -93,6 +93,14 @@ class Machine {
     return std::nullopt;
   }
 
+  // uname -m ("x86_64", "aarch64"): /proc/sys/kernel/arch holds it and honours the prefix.
+  [[nodiscard]] std::string Architecture() const {
+    if (auto arch = ReadTrimmed("proc/sys/kernel/arch"); arch && !arch->empty()) return *arch;
+    utsname names{};
+    if (real_root_ && uname(&names) == 0) return std::string(names.machine);
+    return {};
+  }
+
   [[nodiscard]] std::optional<std::string> KernelRelease() const {
     if (auto release = ReadTrimmed("proc/sys/kernel/osrelease")) return release;
     utsname names{};
@@ -167,6 +175,32 @@ ProbeCheck NotTried(std::string id, std::string name) {
       Make(std::move(id), std::move(name), "unknown (not tried)", CheckStatus::kWarn);
   check.not_tried = true;
   return check;
+}
+
+// What differs between a PC and a Raspberry Pi when the advice says "install" or "boot with":
+// which real-time kernel to get and where the kernel's command line is kept.
+struct PlatformAdvice {
+  std::string rt_kernel;     ///< how to get a PREEMPT_RT kernel here
+  std::string boot_options;  ///< where boot options such as isolcpus= go
+};
+
+PlatformAdvice AdviceFor(const Machine& machine) {
+  const std::string arch = machine.Architecture();
+  // Raspberry Pi OS boots from the firmware's partition, not through GRUB.
+  const bool pi_boot = machine.Read("boot/firmware/cmdline.txt").has_value();
+  PlatformAdvice advice;
+  if (arch == "aarch64" && pi_boot) {
+    advice.rt_kernel =
+        "on a Raspberry Pi 4 boot the Raspberry Pi kernel built with its bcm2711_rt_defconfig "
+        "(\"-v8-rt\"; kernel= in /boot/firmware/config.txt, docs/raspberry-pi.md)";
+    advice.boot_options = "append them to the one line of /boot/firmware/cmdline.txt, reboot";
+  } else {
+    const std::string debian_arch = arch == "aarch64" ? "arm64" : "amd64";
+    advice.rt_kernel =
+        "Debian 12: `sudo apt install linux-image-rt-" + debian_arch + "`, then boot it";
+    advice.boot_options = "GRUB_CMDLINE_LINUX in /etc/default/grub, sudo update-grub";
+  }
+  return advice;
 }
 
 // "key: value" lines of /proc/self/status.
@@ -295,9 +329,10 @@ PreemptMode FindPreemptMode(const Machine& machine, const std::optional<std::str
 ProbeCheck CheckPreemption(const Machine& machine) {
   const std::string id = "preemption";
   const std::string name = "preemption model";
+  const PlatformAdvice platform = AdviceFor(machine);
   const std::string rt_advice =
-      "for wake-up latency in tens of microseconds use a PREEMPT_RT kernel (Debian 12: `sudo "
-      "apt install linux-image-rt-amd64`, then boot it)";
+      "for wake-up latency in tens of microseconds use a PREEMPT_RT kernel (" + platform.rt_kernel +
+      ")";
   const auto realtime = machine.ReadTrimmed("sys/kernel/realtime");
   const auto version = machine.KernelVersion();
   const auto config = machine.KernelConfig();
@@ -328,9 +363,7 @@ ProbeCheck CheckPreemption(const Machine& machine) {
   std::string advice =
       "a kernel without full preemption can delay a wake-up by milliseconds; " + rt_advice;
   if (dynamic) {
-    advice +=
-        "; as a stop-gap boot this kernel with preempt=full (GRUB_CMDLINE_LINUX in "
-        "/etc/default/grub, then sudo update-grub)";
+    advice += "; as a stop-gap boot this kernel with preempt=full (" + platform.boot_options + ")";
   }
   return Make(id, name, value, CheckStatus::kBad, advice);
 }
@@ -517,8 +550,8 @@ ProbeCheck CheckIsolation(const Machine& machine) {
                             : std::string("not built in"));
   const std::string advice =
       "reserve a CPU for the loop: boot with isolcpus=N nohz_full=N rcu_nocbs=N (e.g. the last "
-      "CPU; GRUB_CMDLINE_LINUX in /etc/default/grub, sudo update-grub) and run hiltwin pinned "
-      "to N";
+      "CPU; " +
+      AdviceFor(machine).boot_options + ") and run hiltwin pinned to N";
   if (!isolated)
     return Unknown(id, name, "no /sys/devices/system/cpu/isolated; " + nohz_text, advice);
   if (isolated->empty()) {
@@ -552,13 +585,52 @@ ProbeCheck CheckThrottling(const Machine& machine) {
               "runaway SCHED_FIFO loop then locks up its CPU; restore 950000 afterwards)");
 }
 
+// "0-3,6" -> 5.
+std::optional<int> CountCpuList(std::string_view list) {
+  int count = 0;
+  std::stringstream parts{std::string(list)};
+  for (std::string part; std::getline(parts, part, ',');) {
+    part = Trim(part);
+    if (part.empty()) continue;
+    const auto dash = part.find('-');
+    const auto first = ParseInteger<int>(part.substr(0, dash));
+    const auto last = dash == std::string::npos ? first : ParseInteger<int>(part.substr(dash + 1));
+    if (!first || !last || *last < *first) return std::nullopt;
+    count += *last - *first + 1;
+  }
+  return count;
+}
+
+ProbeCheck CheckSmtByTopology(const Machine& machine, const std::string& id,
+                              const std::string& name) {
+  const auto cpus = CpuDirectories(machine);
+  if (cpus.empty()) return Unknown(id, name, "no /sys/devices/system/cpu/smt, no cpuN folders");
+  for (const auto& [cpu, dir] : cpus) {
+    const auto siblings = machine.ReadTrimmed("sys/devices/system/cpu/cpu" + std::to_string(cpu) +
+                                              "/topology/thread_siblings_list");
+    const auto count = siblings ? CountCpuList(*siblings) : std::nullopt;
+    if (!count) return Unknown(id, name, "no SMT control and no readable CPU topology");
+    if (*count > 1) {
+      return Make(id, name,
+                  "on (cpu" + std::to_string(cpu) + " shares its core: " + *siblings +
+                      "; no SMT control in this kernel)",
+                  CheckStatus::kWarn,
+                  "a sibling hardware thread shares the loop's core: boot with nosmt, or keep "
+                  "the sibling idle (isolate both)");
+    }
+  }
+  return Make(id, name, "none (one thread per core)", CheckStatus::kOk);
+}
+
 ProbeCheck CheckSmt(const Machine& machine) {
   const std::string id = "smt";
   const std::string name = "SMT (hyper-threading)";
   const auto active = machine.ReadTrimmed("sys/devices/system/cpu/smt/active");
   const auto control = machine.ReadTrimmed("sys/devices/system/cpu/smt/control");
   const std::string control_text = control ? " (control: " + *control + ")" : "";
-  if (!active) return Unknown(id, name, "no /sys/devices/system/cpu/smt/active");
+  // A kernel without SMT control (arm64: the Pi's cores run one thread each) has no smt/ folder;
+  // the CPU topology still tells whether any core is shared.
+  if (!active) return CheckSmtByTopology(machine, id, name);
   if (*active == "0") return Make(id, name, "off" + control_text, CheckStatus::kOk);
   return Make(id, name, "on" + control_text, CheckStatus::kWarn,
               "a sibling hyper-thread shares the loop's core: `echo off | sudo tee "
@@ -591,22 +663,6 @@ ProbeCheck CheckClocksource(const Machine& machine) {
                 "every clock read costs about a microsecond; " + switch_advice);
   }
   return Make(id, name, *current, CheckStatus::kWarn, switch_advice);
-}
-
-// "0-3,6" -> 5.
-std::optional<int> CountCpuList(std::string_view list) {
-  int count = 0;
-  std::stringstream parts{std::string(list)};
-  for (std::string part; std::getline(parts, part, ',');) {
-    part = Trim(part);
-    if (part.empty()) continue;
-    const auto dash = part.find('-');
-    const auto first = ParseInteger<int>(part.substr(0, dash));
-    const auto last = dash == std::string::npos ? first : ParseInteger<int>(part.substr(dash + 1));
-    if (!first || !last || *last < *first) return std::nullopt;
-    count += *last - *first + 1;
-  }
-  return count;
 }
 
 ProbeCheck CheckCpus(const Machine& machine) {

@@ -160,7 +160,7 @@ TEST_F(FmuCli, EveryRefusedFmuIsExitTwoWithItsReason) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"bad_corrupt", "zip"},          {"bad_no_xml", "modelDescription.xml"},
       {"bad_malformed", "modelDescription.xml:"}, {"bad_fmi1", "1.0"},
-      {"bad_me_only", "ModelExchange"}, {"bad_no_binary", "binaries/linux64/bad_no_binary.so"},
+      {"bad_me_only", "ModelExchange"}, {"bad_no_binary", "binaries/" HILTWIN_FMU_PLATFORM "/bad_no_binary.so"},
       {"bad_no_dostep", "fmi2DoStep"}};
   for (const auto& [name, reason] : cases) {
     const auto r = Run({"--plant", "fmu:" + Fmu(name), "--plant-map", map});

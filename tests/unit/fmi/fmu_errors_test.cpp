@@ -117,16 +117,17 @@ TEST_F(FmuRefused, ModelExchangeOnly) {
 }
 
 TEST_F(FmuRefused, NoLinuxBinary) {
-  EXPECT_THAT(OpenError(TestFmu("bad_no_binary")),
-              AllOf(HasSubstr("bad_no_binary.fmu: no binaries/linux64/bad_no_binary.so"),
-                    HasSubstr("binaries for: none")));
+  EXPECT_THAT(
+      OpenError(TestFmu("bad_no_binary")),
+      AllOf(HasSubstr("bad_no_binary.fmu: no binaries/" HILTWIN_FMU_PLATFORM "/bad_no_binary.so"),
+            HasSubstr("binaries for: none")));
   EXPECT_TRUE(NothingLeftBehind());
 }
 
 TEST_F(FmuRefused, MissingFunction) {
   EXPECT_THAT(OpenError(TestFmu("bad_no_dostep")),
-              HasSubstr("bad_no_dostep.fmu: binaries/linux64/bad_no_dostep.so does not export "
-                        "fmi2DoStep"));
+              HasSubstr("bad_no_dostep.fmu: binaries/" HILTWIN_FMU_PLATFORM
+                        "/bad_no_dostep.so does not export fmi2DoStep"));
   EXPECT_TRUE(NothingLeftBehind());
 }
 

@@ -217,7 +217,7 @@ TEST(FmuPlantUnpack, PrivateFolderWhileOpenGoneAfterDestruction) {
   const std::filesystem::path dir = plant->unpack_dir();
   ASSERT_TRUE(std::filesystem::is_directory(dir));
   EXPECT_TRUE(std::filesystem::exists(dir / "modelDescription.xml"));
-  EXPECT_TRUE(std::filesystem::exists(dir / "binaries/linux64/lag.so"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "binaries" / HILTWIN_FMU_PLATFORM / "lag.so"));
   struct stat info {};
   ASSERT_EQ(stat(dir.c_str(), &info), 0);
   EXPECT_EQ(info.st_mode & 0777U, 0700U);

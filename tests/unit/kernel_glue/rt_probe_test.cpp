@@ -48,6 +48,7 @@ class FakeRoot : public ::testing::Test {
   void WriteKvmGuest() {
     Write("proc/sys/kernel/version", "#1 SMP PREEMPT_DYNAMIC @0\n");
     Write("proc/sys/kernel/osrelease", "6.18.44-test\n");
+    Write("proc/sys/kernel/arch", "x86_64\n");
     Write("boot/config-6.18.44-test",
           "CONFIG_PREEMPT_BUILD=y\nCONFIG_PREEMPT_NONE=y\n# CONFIG_PREEMPT_VOLUNTARY is not set\n"
           "# CONFIG_PREEMPT is not set\nCONFIG_PREEMPT_DYNAMIC=y\n");
@@ -241,6 +242,55 @@ TEST_F(FakeRoot, SmtOnWarns) {
   const ProbeCheck check = Check(RunRtProbe(Options(false), os_), "smt");
   EXPECT_EQ(check.value, "on");
   EXPECT_EQ(check.status, CheckStatus::kWarn);
+}
+
+// A Raspberry Pi 4 on Raspberry Pi OS: arm64, booted by the firmware (no GRUB), its cores one
+// thread each with no SMT control in the kernel, the arm generic timer as clocksource.
+TEST_F(FakeRoot, RaspberryPiAdviceNamesThePisKernelAndBootFiles) {
+  WriteKvmGuest();
+  Write("proc/sys/kernel/arch", "aarch64\n");
+  Write("boot/firmware/cmdline.txt", "console=serial0,115200 root=PARTUUID=0 rootwait\n");
+  Write("sys/devices/system/clocksource/clocksource0/current_clocksource", "arch_sys_counter\n");
+  const ProbeReport report = RunRtProbe(Options(), os_);
+
+  const ProbeCheck& preemption = Check(report, "preemption");
+  EXPECT_EQ(preemption.status, CheckStatus::kBad);
+  EXPECT_TRUE(Contains(preemption.advice, "bcm2711_rt_defconfig")) << preemption.advice;
+  EXPECT_TRUE(Contains(preemption.advice, "/boot/firmware/cmdline.txt")) << preemption.advice;
+  EXPECT_FALSE(Contains(preemption.advice, "amd64")) << preemption.advice;
+  EXPECT_FALSE(Contains(preemption.advice, "grub")) << preemption.advice;
+  const ProbeCheck& isolation = Check(report, "isolated_cpus");
+  EXPECT_TRUE(Contains(isolation.advice, "/boot/firmware/cmdline.txt")) << isolation.advice;
+  EXPECT_EQ(Check(report, "clocksource").value, "arch_sys_counter");
+  EXPECT_EQ(Check(report, "clocksource").status, CheckStatus::kOk);
+
+  // Plain Debian on an arm64 board boots through GRUB and has Debian's arm64 RT kernel.
+  fs::remove(root_ / "boot/firmware/cmdline.txt");
+  const ProbeReport debian = RunRtProbe(Options(), os_);
+  EXPECT_TRUE(Contains(Check(debian, "preemption").advice, "linux-image-rt-arm64"));
+  EXPECT_TRUE(Contains(Check(debian, "isolated_cpus").advice, "GRUB_CMDLINE_LINUX"));
+}
+
+TEST_F(FakeRoot, WithoutSmtControlTheTopologyTellsWhetherCoresAreShared) {
+  WriteKvmGuest();
+  fs::remove_all(root_ / "sys/devices/system/cpu/smt");
+  Write("sys/devices/system/cpu/cpu0/topology/thread_siblings_list", "0\n");
+  Write("sys/devices/system/cpu/cpu1/topology/thread_siblings_list", "1\n");
+  const ProbeReport one_each = RunRtProbe(Options(), os_);
+  const ProbeCheck& alone = Check(one_each, "smt");
+  EXPECT_EQ(alone.value, "none (one thread per core)");
+  EXPECT_EQ(alone.status, CheckStatus::kOk);
+
+  Write("sys/devices/system/cpu/cpu0/topology/thread_siblings_list", "0-1\n");
+  Write("sys/devices/system/cpu/cpu1/topology/thread_siblings_list", "0-1\n");
+  const ProbeReport shared = RunRtProbe(Options(), os_);
+  EXPECT_EQ(Check(shared, "smt").status, CheckStatus::kWarn);
+  EXPECT_TRUE(Contains(Check(shared, "smt").value, "cpu0 shares its core: 0-1"));
+
+  Write("sys/devices/system/cpu/cpu0/topology/thread_siblings_list", "0\n");
+  fs::remove_all(root_ / "sys/devices/system/cpu/cpu1/topology");
+  const ProbeReport unreadable = RunRtProbe(Options(), os_);
+  EXPECT_TRUE(Contains(Check(unreadable, "smt").value, "unknown"));
 }
 
 TEST_F(FakeRoot, ClocksourceGrades) {

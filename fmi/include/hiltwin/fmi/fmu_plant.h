@@ -1,7 +1,7 @@
 #pragma once
 /// FMI 2.0 co-simulation FMUs as plants (`--plant fmu:PATH.fmu`, docs/fmi.md). Opening an FMU
 /// does everything that may allocate, load or do I/O: unpack the zip into a private folder,
-/// read modelDescription.xml, dlopen binaries/linux64/<modelIdentifier>.so and look up every
+/// read modelDescription.xml, dlopen binaries/<platform>/<modelIdentifier>.so and look up every
 /// function hiltwin calls. Start() instantiates and initialises; Step() is fmi2SetReal ->
 /// fmi2DoStep -> fmi2GetReal and nothing else. Ports are the FMU's Real inputs and outputs.
 
@@ -57,7 +57,7 @@ class FmuPlant : public plant::Plant {
 
 /// Opens an FMU. Throws plant::PlantError saying which file, entry, attribute or symbol is
 /// wrong and what to do: not a zip, no or malformed modelDescription.xml, fmiVersion other
-/// than 2.0, Model Exchange only, no linux64 binary, a missing function.
+/// than 2.0, Model Exchange only, no binary for this platform (fmu_platform.h), a missing function.
 [[nodiscard]] std::unique_ptr<FmuPlant> OpenFmu(const std::filesystem::path& fmu_path,
                                                 FmuOptions options = {});
 

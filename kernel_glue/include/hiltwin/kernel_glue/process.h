@@ -1,7 +1,8 @@
 #pragma once
-/// Child processes without a shell: one way to start a program (posix_spawnp, PATH lookup),
-/// route its output, wait for it with a timeout and tell an exit code from a signal. Used by
-/// the doctor's tools, the assess plot (gnuplot), the benchmarks and the integration tests.
+/// Child processes without a shell: one way to start a program (posix_spawn after a PATH
+/// lookup as execvp's), route its output, wait for it with a timeout and tell an exit code
+/// from a signal. Used by the doctor's tools, the assess plot (gnuplot), the benchmarks and
+/// the integration tests.
 
 #include <sys/types.h>
 

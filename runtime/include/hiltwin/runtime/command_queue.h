@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "hiltwin/kernel_glue/cache_line.h"
+
 namespace hiltwin::runtime {
 
 /// What another thread may ask of a running session.
@@ -71,8 +73,8 @@ class CommandQueue {
     T value{};
   };
   std::array<Cell, kCapacity> cells_;
-  alignas(64) std::atomic<std::size_t> enqueue_{0};
-  alignas(64) std::atomic<std::size_t> dequeue_{0};
+  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::size_t> enqueue_{0};
+  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::size_t> dequeue_{0};
 };
 
 }  // namespace hiltwin::runtime

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "hiltwin/kernel_glue/cache_line.h"
+
 namespace hiltwin::runtime {
 
 template <typename T>
@@ -44,14 +46,14 @@ class LatestValue {
   static constexpr std::uint8_t kIndexMask = 0x3;
   static constexpr std::uint8_t kFresh = 0x4;
   /// One cache line each at least, so the writer's stores never share a line with the reader.
-  struct alignas(64) Slot {
+  struct alignas(kernel_glue::kCacheLineBytes) Slot {
     T value{};
   };
   std::array<Slot, 3> slots_{};
-  alignas(64) std::atomic<std::uint8_t> middle_{1};
-  alignas(64) std::uint8_t back_ = 0;   // writer's
-  std::uint64_t published_ = 0;         // writer's
-  alignas(64) std::uint8_t front_ = 2;  // reader's
+  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::uint8_t> middle_{1};
+  alignas(kernel_glue::kCacheLineBytes) std::uint8_t back_ = 0;   // writer's
+  std::uint64_t published_ = 0;                                   // writer's
+  alignas(kernel_glue::kCacheLineBytes) std::uint8_t front_ = 2;  // reader's
 };
 
 }  // namespace hiltwin::runtime

@@ -10,10 +10,12 @@
 #include <string>
 #include <type_traits>
 
+#include "hiltwin/kernel_glue/cache_line.h"
+
 namespace hiltwin::tracing {
 
 /// Bytes that keep the producer's and the consumer's indices off each other's cache line.
-inline constexpr std::size_t kCacheLineBytes = 64;
+using kernel_glue::kCacheLineBytes;
 
 /// Claim/publish/release index logic over `capacity` slots stored by the owner. Indices are
 /// free-running 64-bit counters (they never wrap in practice), the slot is `index & mask`.
