@@ -46,6 +46,7 @@ packages=(
   stress-ng                                     # the fault matrix's CPU hog (docs/reliability.md)
   dpkg-dev fakeroot file                        # CPack's .deb: dpkg-shlibdeps, file ownership
   help2man groff-base                           # the man page from --help, and its render test
+  ccache                                        # the four builds of scripts/test.sh share one cache
 )
 
 # The arm64 cross build: the libraries hiltwin links, as arm64 multiarch packages beside the
