@@ -5,9 +5,9 @@
 #     `<target> <command> --help` for every command `<target> completion bash` lists
 #   hiltwin_bash_completion(<target>): target hiltwin_bash_completion,
 #     ${PROJECT_BINARY_DIR}/<target>.bash from `<target> completion bash --output`
-# Both belong to ALL in a native build. Cross-compiled, the program runs under
-# CMAKE_CROSSCOMPILING_EMULATOR and the targets build only when asked for (as gtest discovery,
-# a cross build needs no emulator by default); without an emulator they are not defined.
+# Both belong to ALL. Cross-compiled, the program runs under CMAKE_CROSSCOMPILING_EMULATOR
+# (qemu-aarch64 for arm64: a few seconds); without an emulator they are not defined, and the
+# install rules and tests that use them say so or leave them out.
 #
 # This file has two roles: include()d, it defines the two functions; run with `cmake -P` by
 # the man page's rule, it writes the page (the part after return()).
@@ -15,13 +15,11 @@
 if(NOT CMAKE_SCRIPT_MODE_FILE)
 
 # Sets <out> to the command that runs <target> on this machine (a list: the emulator first
-# when cross-compiling) and <out>_ALL to ALL when the file belongs in the default build.
-# Leaves <out> empty, saying so, when the program cannot run here to make <what>.
+# when cross-compiling). Leaves <out> empty, saying so, when the program cannot run here to
+# make <what>.
 function(_hiltwin_program_runner out target what)
-  set(all ALL)
   set(runner "$<TARGET_FILE:${target}>")
   if(CMAKE_CROSSCOMPILING)
-    set(all "")
     if(CMAKE_CROSSCOMPILING_EMULATOR)
       set(runner ${CMAKE_CROSSCOMPILING_EMULATOR} "$<TARGET_FILE:${target}>")
     else()
@@ -31,7 +29,6 @@ function(_hiltwin_program_runner out target what)
     endif()
   endif()
   set(${out} "${runner}" PARENT_SCOPE)
-  set(${out}_ALL "${all}" PARENT_SCOPE)
 endfunction()
 
 function(hiltwin_bash_completion target)
@@ -45,7 +42,7 @@ function(hiltwin_bash_completion target)
     DEPENDS ${target}
     COMMENT "${target}.bash: bash completion from the command line"
     VERBATIM)
-  add_custom_target(hiltwin_bash_completion ${runner_ALL} DEPENDS "${output}")
+  add_custom_target(hiltwin_bash_completion ALL DEPENDS "${output}")
 endfunction()
 
 function(hiltwin_man_page target)
@@ -70,7 +67,7 @@ function(hiltwin_man_page target)
     DEPENDS ${target} "${CMAKE_CURRENT_FUNCTION_LIST_FILE}"
     COMMENT "${target}.1: man page from --help (help2man)"
     VERBATIM)
-  add_custom_target(hiltwin_man_page ${runner_ALL} DEPENDS "${output}")
+  add_custom_target(hiltwin_man_page ALL DEPENDS "${output}")
 endfunction()
 
 return()

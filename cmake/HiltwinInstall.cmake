@@ -50,21 +50,17 @@ install(DIRECTORY "${PROJECT_SOURCE_DIR}/config/" DESTINATION "${HILTWIN_INSTALL
         COMPONENT runtime)
 
 # The man page and the bash completion, made by the built binary (cmake/GenerateManPage.cmake
-# names them <binary>.<ext> in the build folder). A cross build makes them only when asked for
-# (scripts/package.sh asks), so there they may be missing.
-set(optional_when_cross "")
-if(CMAKE_CROSSCOMPILING)
-  set(optional_when_cross OPTIONAL)
-endif()
+# names them <binary>.<ext> in the build folder; a cross build without an emulator, or a machine
+# without help2man, has no target for them, and they are left out).
 if(TARGET hiltwin_man_page)
   install(FILES "${PROJECT_BINARY_DIR}/hiltwin.1" DESTINATION "${CMAKE_INSTALL_MANDIR}/man1"
-          COMPONENT runtime ${optional_when_cross})
+          COMPONENT runtime)
 endif()
 if(TARGET hiltwin_bash_completion)
   # bash-completion loads completions/<command> the first time <command> is completed.
   install(FILES "${PROJECT_BINARY_DIR}/hiltwin.bash" RENAME hiltwin
           DESTINATION "${CMAKE_INSTALL_DATADIR}/bash-completion/completions"
-          COMPONENT runtime ${optional_when_cross})
+          COMPONENT runtime)
 endif()
 
 # LICENSE and CHANGELOG.md are optional here, so a tree without them still installs. docs/

@@ -145,7 +145,9 @@ if(NOT installed_count EQUAL 2)
 endif()
 hiltwin_test_require_files("the installed packages"
                            "see the install rules in cmake/HiltwinInstall.cmake" "${root}"
-                           usr/bin/hiltwin usr/include/hiltwin/runtime/run_session.h)
+                           usr/bin/hiltwin usr/include/hiltwin/runtime/run_session.h
+                           usr/share/bash-completion/completions/hiltwin
+                           usr/share/man/man1/hiltwin.1)
 
 hiltwin_test_check_version("${root}/usr/bin/hiltwin --version" "${root}/usr/bin/hiltwin")
 hiltwin_test_run("${root}/usr/bin/hiltwin run" out EXIT_CODES 0 3
