@@ -25,7 +25,7 @@
 #include "hiltwin/io/board_pair_check.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
-#include "hiltwin/io/wire_bus.h"
+#include "hiltwin/io/peer_link.h"
 #include "hiltwin/kernel_glue/clock.h"
 
 namespace hiltwin::app {
@@ -154,14 +154,16 @@ std::string NoPeerAdvice(const IoTestOptions& options, io::Image image, bool wai
                  : "or add --wait-peer SECONDS to wait for it");
 }
 
-/// Wire only: waits (start-up, not real-time) until the other process has attached.
+/// Wire only: waits (start-up, not real-time) until the other process is up. Poll beats this
+/// side's heartbeat too: a side counts as up from its first beat, so two sides that only
+/// watched would wait for each other.
 void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image image) {
-  const auto* wire = dynamic_cast<const io::WireBus*>(&backend.bus());
-  if (wire == nullptr) return;
+  io::PeerLink* const link = backend.peer_link();
+  if (link == nullptr) return;
   kernel_glue::MonotonicClock clock;
   const std::int64_t deadline =
       clock.NowNs() + static_cast<std::int64_t>(options.wait_peer_s * 1e9);
-  while (wire->PeerStatus().result == io::BusResult::kPeerAbsent) {
+  while (link->Poll().result == io::BusResult::kPeerAbsent) {
     if (clock.NowNs() >= deadline) {
       char seconds[32];
       std::snprintf(seconds, sizeof seconds, "%g", options.wait_peer_s);

@@ -557,8 +557,7 @@ void WireBus::Attach() {
   self.pid.store(pid_);
   self.stop_cause.store(static_cast<std::uint32_t>(StopCause::kNone));
   self.step_ns.store(0);
-  self.last_beat_ns.store(clock_.NowNs());
-  self.heartbeat.fetch_add(1);
+  self.last_beat_ns.store(kNoBeatYet);  // up at its first beat (Poll or a transfer)
   self.attached.store(1);
   self.sessions.fetch_add(1);
   segment_->attach_count.fetch_add(1);
@@ -712,12 +711,17 @@ BusStatus WireBus::PeerStatus() const noexcept {
                                            : "wire: the ECS process detached (it stopped); "
                                              "restart it, either side may start first"};
   }
+  // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
+  const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_acquire);
+  if (beat_ns == kNoBeatYet) {
+    return {BusResult::kPeerAbsent,
+            ecs_side ? "wire: a twin process has attached but not started (no heartbeat yet)"
+                     : "wire: an ECS process has attached but not started (no heartbeat yet)"};
+  }
   std::int64_t step_ns = peer.step_ns.load(std::memory_order_relaxed);
   if (step_ns < 0 || step_ns > kMaxStepNs) step_ns = 0;  // garbage: CheckSegment reports it
   std::int64_t timeout_ns = 20 * step_ns;
   if (timeout_ns < kWireMinHeartbeatTimeoutNs) timeout_ns = kWireMinHeartbeatTimeoutNs;
-  // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
-  const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_acquire);
   if (beat_ns < 0 || clock_.NowNs() - beat_ns > timeout_ns) {
     return {BusResult::kPeerLost,
             ecs_side ? "wire: the twin process stopped updating its heartbeat (crashed, hung or "

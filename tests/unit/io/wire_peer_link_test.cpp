@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
+#include <thread>
 
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
@@ -25,8 +27,28 @@ TEST(WirePeerLink, PollSaysWhetherThePeerIsThereAndKeepsThisSideAlive) {
   WireBus twin(name, Image::kIcoboardInverse);
   EXPECT_EQ(twin.Poll().result, BusResult::kPeerAbsent);
   WireBus ecs(name, Image::kIcoboard);
+  EXPECT_EQ(ecs.Poll().result, BusResult::kOk);  // the twin polled already: it is up
   EXPECT_EQ(twin.Poll().result, BusResult::kOk);
-  EXPECT_EQ(ecs.Poll().result, BusResult::kOk);
+}
+
+// Attaching is not being up: a side counts from its first beat. Before it, it may still be in
+// its real-time set-up (which may outlast the heartbeat timeout), so its peer must neither start
+// against it nor, later, call it lost.
+TEST(WirePeerLink, AnAttachedSideThatHasNotBeatenYetIsAbsentNotUp) {
+  const std::string name = FreshName("setup");
+  WireBus twin(name, Image::kIcoboardInverse);
+  ASSERT_EQ(twin.Poll().result, BusResult::kPeerAbsent);
+  WireBus ecs(name, Image::kIcoboard);  // attached, still setting up: no Poll, no transfer
+  const BusStatus before = twin.Poll();
+  EXPECT_EQ(before.result, BusResult::kPeerAbsent);
+  EXPECT_STREQ(before.reason, "wire: an ECS process has attached but not started (no heartbeat "
+                              "yet)");
+  // Set-up longer than the heartbeat timeout: still absent, never lost.
+  std::this_thread::sleep_for(std::chrono::nanoseconds(kWireMinHeartbeatTimeoutNs) +
+                              std::chrono::milliseconds(50));
+  EXPECT_EQ(twin.Poll().result, BusResult::kPeerAbsent);
+  EXPECT_EQ(ecs.Poll().result, BusResult::kOk);  // its first beat: the twin beat already
+  EXPECT_EQ(twin.Poll().result, BusResult::kOk);
 }
 
 TEST(WirePeerLink, AnAnnouncedStopReachesThePeerWithItsCause) {
@@ -67,6 +89,7 @@ TEST(WirePeerLink, AStoppedPeerThatDetachedStaysStoppedNotLost) {
   EXPECT_STREQ(status.reason, "wire: the ECS finished its run");
   // A new ECS on the same wire starts afresh: its stop cause is cleared when it attaches.
   WireBus next(name, Image::kIcoboard);
+  static_cast<void>(next.Poll());  // its first beat: up from here
   EXPECT_EQ(twin.Poll().result, BusResult::kOk);
 }
 

@@ -13,8 +13,10 @@
 /// restart; each side beats a heartbeat on every transfer and a peer whose heartbeat stops is
 /// reported as kPeerLost. A peer that ends its run announces why (PeerLink::AnnounceStop) and is
 /// then reported as kPeerStopped, so the other side can stop cleanly rather than as a fault.
-/// While a side waits to start it keeps its heartbeat fresh with PeerLink::Poll. A peer that
-/// crashed is forgotten when a new process attaches.
+/// While a side waits to start it keeps its heartbeat fresh with PeerLink::Poll. A side counts
+/// as up from its first beat, not from its attach: its set-up may outlast the heartbeat timeout,
+/// and until then its peer sees kPeerAbsent. A peer that crashed is forgotten when a new
+/// process attaches.
 ///
 /// Trust: the segment is created owner-only (0600) and refused when it exists with another
 /// mode or owner, but any process of the same user can still write into it. So everything read

@@ -21,6 +21,11 @@ constexpr std::uint32_t kLayoutVersion = 4;
 constexpr std::uint32_t kFresh = 0;
 constexpr std::uint32_t kInitialising = 1;
 constexpr std::uint32_t kReady = 2;
+/// last_beat_ns from Attach until the side's first beat: attached, still setting up (real-time
+/// set-up, pre-faulting, under a sanitizer easily longer than the heartbeat timeout). Its peer
+/// waits for the first beat: an attach-time beat would count a side that is not yet polling as
+/// up, and then as lost once its set-up outlasts the timeout. No CLOCK_MONOTONIC reading is 0.
+constexpr std::int64_t kNoBeatYet = 0;
 /// twin_sampling_ns when the twin is not inside a transfer.
 constexpr std::int64_t kNotSampling = std::numeric_limits<std::int64_t>::max();
 /// Words of one encoder period: start_ns, subticks << 32 | divider, start_counts (4 × 16),
