@@ -711,7 +711,6 @@ BusStatus WireBus::PeerStatus() const noexcept {
                                            : "wire: the ECS process detached (it stopped); "
                                              "restart it, either side may start first"};
   }
-  // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
   const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_acquire);
   if (beat_ns == kNoBeatYet) {
     return {BusResult::kPeerAbsent,
@@ -722,6 +721,7 @@ BusStatus WireBus::PeerStatus() const noexcept {
   if (step_ns < 0 || step_ns > kMaxStepNs) step_ns = 0;  // garbage: CheckSegment reports it
   std::int64_t timeout_ns = 20 * step_ns;
   if (timeout_ns < kWireMinHeartbeatTimeoutNs) timeout_ns = kWireMinHeartbeatTimeoutNs;
+  // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
   if (beat_ns < 0 || clock_.NowNs() - beat_ns > timeout_ns) {
     return {BusResult::kPeerLost,
             ecs_side ? "wire: the twin process stopped updating its heartbeat (crashed, hung or "
