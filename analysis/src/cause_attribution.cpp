@@ -306,7 +306,7 @@ void IndexBuilder::AssignLoopCpus() {
 
 // Event indices in time order (the recorder writes them so; a merge of per-CPU buffers that
 // is slightly off is put right rather than misread).
-std::vector<std::size_t> TimeOrder(const std::vector<KernelEvent>& events, bool& reordered) {
+std::vector<std::size_t> IndicesByTime(const std::vector<KernelEvent>& events, bool& reordered) {
   std::vector<std::size_t> order(events.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   reordered = !std::is_sorted(events.begin(), events.end(),
@@ -648,7 +648,7 @@ CauseAttributor::CauseAttributor(const KernelTrace& kernel, const LoopThread& lo
     ix->last_ns = hi->time_ns;
   }
   IndexBuilder builder(*ix);
-  for (const std::size_t i : TimeOrder(kernel.events, ix->reordered)) builder.Add(kernel.events[i]);
+  for (const std::size_t i : IndicesByTime(kernel.events, ix->reordered)) builder.Add(kernel.events[i]);
   builder.Finish();
   index_ = std::move(ix);
 }

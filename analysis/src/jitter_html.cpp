@@ -8,9 +8,12 @@
 #include "hiltwin/analysis/jitter_outputs.h"
 #include "jitter_format.h"
 #include "jitter_svg.h"
+#include "time_units.h"
 
 namespace hiltwin::analysis {
 namespace {
+
+using detail::Us;
 
 using detail::SvgAxis;
 using detail::SvgChart;
@@ -24,7 +27,6 @@ constexpr const char* kGreen = "#2ca02c";
 constexpr const char* kOrange = "#ff7f0e";
 constexpr const char* kRed = "#d62728";
 
-double Us(std::int64_t ns) { return static_cast<double>(ns) / 1e3; }
 
 std::string HistogramSvg(const JitterReport& r) {
   const std::vector<HistogramBin> bins = detail::LogDisplayBins(r.latency, kMaxSvgBins);

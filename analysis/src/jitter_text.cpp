@@ -6,13 +6,15 @@
 #include "hiltwin/analysis/jitter_outputs.h"
 #include "jitter_format.h"
 #include "string_format.h"
+#include "time_units.h"
 
 namespace hiltwin::analysis {
 namespace {
 
+using detail::Us;
+
 using detail::Format;
 
-double Us(std::int64_t ns) { return static_cast<double>(ns) / 1e3; }
 
 void Header(const JitterReport& r, std::string& out) {
   out += "hiltwin jitter report: " + r.path + " (" + detail::SourceName(r.source) + ")\n";

@@ -179,7 +179,7 @@ class OutputFile {
 
 // The events in time order. The recorder drains each CPU's buffer in turn, so consecutive
 // drains interleave CPUs; a stable sort keeps each CPU's own order for equal times.
-std::vector<std::size_t> TimeOrder(const std::vector<KernelEvent>& events) {
+std::vector<std::size_t> IndicesByTime(const std::vector<KernelEvent>& events) {
   std::vector<std::size_t> order(events.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   const auto earlier = [&events](std::size_t a, std::size_t b) {
@@ -196,7 +196,7 @@ void WriteEvents(const fs::path& path, const KernelTrace& trace) {
   out.Write(CommentLine(trace));
   out.Write(EventsHeader() + "\n");
   std::string line;
-  for (std::size_t index : TimeOrder(trace.events)) {
+  for (std::size_t index : IndicesByTime(trace.events)) {
     line.clear();
     AppendEventRow(line, trace.events[index]);
     out.Write(line);
@@ -224,9 +224,9 @@ void WriteTasks(const fs::path& path, const std::vector<KernelTask>& tasks) {
 }
 
 // Reads a file line by line, knowing where it is for messages.
-class LineReader {
+class EventsFileLines {
  public:
-  explicit LineReader(fs::path path) : path_(std::move(path)), in_(path_, std::ios::binary) {
+  explicit EventsFileLines(fs::path path) : path_(std::move(path)), in_(path_, std::ios::binary) {
     if (!in_) {
       throw TraceReadError(path_.string() + ": cannot open (" + kernel_glue::ErrnoText(errno) +
                            "): record with `hiltwin trace --kernel`, or analyse without it");
@@ -270,7 +270,7 @@ std::vector<std::string_view> SplitCells(std::string_view line) {
 
 // A number cell: empty gives `fallback`; anything but a whole number is an error.
 template <typename Number>
-Number ParseNumber(const LineReader& reader, std::string_view cell, std::string_view column,
+Number ParseNumber(const EventsFileLines& reader, std::string_view cell, std::string_view column,
                    Number fallback, int base = 10) {
   if (cell.empty()) return fallback;
   std::string_view digits = cell;
@@ -289,7 +289,7 @@ Number ParseNumber(const LineReader& reader, std::string_view cell, std::string_
   return value;
 }
 
-KernelEventKind ParseKind(const LineReader& reader, std::string_view cell) {
+KernelEventKind ParseKind(const EventsFileLines& reader, std::string_view cell) {
   for (KernelEventKind kind : kAllKinds) {
     if (cell == ToString(kind)) return kind;
   }
@@ -301,7 +301,7 @@ KernelEventKind ParseKind(const LineReader& reader, std::string_view cell) {
   reader.Fail("unknown event name '" + std::string(cell) + "' (known: " + known + ")");
 }
 
-KernelEvent ParseEventRow(const LineReader& reader, std::string_view line) {
+KernelEvent ParseEventRow(const EventsFileLines& reader, std::string_view line) {
   const std::vector<std::string_view> cells = SplitCells(line);
   if (cells.size() != kEventColumns.size()) {
     reader.Fail(std::to_string(cells.size()) + " fields, expected " +
@@ -326,7 +326,7 @@ KernelEvent ParseEventRow(const LineReader& reader, std::string_view line) {
 }
 
 // "# hiltwin kernel events 1 cpus=0,1 lost=0" into trace.cpus and trace.lost_events.
-void ParseCommentLine(const LineReader& reader, std::string_view line, KernelTrace& trace) {
+void ParseCommentLine(const EventsFileLines& reader, std::string_view line, KernelTrace& trace) {
   const std::string expected = std::string(kCommentPrefix) + std::string(kFormatVersion) + " ";
   if (!line.starts_with(expected)) {
     reader.Fail("missing the comment line '" + expected + "cpus=<list> lost=<count>' (found '" +
@@ -346,13 +346,13 @@ void ParseCommentLine(const LineReader& reader, std::string_view line, KernelTra
   trace.lost_events = ParseNumber<std::uint64_t>(reader, line.substr(lost_at + 6), "lost", 0);
 }
 
-void ExpectHeader(LineReader& reader, std::string& line, const std::string& header) {
+void ExpectHeader(EventsFileLines& reader, std::string& line, const std::string& header) {
   reader.Expect(line, "the header row");
   if (line != header) reader.Fail("missing the header row '" + header + "'");
 }
 
 void ReadEvents(const fs::path& path, KernelTrace& trace) {
-  LineReader reader(path);
+  EventsFileLines reader(path);
   std::string line;
   reader.Expect(line, "the comment line");
   ParseCommentLine(reader, line, trace);
@@ -367,7 +367,7 @@ void ReadEvents(const fs::path& path, KernelTrace& trace) {
 }
 
 void ReadTasks(const fs::path& path, KernelTrace& trace) {
-  LineReader reader(path);
+  EventsFileLines reader(path);
   std::string line;
   ExpectHeader(reader, line, TasksHeader());
   while (reader.Next(line)) {

@@ -14,9 +14,12 @@
 #include <nlohmann/json.hpp>
 
 #include "hiltwin/analysis/jitter_outputs.h"
+#include "time_units.h"
 
 namespace hiltwin::analysis {
 namespace {
+
+using detail::Us;
 
 enum class EventKind : std::uint8_t { kLatency, kCycle, kMiss, kSkipped };
 
@@ -28,7 +31,6 @@ struct PendingEvent {
   std::size_t cycle = 0;
 };
 
-double Us(std::int64_t ns) { return static_cast<double>(ns) / 1e3; }
 
 // A JSON string literal; bytes that are not UTF-8 (a thread's name) become U+FFFD.
 std::string JsonString(const std::string& text) {

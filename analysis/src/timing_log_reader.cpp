@@ -59,9 +59,9 @@ const char* ColumnName(std::size_t column) {
 }
 
 /// A file read line by line through one large buffer.
-class LineReader {
+class TimingLogLines {
  public:
-  explicit LineReader(const std::string& path) : path_(path), buffer_(kChunkBytes) {
+  explicit TimingLogLines(const std::string& path) : path_(path), buffer_(kChunkBytes) {
     file_.reset(std::fopen(path.c_str(), "rbe"));
     if (!file_) {
       const int error = errno;
@@ -171,7 +171,7 @@ class TimingLogParser {
   }
 
   const std::string& path_;
-  LineReader lines_;
+  TimingLogLines lines_;
   TimingTrace trace_;
   bool has_period_ = false;
   bool has_deadline_ = false;

@@ -3,9 +3,12 @@
 #include <string>
 
 #include "tuning_format.h"
+#include "time_units.h"
 
 namespace hiltwin::analysis {
 namespace {
+
+using detail::Us;
 
 using detail::Format;
 using detail::HzText;
@@ -13,8 +16,6 @@ using detail::MmText;
 using detail::UsText;
 using nlohmann::ordered_json;
 
-double Us(double ns) { return ns / 1e3; }
-double Us(std::int64_t ns) { return static_cast<double>(ns) / 1e3; }
 
 template <typename T>
 ordered_json OrNull(const std::optional<T>& value) {

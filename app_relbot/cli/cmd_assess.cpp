@@ -44,8 +44,6 @@ struct Spec {
   std::string column;
 };
 
-CommandError Usage(const std::string& message) { return CommandError(ExitCode::kUsage, message); }
-
 // "[FILE:]COL". With a positional FILE, a prefix counts as a file only if it names one, so
 // column names may contain ':'; without it, FILE:COL is required.
 Spec ParseSpec(const std::string& value, const std::string& positional, const char* flag) {
@@ -58,7 +56,7 @@ Spec ParseSpec(const std::string& value, const std::string& positional, const ch
     }
   }
   if (positional.empty()) {
-    throw Usage(std::string(flag) + " " + value +
+    ThrowUsage(std::string(flag) + " " + value +
                 ": which file? Give FILE as the first argument (hiltwin assess FILE " + flag +
                 " COL) or name it here (" + flag + " FILE.csv:COL)");
   }
@@ -72,7 +70,7 @@ double ParseDouble(const std::string& text, const std::string& what) {
   if (!text.empty() && text.front() == '+') ++first;
   const auto result = std::from_chars(first, last, value);
   if (result.ec != std::errc() || result.ptr != last || text.empty()) {
-    throw Usage(what + ": '" + text + "' is not a number");
+    ThrowUsage(what + ": '" + text + "' is not a number");
   }
   return value;
 }
@@ -83,7 +81,7 @@ std::array<double, 3> ParseWeights(const std::string& text) {
   for (std::size_t i = 0; i < 3; ++i) {
     const std::size_t comma = text.find(',', start);
     if ((i < 2) == (comma == std::string::npos)) {
-      throw Usage("--weights " + text + ": give three numbers t,p,f (time, performance, "
+      ThrowUsage("--weights " + text + ": give three numbers t,p,f (time, performance, "
                   "frequency), e.g. 1,0,0 as the thesis chose");
     }
     const std::string part = text.substr(start, i < 2 ? comma - start : std::string::npos);
@@ -97,7 +95,7 @@ std::pair<double, double> ParseRange(const std::string& text, const std::string&
                                      const char* example) {
   const auto colon = text.find(':');
   if (colon == std::string::npos) {
-    throw Usage(flag + " " + text + ": give a range LO:HI, e.g. " + flag + " " + example);
+    ThrowUsage(flag + " " + text + ": give a range LO:HI, e.g. " + flag + " " + example);
   }
   return {ParseDouble(text.substr(0, colon), flag + " " + text),
           ParseDouble(text.substr(colon + 1), flag + " " + text)};
@@ -148,7 +146,7 @@ std::string FlagPrefix(const AssessCliOptions& o, analysis::AssessOption option)
 
 int RunAssess(const AssessCliOptions& o) {
   if (o.file.empty() && (o.sim.empty() || o.exp.empty())) {
-    throw Usage("nothing to compare: give FILE (columns 2 and 3 are the simulation and the "
+    ThrowUsage("nothing to compare: give FILE (columns 2 and 3 are the simulation and the "
                 "experiment, as thesis appendix C), or --sim A.csv:COL --exp B.csv:COL");
   }
   const Spec sim_spec = ParseSpec(o.sim.empty() ? "2" : o.sim, o.file, "--sim");
@@ -172,7 +170,7 @@ int RunAssess(const AssessCliOptions& o) {
     const std::filesystem::path parent = std::filesystem::path(o.plot).parent_path();
     std::error_code ec;
     if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
-      throw Usage("--plot " + o.plot + ": directory " + parent.string() +
+      ThrowUsage("--plot " + o.plot + ": directory " + parent.string() +
                   " does not exist; create it or choose another path");
     }
   }
@@ -194,7 +192,7 @@ int RunAssess(const AssessCliOptions& o) {
       try {
         analysis::WritePlot(result, o.plot);
       } catch (const analysis::InputError& e) {  // gnuplot is not installed
-        throw Usage(std::string("--plot: ") + e.what() + ", or leave out --plot");
+        ThrowUsage(std::string("--plot: ") + e.what() + ", or leave out --plot");
       } catch (const analysis::PlotError& e) {
         throw CommandError(ExitCode::kIo, std::string("--plot: ") + e.what());
       }
@@ -206,9 +204,9 @@ int RunAssess(const AssessCliOptions& o) {
       if (!o.plot.empty()) std::printf("Plot written to %s\n", o.plot.c_str());
     }
   } catch (const analysis::OptionError& e) {
-    throw Usage(FlagPrefix(o, e.option()) + e.what());
+    ThrowUsage(FlagPrefix(o, e.option()) + e.what());
   } catch (const analysis::InputError& e) {
-    throw Usage(e.what());
+    ThrowUsage(e.what());
   } catch (const analysis::PlotError& e) {
     throw CommandError(ExitCode::kIo, e.what());
   }

@@ -34,10 +34,6 @@ struct EcsOptions {
   std::string config_path;
 };
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 /// The controller behind its board, built from the flags; owns everything the task uses.
 struct Ecs {
   RelbotParams params = DefaultRelbotParams();
@@ -62,9 +58,9 @@ void LoadEcsConfiguration(const EcsOptions& o, Ecs& ecs) {
       ecs.profile_name = ecs.duty_profile->name();
     }
   } catch (const ConfigError& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   } catch (const ProfileError& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   }
 }
 
@@ -84,7 +80,7 @@ std::unique_ptr<Ecs> BuildEcs(const EcsOptions& o, kernel_glue::TimeNs period_ns
       ecs->task.emplace(*ecs->driver, *ecs->duty_profile, geometry, period_ns);
     }
   } catch (const ConfigError& e) {
-    Usage(std::string("--gains: ") + e.what());
+    ThrowUsage(std::string("--gains: ") + e.what());
   }
   return ecs;
 }

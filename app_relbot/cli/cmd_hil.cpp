@@ -68,31 +68,27 @@ struct HilOptions {
   telemetry::TelemetryOptions telemetry = HilTelemetryDefaults();
 };
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 void Validate(HilOptions& o) {
   for (const auto& [flag, rate] :
        {std::pair{"--twin-rate", o.twin_rate_hz}, std::pair{"--ecs-rate", o.ecs_rate_hz}}) {
     try {
       scheduler::ValidateRateHz(rate);
     } catch (const std::invalid_argument& e) {
-      Usage(std::string(flag) + ": " + e.what());
+      ThrowUsage(std::string(flag) + ": " + e.what());
     }
   }
   if (!std::isfinite(o.duration_s) || o.duration_s < 0.0 || o.duration_s > 7 * 86400.0) {
-    Usage("--duration " + Num(o.duration_s) + ": must be 0 (the profile's length) .. 604800 s");
+    ThrowUsage("--duration " + Num(o.duration_s) + ": must be 0 (the profile's length) .. 604800 s");
   }
   if (!std::isfinite(o.wait_peer_s) || o.wait_peer_s <= 0.0 || o.wait_peer_s > 3600.0) {
-    Usage("--wait-peer " + Num(o.wait_peer_s) + ": must be above 0 and at most 3600 s");
+    ThrowUsage("--wait-peer " + Num(o.wait_peer_s) + ": must be above 0 and at most 3600 s");
   }
   if (o.duration_s == 0.0) {
     try {  // the same loaders the ECS uses, so a bad profile fails here with file:line
       o.duration_s = o.mode == "closedloop" ? LoadSetpointProfile(o.setpoint).length_s()
                                             : LoadInputProfile(o.input).period_s();
     } catch (const ProfileError& e) {
-      Usage(e.what());
+      ThrowUsage(e.what());
     }
   }
 }
@@ -114,7 +110,7 @@ std::unique_ptr<WorkDir> MakeWorkDir(const HilOptions& o) {
   if (!o.log_dir.empty()) {
     dir->path = o.log_dir;
     fs::create_directories(dir->path, error);
-    if (error) Usage("--log-dir " + o.log_dir + ": " + error.message());
+    if (error) ThrowUsage("--log-dir " + o.log_dir + ": " + error.message());
     return dir;
   }
   std::string pattern = (fs::temp_directory_path() / "hiltwin-hil-XXXXXX").string();
@@ -135,7 +131,7 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
     if (!t.web.empty()) static_cast<void>(telemetry::ParseWebSpec(t.web));
     telemetry::CheckNamespace(t.ns + "/controller");
   } catch (const std::invalid_argument& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   }
 }
 
@@ -299,7 +295,7 @@ int RunHil(HilOptions o) {
   try {
     (void)io::WireBus::SegmentName(name);
   } catch (const std::invalid_argument& e) {
-    Usage(std::string("--wire: ") + e.what());
+    ThrowUsage(std::string("--wire: ") + e.what());
   }
   // Before anything is created: a stop signal from here on ends the pair cleanly, never
   // leaving a half-made report or work folder (docs/reliability.md, row M13).

@@ -37,8 +37,6 @@ struct MonitorOptions {
   std::vector<std::string> command;  // NS VERB
 };
 
-CommandError Usage(const std::string& message) { return CommandError(ExitCode::kUsage, message); }
-
 runtime::RemoteCommand ParseVerb(const std::string& ns, const std::string& text) {
   std::string verb = text;  // the codes' names are upper case; users type either
   std::transform(verb.begin(), verb.end(), verb.begin(),
@@ -47,20 +45,20 @@ runtime::RemoteCommand ParseVerb(const std::string& ns, const std::string& text)
     const auto command = runtime::RemoteCommandOf(code);
     if (command && verb == runtime::ToString(*command)) return *command;
   }
-  throw Usage("--command " + ns + " " + text +
+  ThrowUsage("--command " + ns + " " + text +
               ": unknown command; use one of stop, pause, start, quit, reset, initialise");
 }
 
 std::unique_ptr<telemetry::DdsMonitor> OpenMonitor(const MonitorOptions& o) {
   if (o.domain < 0 || o.domain > 232) {
-    throw Usage("--domain " + std::to_string(o.domain) +
+    ThrowUsage("--domain " + std::to_string(o.domain) +
                 ": DDS domain out of range; use 0..232 (the range of ROS_DOMAIN_ID), the "
                 "number the tasks were given with --telemetry dds:DOMAIN");
   }
   try {
     return std::make_unique<telemetry::DdsMonitor>(static_cast<std::uint32_t>(o.domain));
   } catch (const std::exception& e) {
-    throw Usage(std::string("--domain ") + std::to_string(o.domain) + ": " + e.what());
+    ThrowUsage(std::string("--domain ") + std::to_string(o.domain) + ": " + e.what());
   }
 }
 
@@ -164,7 +162,7 @@ int RunCommand(const MonitorOptions& o) {
     const std::vector<std::string> names = monitor->Namespaces();
     if (std::find(names.begin(), names.end(), ns) != names.end()) break;
     if (Clock::now() >= until) {
-      throw Usage("--command " + ns + ": no task publishes rt/" + ns + "/timing on DDS domain " +
+      ThrowUsage("--command " + ns + ": no task publishes rt/" + ns + "/timing on DDS domain " +
                   std::to_string(o.domain) + " (waited " + Fixed(o.wait_s, 1) +
                   " s); tasks there: " + NamespaceList(names) +
                   ". Check the namespace (--namespace of run/ecs), the domain (--domain), and "
@@ -175,7 +173,7 @@ int RunCommand(const MonitorOptions& o) {
   // The task's command reader was announced with its timing writer: a second is plenty.
   const double left_s = std::max(1.0, Seconds(until - Clock::now()).count());
   const std::string why = monitor->SendCommand(ns, command, left_s);
-  if (!why.empty()) throw Usage("--command " + ns + " " + o.command[1] + ": " + why);
+  if (!why.empty()) ThrowUsage("--command " + ns + " " + o.command[1] + ": " + why);
   // The acknowledgement is DDS's: the task's reader has the command. Whether the task can
   // act on it (a RESET while running, say) only the task knows; it prints that on its stderr.
   std::printf(
@@ -221,9 +219,9 @@ int RunLive(const MonitorOptions& o) {
 }
 
 int RunMonitor(const MonitorOptions& o) {
-  if (o.wait_s <= 0.0) throw Usage("--wait " + Fixed(o.wait_s, 1) + ": give a positive time");
+  if (o.wait_s <= 0.0) ThrowUsage("--wait " + Fixed(o.wait_s, 1) + ": give a positive time");
   if (o.duration_s < 0.0) {
-    throw Usage("--duration " + Fixed(o.duration_s, 1) + ": give a positive time, or 0");
+    ThrowUsage("--duration " + Fixed(o.duration_s, 1) + ": give a positive time, or 0");
   }
   if (!o.command.empty()) return RunCommand(o);
   if (o.json) return RunJson(o);

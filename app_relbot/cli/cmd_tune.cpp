@@ -28,10 +28,6 @@ struct TuneCommandOptions {
   bool no_progress = false;
 };
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 /// A bar redrawn in place on a terminal; one line per step otherwise (logs, CI).
 class ProgressBar {
  public:
@@ -65,7 +61,7 @@ void CheckOutputPath(const std::string& path, const char* flag) {
   if (path.empty()) return;
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    Usage(std::string(flag) + " " + path + ": the folder " + parent.string() +
+    ThrowUsage(std::string(flag) + " " + path + ": the folder " + parent.string() +
           " does not exist; create it or write elsewhere");
   }
 }

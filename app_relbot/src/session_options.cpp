@@ -20,10 +20,6 @@
 namespace hiltwin::app {
 namespace {
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 qos::QosConfig MakeQosConfig(const SessionOptions& o, const SessionRole& role,
                              std::uint64_t planned_cycles) {
   qos::QosConfig config;
@@ -48,7 +44,7 @@ qos::QosConfig MakeQosConfig(const SessionOptions& o, const SessionRole& role,
     }
     qos::Validate(config);
   } catch (const std::invalid_argument& e) {
-    Usage(std::string("QoS rules: ") + e.what() + " (see 'hiltwin " + role.command +
+    ThrowUsage(std::string("QoS rules: ") + e.what() + " (see 'hiltwin " + role.command +
           " --help' and docs/qos.md)");
   }
   return config;
@@ -61,7 +57,7 @@ runtime::OverrunInjector MakeInjector(const SessionOptions& o, std::uint64_t pla
       injector.Add(runtime::ParseOverrunInjection(spec));
     injector.CheckFiresWithin(planned);
   } catch (const std::exception& e) {  // invalid_argument, length_error: both the user's input
-    Usage(std::string("--inject-overrun ") + e.what());
+    ThrowUsage(std::string("--inject-overrun ") + e.what());
   }
   return injector;
 }
@@ -75,7 +71,7 @@ runtime::TelemetryConfig MakeTelemetry(telemetry::TelemetryOptions t, const Sess
   try {
     return telemetry::MakeTelemetryConfig(t);
   } catch (const std::exception& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   }
 }
 
@@ -176,30 +172,30 @@ void ValidateSessionOptions(const SessionOptions& o) {
   try {
     scheduler::ValidateRateHz(o.rate_hz);
   } catch (const std::invalid_argument& e) {
-    Usage(std::string("--rate: ") + e.what());
+    ThrowUsage(std::string("--rate: ") + e.what());
   }
   if (!std::isfinite(o.duration_s) || o.duration_s <= 0.0 || o.duration_s > 7 * 86400.0) {
-    Usage("--duration " + Num(o.duration_s) +
+    ThrowUsage("--duration " + Num(o.duration_s) +
           ": must be a positive number of seconds, at most 604800 (7 days)");
   }
   if (!std::isfinite(o.deadline_us) || o.deadline_us < 0.0 ||
       o.deadline_us * 1e3 > 1e9 / o.rate_hz) {
-    Usage("--deadline-us: must be between 0 (= the period) and the period (" +
+    ThrowUsage("--deadline-us: must be between 0 (= the period) and the period (" +
           Num(1e6 / o.rate_hz) + " us)");
   }
-  if (o.log_decimation == 0) Usage("--log-decimation: must be at least 1");
-  if (o.priority < 0 || o.priority > 99) Usage("--priority: 0 (no SCHED_FIFO) .. 99");
+  if (o.log_decimation == 0) ThrowUsage("--log-decimation: must be at least 1");
+  if (o.priority < 0 || o.priority > 99) ThrowUsage("--priority: 0 (no SCHED_FIFO) .. 99");
   if (!std::isfinite(o.wait_peer_s) || o.wait_peer_s < 0.0 || o.wait_peer_s > 86400.0) {
-    Usage("--wait-peer " + Num(o.wait_peer_s) + ": must be 0 .. 86400 seconds");
+    ThrowUsage("--wait-peer " + Num(o.wait_peer_s) + ": must be 0 .. 86400 seconds");
   }
 }
 
 std::uint64_t PlannedCycles(const SessionOptions& o) {
   const auto planned = static_cast<std::uint64_t>(std::llround(o.duration_s * o.rate_hz));
-  if (planned == 0) Usage("--duration is shorter than one period at --rate");
+  if (planned == 0) ThrowUsage("--duration is shorter than one period at --rate");
   if (o.grace_cycles >= planned) {
     // A grace period that covers the whole run would judge nothing and always PASS.
-    Usage("--grace-cycles " + std::to_string(o.grace_cycles) + ": must be below the " +
+    ThrowUsage("--grace-cycles " + std::to_string(o.grace_cycles) + ": must be below the " +
           std::to_string(planned) + " cycles of the run; lower it or lengthen --duration");
   }
   return planned;
@@ -219,7 +215,7 @@ std::unique_ptr<io::IoBackend> OpenBoard(const SessionOptions& o, io::Image side
   try {
     return io::OpenBackend(o.io, BackendOptionsFor(o, side));
   } catch (const io::ConfigError& e) {
-    Usage(std::string("--io: ") + e.what());
+    ThrowUsage(std::string("--io: ") + e.what());
   } catch (const std::exception& e) {
     throw CommandError(ExitCode::kIo, std::string("--io ") + o.io + ": " + e.what());
   }
@@ -241,7 +237,7 @@ runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionR
   if (const auto policy = scheduler::ParseOverrunPolicy(o.overrun_policy)) {
     config.executive.overrun_policy = *policy;
   } else {
-    Usage("--overrun-policy '" + o.overrun_policy + "': use 'catch-up' or 'skip'");
+    ThrowUsage("--overrun-policy '" + o.overrun_policy + "': use 'catch-up' or 'skip'");
   }
   config.qos = MakeQosConfig(o, role, planned);
   config.rt.fifo_priority = o.priority;
@@ -255,7 +251,7 @@ runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionR
     config.peer =
         runtime::PeerWait{link, o.wait_peer_s, std::string(role.peer_command) + " --io " + o.io};
   } else if (o.wait_peer_s != SessionOptions{}.wait_peer_s && o.wait_peer_s != 0.0) {
-    Usage(
+    ThrowUsage(
         "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a real "
         "board's peer cannot be seen from here (drop --wait-peer)");
   }
@@ -289,7 +285,7 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
   try {
     session.emplace(std::move(config), task);
   } catch (const kernel_glue::OutputFileError& e) {
-    Usage(e.MessageFor(!timing_log_path.empty() && e.path() == timing_log_path ? "--timing-log"
+    ThrowUsage(e.MessageFor(!timing_log_path.empty() && e.path() == timing_log_path ? "--timing-log"
                                                                                 : "--log"));
   } catch (const tracing::LogWriteError& e) {
     // The path was fine, the disk is not (already full, an I/O error): exit 5, not usage.
@@ -297,13 +293,13 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
                         std::string(e.what()).find(timing_log_quoted) != std::string::npos;
     throw CommandError(ExitCode::kIo, std::string(timing ? "--timing-log: " : "--log: ") + e.what());
   } catch (const std::invalid_argument& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   } catch (const runtime::TelemetryError& e) {
-    Usage(std::string("telemetry: ") + e.what());
+    ThrowUsage(std::string("telemetry: ") + e.what());
   } catch (const std::runtime_error& e) {
     const bool timing = timing_log_quoted != "''" &&
                         std::string(e.what()).find(timing_log_quoted) != std::string::npos;
-    Usage(std::string(timing ? "--timing-log: " : "--log: ") + e.what());
+    ThrowUsage(std::string(timing ? "--timing-log: " : "--log: ") + e.what());
   }
   return session->Run();
 }
@@ -313,7 +309,7 @@ ReportFile::ReportFile(std::string path) : path_(std::move(path)) {
   try {
     fd_ = kernel_glue::OpenOutputFile(path_, "--report");  // a link or a missing folder: exit 2
   } catch (const kernel_glue::OutputFileError& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   }
 }
 

@@ -31,25 +31,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 /// A folder for a new recording: created when missing, refused when it already holds files
 /// (LTTng would mix two runs' streams, and the report would describe neither).
 void PrepareOutputDir(const std::string& dir) {
-  if (dir.empty()) Usage("--output DIR is required: the folder the trace and its report go to");
+  if (dir.empty()) ThrowUsage("--output DIR is required: the folder the trace and its report go to");
   std::error_code ec;
   if (fs::exists(dir, ec)) {
-    if (!fs::is_directory(dir, ec)) Usage("--output " + dir + ": exists and is not a folder");
+    if (!fs::is_directory(dir, ec)) ThrowUsage("--output " + dir + ": exists and is not a folder");
     if (!fs::is_empty(dir, ec)) {
-      Usage("--output " + dir +
+      ThrowUsage("--output " + dir +
             ": the folder already holds files; choose a new folder or remove its contents");
     }
     return;
   }
   if (!fs::create_directories(dir, ec)) {
-    Usage("--output " + dir + ": cannot create the folder: " + ec.message());
+    ThrowUsage("--output " + dir + ": cannot create the folder: " + ec.message());
   }
 }
 
@@ -224,11 +220,11 @@ int AnalyzeTrace(const TraceOptions& o) {
     if (is_folder && analysis::HasKernelTrace(path)) kernel = analysis::ReadKernelTrace(path);
     const analysis::JitterReport report = Analyze(trace, kernel ? &*kernel : nullptr);
     fs::create_directories(dir, ec);
-    if (ec) Usage("--output " + dir + ": cannot create the folder: " + ec.message());
+    if (ec) ThrowUsage("--output " + dir + ": cannot create the folder: " + ec.message());
     WriteOutputs(report, trace, dir);
     for (const std::string& warning : report.warnings) spdlog::warn("{}", warning);
   } catch (const analysis::TraceReadError& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   }
   return static_cast<int>(ExitCode::kPass);
 }

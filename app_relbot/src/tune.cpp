@@ -24,10 +24,6 @@
 namespace hiltwin::app {
 namespace {
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 bool IsVirtual(const TuneOptions& o) { return o.clock == "virtual"; }
 
 bool AllInjected(const TuneOptions& o) {
@@ -41,12 +37,12 @@ kernel_glue::TimeNs NsOfUs(double us) {
 void CheckInjection(const std::optional<double>& us, const char* flag, const TuneOptions& o) {
   if (!us) return;
   if (!IsVirtual(o)) {
-    Usage(std::string(flag) +
+    ThrowUsage(std::string(flag) +
           ": injected costs replace measurements on the virtual clock only; "
           "add --clock virtual, or drop it to measure this machine");
   }
   if (!std::isfinite(*us) || *us < 0.0 || *us > 1e6) {
-    Usage(std::string(flag) + " " + Num(*us) + ": must be 0 .. 1000000 microseconds");
+    ThrowUsage(std::string(flag) + " " + Num(*us) + ": must be 0 .. 1000000 microseconds");
   }
 }
 
@@ -57,7 +53,7 @@ void CheckModelRunsAt(const TuneOptions& o, double rate_hz) {
   LoadTwinConfiguration(TwinOptionsFor(o, rate_hz, o.validate_seconds, true), twin);
   const double max_step_s = RelbotMaxStableStepS(twin.params, twin.integrator);
   if (1.0 / rate_hz > max_step_s) {
-    Usage("--candidates: " + Num(rate_hz) + " Hz is too slow for the " +
+    ThrowUsage("--candidates: " + Num(rate_hz) + " Hz is too slow for the " +
           std::string(IntegratorName(twin.integrator)) + " integrator to run this model stably " +
           "(it needs at least " + Num(std::ceil(1.0 / max_step_s)) +
           " Hz); drop it or choose another --integrator");
@@ -298,29 +294,29 @@ TwinRunOptions TwinOptionsFor(const TuneOptions& o, double rate_hz, double secon
 void CheckTuneOptions(const TuneOptions& o) {
   if (!std::isfinite(o.controller_rate_hz) || o.controller_rate_hz <= 0.0 ||
       o.controller_rate_hz > scheduler::kMaxRateHz) {
-    Usage("--controller-rate " + Num(o.controller_rate_hz) +
+    ThrowUsage("--controller-rate " + Num(o.controller_rate_hz) +
           ": must be a rate in Hz above 0 and at most 50000 (the thesis's ECS runs at 1000)");
   }
   if (!std::isfinite(o.tolerance_m) || o.tolerance_m <= 0.0) {
-    Usage("--tolerance-m " + Num(o.tolerance_m) +
+    ThrowUsage("--tolerance-m " + Num(o.tolerance_m) +
           ": must be a positive distance in metres (default 0.0001 = 0.1 mm)");
   }
   try {
     analysis::CheckCandidateRates(o.candidates_hz, scheduler::kMaxRateHz);
   } catch (const std::invalid_argument& e) {
-    Usage(std::string("--candidates: ") + e.what());
+    ThrowUsage(std::string("--candidates: ") + e.what());
   }
   if (o.candidates_hz.front() < o.controller_rate_hz) {
-    Usage("--candidates: " + Num(o.candidates_hz.front()) + " Hz is below --controller-rate " +
+    ThrowUsage("--candidates: " + Num(o.candidates_hz.front()) + " Hz is below --controller-rate " +
           Num(o.controller_rate_hz) +
           " Hz; a twin slower than its controller cannot answer every sample");
   }
   if (!std::isfinite(o.validate_seconds) || o.validate_seconds < 0.1 ||
       o.validate_seconds > 3600.0) {
-    Usage("--validate-seconds " + Num(o.validate_seconds) + ": must be 0.1 .. 3600");
+    ThrowUsage("--validate-seconds " + Num(o.validate_seconds) + ": must be 0.1 .. 3600");
   }
   if (!std::isfinite(o.latency_seconds) || o.latency_seconds < 0.1 || o.latency_seconds > 600.0) {
-    Usage("--latency-seconds " + Num(o.latency_seconds) + ": must be 0.1 .. 600");
+    ThrowUsage("--latency-seconds " + Num(o.latency_seconds) + ": must be 0.1 .. 600");
   }
   CheckInjection(o.inject_compute_us, "--inject-compute-us", o);
   CheckInjection(o.inject_overhead_us, "--inject-overhead-us", o);

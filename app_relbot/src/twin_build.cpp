@@ -13,10 +13,6 @@
 namespace hiltwin::app {
 namespace {
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 constexpr std::string_view kFmuPrefix = "fmu:";
 
 std::string KnownPlants() {
@@ -35,7 +31,7 @@ std::unique_ptr<plant::Plant> OpenPlant(const TwinRunOptions& o,
   }
   const plant::PlantEntry* entry = plant::FindPlant(o.plant);
   if (entry == nullptr) {
-    Usage("--plant " + o.plant + ": no such plant; the plants are:" + KnownPlants());
+    ThrowUsage("--plant " + o.plant + ": no such plant; the plants are:" + KnownPlants());
   }
   *entry_out = entry;
   return entry->make(options);
@@ -51,11 +47,11 @@ void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin) {
     }
     twin.profile.emplace(LoadInputProfile(o.input));
   } catch (const ConfigError& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   } catch (const ProfileError& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   } catch (const std::invalid_argument& e) {
-    Usage(e.what());
+    ThrowUsage(e.what());
   }
 }
 
@@ -70,15 +66,15 @@ TwinPlant MakeTwinPlant(const TwinRunOptions& o) {
     } else if (entry != nullptr && entry->default_map) {
       out.map = entry->default_map(*out.plant);
     } else {
-      Usage("--plant " + o.plant + " needs --plant-map FILE.toml: which PWM channel drives which "
+      ThrowUsage("--plant " + o.plant + " needs --plant-map FILE.toml: which PWM channel drives which "
             "of its inputs and which output each encoder follows (docs/plants.md)");
     }
     out.bound = plant::BindPlantMap(out.map, *out.plant);  // refused now, before the board opens
     return out;
   } catch (const plant::PlantError& e) {
-    Usage("--plant " + o.plant + ": " + e.what());
+    ThrowUsage("--plant " + o.plant + ": " + e.what());
   } catch (const plant::PlantMapError& e) {
-    Usage("--plant-map: " + std::string(e.what()));
+    ThrowUsage("--plant-map: " + std::string(e.what()));
   }
 }
 
@@ -95,7 +91,7 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   } catch (const plant::PlantError& e) {
     // A plant that names the flag itself (a 20-sim step mismatch) is quoted as it is.
     const std::string why = e.what();
-    Usage(why.starts_with("--rate") ? why : "--rate " + Num(o.session.rate_hz) + ": " + why);
+    ThrowUsage(why.starts_with("--rate") ? why : "--rate " + Num(o.session.rate_hz) + ": " + why);
   }
   twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
   twin->pwm_source =

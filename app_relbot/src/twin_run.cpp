@@ -25,15 +25,11 @@
 namespace hiltwin::app {
 namespace {
 
-[[noreturn]] void Usage(const std::string& message) {
-  throw CommandError(ExitCode::kUsage, message);
-}
-
 void Validate(const TwinRunOptions& o) {
   ValidateSessionOptions(o.session);
   if (!std::isfinite(o.controller_rate_hz) || o.controller_rate_hz <= 0.0 ||
       o.controller_rate_hz > o.session.rate_hz) {
-    Usage("--input-rate: the controller rate must be positive and not above --rate (" +
+    ThrowUsage("--input-rate: the controller rate must be positive and not above --rate (" +
           Num(o.session.rate_hz) + " Hz)");
   }
 }
@@ -74,7 +70,7 @@ runtime::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
   runtime::LinkFaultSchedule schedule;
   if (o.inject_link_faults.empty()) return schedule;
   if (o.session.io != "mock" && o.session.io.rfind("wire:", 0) != 0) {
-    Usage("--inject-link-fault needs an emulated board (--io mock or wire:NAME), not --io " +
+    ThrowUsage("--inject-link-fault needs an emulated board (--io mock or wire:NAME), not --io " +
           o.session.io);
   }
   try {
@@ -82,7 +78,7 @@ runtime::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
       schedule.Add(runtime::ParseLinkFaultInjection(spec));
     schedule.CheckFiresWithin(PlannedCycles(o.session));
   } catch (const std::exception& e) {
-    Usage(std::string("--inject-link-fault ") + e.what());
+    ThrowUsage(std::string("--inject-link-fault ") + e.what());
   }
   return schedule;
 }

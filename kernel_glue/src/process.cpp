@@ -23,7 +23,7 @@ extern char** environ;
 namespace hiltwin::kernel_glue {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using SteadyClock = std::chrono::steady_clock;
 
 // How often a wait with a deadline and no pipes to watch looks at the child again.
 constexpr std::chrono::milliseconds kWaitTick{2};
@@ -195,9 +195,9 @@ ExitStatus ReapBlocking(pid_t pid) {
   return ExitStatus::FromWaitStatus(status);
 }
 
-int PollTimeoutMs(std::optional<Clock::time_point> deadline) {
+int PollTimeoutMs(std::optional<SteadyClock::time_point> deadline) {
   if (!deadline) return kPollTickMs;
-  const auto left = std::chrono::ceil<std::chrono::milliseconds>(*deadline - Clock::now());
+  const auto left = std::chrono::ceil<std::chrono::milliseconds>(*deadline - SteadyClock::now());
   return static_cast<int>(std::clamp<std::chrono::milliseconds::rep>(left.count(), 0, kPollTickMs));
 }
 
@@ -321,7 +321,7 @@ void Process::CloseFds() noexcept {
 ExitStatus Process::Wait() { return *Await(std::nullopt); }
 
 std::optional<ExitStatus> Process::WaitFor(std::chrono::milliseconds timeout) {
-  return Await(Clock::now() + timeout);
+  return Await(SteadyClock::now() + timeout);
 }
 
 ExitStatus Process::Kill(int signal) {
@@ -334,12 +334,12 @@ ProcessResult Process::TakeResult(const ExitStatus& status) {
   return ProcessResult{status, std::move(out_), std::move(err_)};
 }
 
-std::optional<ExitStatus> Process::Await(std::optional<Clock::time_point> deadline) {
+std::optional<ExitStatus> Process::Await(std::optional<SteadyClock::time_point> deadline) {
   if (pid_ <= 0) throw std::logic_error("Process: the child was already reaped");
   for (;;) {
     // Once the deadline has passed, one more look without blocking, so a child that ended
     // during the last tick is not reported as still running.
-    const bool last_look = deadline && Clock::now() >= *deadline;
+    const bool last_look = deadline && SteadyClock::now() >= *deadline;
     std::optional<ExitStatus> status;
     if (out_fd_ >= 0 || err_fd_ >= 0) {
       // Both pipes at once, so a child filling one while we block on the other cannot stall.

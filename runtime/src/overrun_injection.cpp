@@ -7,16 +7,16 @@
 namespace hiltwin::runtime {
 namespace {
 
-constexpr const char* kForms =
+constexpr const char* kOverrunForms =
     "accepted forms: 'at=K[,count=N],extra-us=US' or 'every=P[,offset=O],extra-us=US', "
     "e.g. 'at=40000,count=5,extra-us=600' or 'every=1000,extra-us=300'";
 
-[[noreturn]] void Fail(std::string_view spec, const std::string& what) {
-  throw std::invalid_argument("'" + std::string(spec) + "': " + what + "; " + kForms);
+[[noreturn]] void FailOverrun(std::string_view spec, const std::string& what) {
+  throw std::invalid_argument("'" + std::string(spec) + "': " + what + "; " + kOverrunForms);
 }
 
 std::uint64_t ParseCount(std::string_view spec, std::string_view key, std::string_view text) {
-  return spec_items::WholeOf(key, text, [&](const std::string& what) { Fail(spec, what); });
+  return spec_items::WholeOf(key, text, [&](const std::string& what) { FailOverrun(spec, what); });
 }
 
 }  // namespace
@@ -27,7 +27,7 @@ OverrunInjection ParseOverrunInjection(std::string_view spec) {
        have_offset = false;
   spec_items::ForEachItem(spec, [&](std::string_view item) {
     const std::size_t eq = item.find('=');
-    if (eq == std::string_view::npos) Fail(spec, "'" + std::string(item) + "' is not key=value");
+    if (eq == std::string_view::npos) FailOverrun(spec, "'" + std::string(item) + "' is not key=value");
     const std::string_view key = item.substr(0, eq);
     const std::string_view value = item.substr(eq + 1);
     if (key == "at") {
@@ -44,21 +44,21 @@ OverrunInjection ParseOverrunInjection(std::string_view spec) {
       have_offset = true;
     } else if (key == "extra-us") {
       const std::uint64_t extra_us = ParseCount(spec, key, value);
-      if (extra_us == 0 || extra_us > 10'000'000) Fail(spec, "extra-us must be 1 .. 10000000 µs");
+      if (extra_us == 0 || extra_us > 10'000'000) FailOverrun(spec, "extra-us must be 1 .. 10000000 µs");
       injection.extra_ns = static_cast<kernel_glue::TimeNs>(extra_us) * kernel_glue::kNsPerUs;
       have_extra = true;
     } else {
-      Fail(spec, "unknown key '" + std::string(key) + "'");
+      FailOverrun(spec, "unknown key '" + std::string(key) + "'");
     }
   });
-  if (have_at == have_every) Fail(spec, "give exactly one of 'at=' and 'every='");
-  if (!have_extra) Fail(spec, "'extra-us=' is required");
-  if (have_at && have_offset) Fail(spec, "'offset=' goes with 'every='");
-  if (have_every && have_count) Fail(spec, "'count=' goes with 'at='");
-  if (have_at && injection.count == 0) Fail(spec, "count must be at least 1");
+  if (have_at == have_every) FailOverrun(spec, "give exactly one of 'at=' and 'every='");
+  if (!have_extra) FailOverrun(spec, "'extra-us=' is required");
+  if (have_at && have_offset) FailOverrun(spec, "'offset=' goes with 'every='");
+  if (have_every && have_count) FailOverrun(spec, "'count=' goes with 'at='");
+  if (have_at && injection.count == 0) FailOverrun(spec, "count must be at least 1");
   if (have_every) {
-    if (injection.every == 0) Fail(spec, "every must be at least 1");
-    if (injection.offset >= injection.every) Fail(spec, "offset must be less than every");
+    if (injection.every == 0) FailOverrun(spec, "every must be at least 1");
+    if (injection.offset >= injection.every) FailOverrun(spec, "offset must be less than every");
     injection.kind = OverrunInjection::Kind::kEvery;
   }
   return injection;

@@ -34,7 +34,7 @@ using std::chrono::milliseconds;
 constexpr milliseconds kSpawnTimeout{10'000};  // --daemonize returns once the daemon is ready
 constexpr milliseconds kAliveTimeout{5'000};
 constexpr milliseconds kExitTimeout{5'000};  // it stops its consumer daemons first
-constexpr milliseconds kPollTick{20};
+constexpr milliseconds kDaemonPollTick{20};
 
 constexpr const char* kWhatToDo =
     "start one with `lttng-sessiond --daemonize` as root, or join the `tracing` group "
@@ -94,7 +94,7 @@ bool WaitUntil(milliseconds timeout, const auto& done) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (!done()) {
     if (std::chrono::steady_clock::now() >= deadline) return false;
-    std::this_thread::sleep_for(kPollTick);
+    std::this_thread::sleep_for(kDaemonPollTick);
   }
   return true;
 }

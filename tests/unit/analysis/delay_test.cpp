@@ -10,7 +10,7 @@ namespace hiltwin::analysis {
 namespace {
 
 // A position-like curve: a ramp with smooth wiggles, like a wheel driven by a varying duty.
-double Position(double t_s) {
+double WigglyRamp(double t_s) {
   return 0.3 * t_s + 0.2 * std::sin(2.1 * t_s) + 0.05 * std::sin(7.3 * t_s + 0.4) +
          0.02 * std::cos(13.7 * t_s);
 }
@@ -29,8 +29,8 @@ TEST_P(DelayRecovery, FindsTheShift) {
   std::vector<double> exp(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * c.step_s;
-    sim[i] = Position(t);
-    exp[i] = Position(t - c.delay_s);  // the experiment lags by delay_s
+    sim[i] = WigglyRamp(t);
+    exp[i] = WigglyRamp(t - c.delay_s);  // the experiment lags by delay_s
   }
   const DelayEstimate d = EstimateDelay(sim, exp, c.step_s, 0.5);
   EXPECT_NEAR(d.delay_s, c.delay_s, 0.02 * c.step_s) << "delay " << c.delay_s;
@@ -44,7 +44,7 @@ INSTANTIATE_TEST_SUITE_P(Shifts, DelayRecovery,
 
 TEST(Delay, IdenticalCurvesHaveNoDelay) {
   std::vector<double> y(1000);
-  for (std::size_t i = 0; i < y.size(); ++i) y[i] = Position(0.01 * static_cast<double>(i));
+  for (std::size_t i = 0; i < y.size(); ++i) y[i] = WigglyRamp(0.01 * static_cast<double>(i));
   const DelayEstimate d = EstimateDelay(y, y, 0.01, 1.0);
   EXPECT_NEAR(d.delay_s, 0.0, 1e-9);
   EXPECT_NEAR(d.spread_at_delay, 0.0, 1e-12);
@@ -56,8 +56,8 @@ TEST(Delay, ReportsTheSearchLimit) {
   std::vector<double> exp(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * 1e-3;
-    sim[i] = Position(t);
-    exp[i] = Position(t - 0.05);
+    sim[i] = WigglyRamp(t);
+    exp[i] = WigglyRamp(t - 0.05);
   }
   const DelayEstimate d = EstimateDelay(sim, exp, 1e-3, 0.01);  // 10 ms range, 50 ms delay
   EXPECT_TRUE(d.at_search_limit);
@@ -71,8 +71,8 @@ TEST(Delay, LargeOffsetDoesNotSpoilPrecision) {
   std::vector<double> exp(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * 1e-3;
-    sim[i] = 1000.0 + Position(t);
-    exp[i] = 1000.0 + Position(t - 0.0026);
+    sim[i] = 1000.0 + WigglyRamp(t);
+    exp[i] = 1000.0 + WigglyRamp(t - 0.0026);
   }
   EXPECT_NEAR(EstimateDelay(sim, exp, 1e-3, 0.1).delay_s, 0.0026, 2e-5);
 }
@@ -83,11 +83,11 @@ TEST(Delay, ConstantOffsetIsNotMistakenForADelay) {
   std::vector<double> exp(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * 1e-3;
-    sim[i] = Position(t) + 0.05;  // offset, no shift
-    exp[i] = Position(t);
+    sim[i] = WigglyRamp(t) + 0.05;  // offset, no shift
+    exp[i] = WigglyRamp(t);
   }
   EXPECT_NEAR(EstimateDelay(sim, exp, 1e-3, 0.5).delay_s, 0.0, 1e-6);
-  for (std::size_t i = 0; i < n; ++i) exp[i] = Position(static_cast<double>(i) * 1e-3 - 0.0042);
+  for (std::size_t i = 0; i < n; ++i) exp[i] = WigglyRamp(static_cast<double>(i) * 1e-3 - 0.0042);
   EXPECT_NEAR(EstimateDelay(sim, exp, 1e-3, 0.5).delay_s, 0.0042, 2e-5);
 }
 
@@ -99,7 +99,7 @@ TEST(Delay, NoShiftReportsExactlyZero) {
       std::vector<double> sim(2000);
       std::vector<double> exp(2000);
       for (std::size_t i = 0; i < exp.size(); ++i) {
-        exp[i] = Position(static_cast<double>(i) * step_s);
+        exp[i] = WigglyRamp(static_cast<double>(i) * step_s);
         sim[i] = exp[i] + offset;
       }
       const DelayEstimate d = EstimateDelay(sim, exp, step_s, 200 * step_s);

@@ -15,7 +15,7 @@
 namespace hiltwin::app {
 namespace {
 
-std::string ErrorOf(const std::string& csv) {
+std::string ProfileErrorOf(const std::string& csv) {
   try {
     (void)ParseCsvProfile(csv, "p.csv");
   } catch (const ProfileError& error) {
@@ -178,7 +178,7 @@ TEST(CsvProfile, ErrorsGiveLineColumnWhatAndWhatToDo) {
       {"time,left,right\n0,0,0\n0,1,1\n", "p.csv:3:1:", "the last time is 0 s"},
   };
   for (const BadCsv& c : cases) {
-    const std::string message = ErrorOf(c.csv);
+    const std::string message = ProfileErrorOf(c.csv);
     EXPECT_EQ(message.rfind(c.where, 0), 0U) << c.csv << " -> " << message;
     EXPECT_NE(message.find(c.what), std::string::npos) << c.csv << " -> " << message;
     EXPECT_NE(message.find("; "), std::string::npos) << "no advice in: " << message;
@@ -219,14 +219,14 @@ TEST(CsvProfile, ReadsTheDutyColumnsOfAHiltwinLogAndIgnoresTheRest) {
 
 TEST(CsvProfile, LogColumnsAreCheckedLikeProfileColumns) {
   const std::string bad_duty =
-      ErrorOf("time_s,wheel_left_m,duty_left,duty_right\n0,0,0,0\n1,0,1.5,0\n");
+      ProfileErrorOf("time_s,wheel_left_m,duty_left,duty_right\n0,0,0,0\n1,0,1.5,0\n");
   EXPECT_EQ(bad_duty.rfind("p.csv:3:3: left duty 1.5 is outside [-1, 1]", 0), 0U) << bad_duty;
   // Only one of the two duty columns: not a log, and not a profile either.
-  const std::string half = ErrorOf("time_s,duty_left,wheel_left_m\n0,0,0\n1,0,0\n");
+  const std::string half = ProfileErrorOf("time_s,duty_left,wheel_left_m\n0,0,0\n1,0,0\n");
   EXPECT_EQ(half.rfind("p.csv:1:2: expected the header 'time,left,right' (or a hiltwin log", 0),
             0U)
       << half;
-  const std::string no_time = ErrorOf("cycle,duty_left,duty_right\n0,0,0\n1,0,0\n");
+  const std::string no_time = ProfileErrorOf("cycle,duty_left,duty_right\n0,0,0\n1,0,0\n");
   EXPECT_EQ(no_time.rfind("p.csv:1:1:", 0), 0U) << no_time;
 }
 

@@ -9,7 +9,7 @@
 namespace hiltwin::app {
 namespace {
 
-constexpr double kStepS = 2.5e-4;   // 4 kHz twin
+constexpr double kReferenceStepS = 2.5e-4;   // 4 kHz twin
 constexpr double kHoldS = 1.0e-3;   // inputs from a 1 kHz controller, as in `hiltwin run`
 
 double MaxWheelError(const std::vector<RelbotOutputs>& a, const std::vector<RelbotOutputs>& b) {
@@ -29,9 +29,9 @@ TEST(RelbotReference, Rk4At4kHzMatchesDopri5OverTheOpenLoopProfile) {
   const double duration_s = profile.period_s();
   const auto start = std::chrono::steady_clock::now();
   const std::vector<RelbotOutputs> reference =
-      SimulateReference(params, profile, duration_s, kStepS, {kHoldS, 1e-10, 1e-10});
+      SimulateReference(params, profile, duration_s, kReferenceStepS, {kHoldS, 1e-10, 1e-10});
   const auto reference_done = std::chrono::steady_clock::now();
-  RelbotModel model(params, Integrator::kRk4, kStepS);
+  RelbotModel model(params, Integrator::kRk4, kReferenceStepS);
   const std::vector<RelbotOutputs> twin = SimulateFixedStep(model, profile, duration_s, kHoldS);
 
   ASSERT_EQ(reference.size(), 144000U);
@@ -57,9 +57,9 @@ TEST(RelbotReference, EulerAt4kHzIsFarLessAccurate) {
   const RelbotParams params;
   const InputProfile profile = OpenLoopProfile();
   const double duration_s = 10.0;
-  const auto reference = SimulateReference(params, profile, duration_s, kStepS, {kHoldS});
-  RelbotModel euler(params, Integrator::kEuler, kStepS);
-  RelbotModel rk4(params, Integrator::kRk4, kStepS);
+  const auto reference = SimulateReference(params, profile, duration_s, kReferenceStepS, {kHoldS});
+  RelbotModel euler(params, Integrator::kEuler, kReferenceStepS);
+  RelbotModel rk4(params, Integrator::kRk4, kReferenceStepS);
   const double euler_rms = RmsWheelPositionError(
       SimulateFixedStep(euler, profile, duration_s, kHoldS), reference);
   const double rk4_rms =
@@ -104,8 +104,8 @@ TEST(RelbotReference, IntegratorsConvergeWithTheirOrder) {
 TEST(RelbotReference, ReferenceHasConverged) {
   const RelbotParams params;
   const InputProfile profile = OpenLoopProfile();
-  const auto normal = SimulateReference(params, profile, 3.0, kStepS, {kHoldS, 1e-10, 1e-10});
-  const auto tighter = SimulateReference(params, profile, 3.0, kStepS, {kHoldS, 1e-13, 1e-13});
+  const auto normal = SimulateReference(params, profile, 3.0, kReferenceStepS, {kHoldS, 1e-10, 1e-10});
+  const auto tighter = SimulateReference(params, profile, 3.0, kReferenceStepS, {kHoldS, 1e-13, 1e-13});
   EXPECT_LT(MaxWheelError(normal, tighter), 1e-8);
 }
 

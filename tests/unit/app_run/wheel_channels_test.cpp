@@ -24,7 +24,7 @@ namespace hiltwin::app {
 namespace {
 
 constexpr std::int64_t kStepNs = 250'000;  // 4 kHz, the thesis's preferred twin rate
-constexpr std::uint64_t kCycles = 1'600;   // 0.4 s: less than a quarter turn, so signs are clear
+constexpr std::uint64_t kChannelCycles = 1'600;   // 0.4 s: less than a quarter turn, so signs are clear
 constexpr std::int32_t kPwm = 1400;        // duty 1400/2048 = 0.68 on the one driven channel
 
 /// An ECS board and a twin board wired to each other, each with its own driver; the twin's
@@ -64,13 +64,13 @@ struct HilRig {
 /// What one asymmetric run ended with.
 struct DriveResult {
   Duty duty_read;                                  ///< what the twin's model was given, last cycle
-  RelbotOutputs halfway;                           ///< outputs after kCycles / 2
-  RelbotOutputs end;                               ///< outputs after kCycles
+  RelbotOutputs halfway;                           ///< outputs after kChannelCycles / 2
+  RelbotOutputs end;                               ///< outputs after kChannelCycles
   std::array<std::int32_t, io::kChannels> sent{};  ///< counts the twin sent last, by index
   std::array<std::int64_t, io::kChannels> ecs_read{};  ///< what the ECS decoded from them
 };
 
-/// Runs kCycles with PWM `kPwm` on board index `driven` only, then lets the ECS read the last
+/// Runs kChannelCycles with PWM `kPwm` on board index `driven` only, then lets the ECS read the last
 /// positions the twin sent (two more ECS frames: the emulator pulses each position over the
 /// period after it was sent, and the twin's last exchange went out after the last cycle).
 DriveResult DriveOneChannel(std::size_t driven) {
@@ -78,9 +78,9 @@ DriveResult DriveOneChannel(std::size_t driven) {
   std::array<std::int32_t, io::kChannels> pwm{};
   pwm[driven] = kPwm;
   DriveResult drive;
-  for (std::uint64_t k = 0; k < kCycles; ++k) {
+  for (std::uint64_t k = 0; k < kChannelCycles; ++k) {
     rig.Cycle(pwm, k);
-    if (k + 1 == kCycles / 2) drive.halfway = rig.relbot.outputs();
+    if (k + 1 == kChannelCycles / 2) drive.halfway = rig.relbot.outputs();
   }
   drive.duty_read = rig.relbot.duty();
   drive.end = rig.relbot.outputs();

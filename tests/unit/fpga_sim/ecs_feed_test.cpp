@@ -18,9 +18,9 @@
 namespace hiltwin::fpga_sim::test {
 namespace {
 
-constexpr std::int64_t kStepNs = 250'000;
+constexpr std::int64_t kFeedStepNs = 250'000;
 
-std::size_t Mismatches(std::int64_t line_delay_clocks, int steps, std::string* first) {
+std::size_t FeedMismatches(std::int64_t line_delay_clocks, int steps, std::string* first) {
   io::EmulatedFpga twin_board(io::Image::kIcoboardInverse);
   io::EmulatorToReaderLink lines(twin_board);
   io::EmulatedSpiBus twin_bus(twin_board);
@@ -43,10 +43,10 @@ std::size_t Mismatches(std::int64_t line_delay_clocks, int steps, std::string* f
       *first += "MOSI " + Hex(mosi) + "\n  model " + Hex(a) + "\n  RTL   " + Hex(b) + "\n";
     }
   };
-  EXPECT_TRUE(twin.Init(kStepNs).ok);
-  both(Init(seq++, kStepNs, 0, io::Image::kIcoboard));
+  EXPECT_TRUE(twin.Init(kFeedStepNs).ok);
+  both(Init(seq++, kFeedStepNs, 0, io::Image::kIcoboard));
   both(Noop(seq++));
-  const auto limit = static_cast<std::int64_t>(io::MaxCountsPerStep(kStepNs, twin.clock_divider()));
+  const auto limit = static_cast<std::int64_t>(io::MaxCountsPerStep(kFeedStepNs, twin.clock_divider()));
   std::mt19937_64 rng(42);
   std::uniform_int_distribution<std::int64_t> small(-300, 300);
   std::uniform_int_distribution<std::int64_t> large(-limit, limit);
@@ -68,12 +68,12 @@ std::size_t Mismatches(std::int64_t line_delay_clocks, int steps, std::string* f
 
 TEST(EcsFedByTheModelTwin, DecodersCountExactlyWhatTheModelReadersCount) {
   std::string first;
-  EXPECT_EQ(Mismatches(DeviceTiming{}.line_delay_clocks, 2000, &first), 0U) << first;
+  EXPECT_EQ(FeedMismatches(DeviceTiming{}.line_delay_clocks, 2000, &first), 0U) << first;
   // The window of line delays for which every answer matches (the default sits inside it).
   std::int64_t low = 0;
   std::int64_t high = 0;
   for (std::int64_t d = 300; d <= 330; ++d) {
-    if (Mismatches(d, 200, nullptr) == 0) {
+    if (FeedMismatches(d, 200, nullptr) == 0) {
       if (low == 0) low = d;
       high = d;
     }

@@ -18,7 +18,7 @@
 namespace hiltwin::fpga_sim::test {
 namespace {
 
-constexpr std::uint32_t kStepNs = 250'000;  // room for long runs of non-ALL transfers
+constexpr std::uint32_t kEquivalenceStepNs = 250'000;  // room for long runs of non-ALL transfers
 
 class ConstantDuty final : public io::PwmSignalSource {
  public:
@@ -37,7 +37,7 @@ class Script {
     if (fetch_after) frames_.push_back(Noop(Seq()));
   }
   std::uint8_t Seq() { return sequence_++; }
-  void ValidInit() { Request(Init(Seq(), kStepNs, io::ClockDividerForStep(kStepNs), image_), true); }
+  void ValidInit() { Request(Init(Seq(), kEquivalenceStepNs, io::ClockDividerForStep(kEquivalenceStepNs), image_), true); }
 
   std::vector<io::FrameBytes> Make(int actions) {
     ValidInit();

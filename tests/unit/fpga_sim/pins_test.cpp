@@ -14,7 +14,7 @@
 namespace hiltwin::fpga_sim::test {
 namespace {
 
-constexpr std::uint32_t kStepNs = 200'000;  // 20,000 clocks: D = 4, S = 5,000
+constexpr std::uint32_t kPinsStepNs = 200'000;  // 20,000 clocks: D = 4, S = 5,000
 
 /// Per ALL, the targets of the four channels (relative counts).
 const std::vector<std::array<std::int32_t, 4>> kTargets = {
@@ -54,14 +54,14 @@ std::array<std::vector<ChannelEdge>, 4> SplitByChannel(const std::vector<OutputE
 TEST(Pins, EncoderEdgesMatchThePulseSegmentsEdgeForEdge) {
   RtlBench bench(true, false, false);
   VerilatedBoardDevice device(bench, io::Image::kIcoboardInverse);
-  const std::uint32_t divider = io::ClockDividerForStep(kStepNs);
+  const std::uint32_t divider = io::ClockDividerForStep(kPinsStepNs);
   ASSERT_EQ(divider, 4U);
   io::FrameBytes miso{};
   std::uint8_t seq = 0;
-  device.Exchange(Init(seq++, kStepNs, divider, io::Image::kIcoboardInverse), miso);
+  device.Exchange(Init(seq++, kPinsStepNs, divider, io::Image::kIcoboardInverse), miso);
   device.Exchange(Noop(seq++), miso);
   std::array<io::EncoderEmulator, 4> model;
-  for (auto& m : model) ASSERT_TRUE(m.Configure(kStepNs, divider));
+  for (auto& m : model) ASSERT_TRUE(m.Configure(kPinsStepNs, divider));
   bench.StartRecording();
   // Expected edges in model time (ns from the origin) and the position after each.
   std::array<std::vector<std::pair<std::int64_t, std::int64_t>>, 4> expected;
@@ -73,7 +73,7 @@ TEST(Pins, EncoderEdgesMatchThePulseSegmentsEdgeForEdge) {
     device.Exchange(Noop(seq++), miso);
     ASSERT_EQ(miso[10] & io::kStatusPulseLimit, 0) << "ALL " << k;
     for (std::size_t c = 0; c < 4; ++c) {
-      ASSERT_TRUE(model[c].StartPeriod(targets[c], static_cast<std::int64_t>(k) * kStepNs));
+      ASSERT_TRUE(model[c].StartPeriod(targets[c], static_cast<std::int64_t>(k) * kPinsStepNs));
       ++cases[static_cast<std::size_t>(model[c].last_case())];
       const io::PulseSegment& s = model[c].segment();
       for (std::uint32_t j = 1; j <= s.pulses; ++j) {

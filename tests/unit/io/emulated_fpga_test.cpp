@@ -15,7 +15,7 @@
 namespace hiltwin::io {
 namespace {
 
-constexpr std::int64_t kStepNs = 250'000;  // 4 kHz
+constexpr std::int64_t kFpgaStepNs = 250'000;  // 4 kHz
 
 /// Duty that depends on time, so the test can tell which instant the board sampled.
 class RampSource final : public PwmSignalSource {
@@ -40,15 +40,15 @@ struct TwinRig {
 
 TEST(IcoBoardInverse, InitChecksIdentityAndSendsStepAndDivider) {
   TwinRig rig;
-  const InitResult init = rig.driver.Init(kStepNs);
+  const InitResult init = rig.driver.Init(kFpgaStepNs);
   ASSERT_TRUE(init.ok) << init.message;
   EXPECT_TRUE(init.image_known);
   EXPECT_EQ(init.found, Image::kIcoboardInverse);
   EXPECT_EQ(init.identity, kIdentityIcoboardInverse);
-  EXPECT_EQ(init.clock_divider, ClockDividerForStep(kStepNs));
+  EXPECT_EQ(init.clock_divider, ClockDividerForStep(kFpgaStepNs));
   EXPECT_TRUE(rig.board.initialised());
-  EXPECT_EQ(rig.board.step_ns(), kStepNs);
-  EXPECT_EQ(rig.board.clock_divider(), ClockDividerForStep(kStepNs));
+  EXPECT_EQ(rig.board.step_ns(), kFpgaStepNs);
+  EXPECT_EQ(rig.board.clock_divider(), ClockDividerForStep(kFpgaStepNs));
   // INIT is counted apart: frames_sent and frames_received are data frames only.
   EXPECT_EQ(rig.driver.counters().init_frames_sent, 1U);
   EXPECT_EQ(rig.driver.counters().init_frames_received, 1U);
@@ -61,7 +61,7 @@ TEST(IcoBoardInverse, WrongImageFailsWithTheThesisStyleMessage) {
   EmulatedFpga ecs_board(Image::kIcoboard);
   EmulatedSpiBus bus(ecs_board);
   IcoBoardInverse twin(bus);
-  const InitResult init = twin.Init(kStepNs);
+  const InitResult init = twin.Init(kFpgaStepNs);
   EXPECT_FALSE(init.ok);
   EXPECT_EQ(init.found, Image::kIcoboard);
   EXPECT_EQ(init.message.rfind("Failed to initialise FPGA: found icoboard, the twin needs "
@@ -81,27 +81,27 @@ TEST(IcoBoardInverse, WrongImageFailsWithTheThesisStyleMessage) {
   // The fault hook: a board that answers as the other image.
   TwinRig rig;
   rig.board.faults().answer_as_image = Image::kIcoboard;
-  EXPECT_FALSE(rig.driver.Init(kStepNs).ok);
+  EXPECT_FALSE(rig.driver.Init(kFpgaStepNs).ok);
 }
 
 TEST(IcoBoardInverse, ExchangeCarriesValuesAndBoardTimeIsFramesTimesStep) {
   TwinRig rig;
   RampSource source;
   rig.board.SetPwmSource(&source);
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
   TwinInputs in;
   for (int k = 0; k < 50; ++k) {
     const std::array<std::int32_t, kChannels> out = {k * 10, -k * 10, k * 1000, 20000 + k};
     const ExchangeStatus status = rig.driver.Exchange(out, in);
     ASSERT_TRUE(status.ok()) << status.reason;
-    const std::int64_t t_ns = k * kStepNs;
+    const std::int64_t t_ns = k * kFpgaStepNs;
     ASSERT_EQ(source.times.back(), t_ns);
     for (std::size_t c = 0; c < kChannels; ++c) {
       const std::int32_t expected = PwmReaderValue(RampSource::Duty(t_ns, c));
       EXPECT_EQ(in.pwm[c], expected) << k << " " << c;
       EXPECT_DOUBLE_EQ(in.duty[c], expected / 2048.0);
       // At the end of this period the emulator has emitted the (wrapped) position sent.
-      EXPECT_EQ(rig.board.encoder(c).PositionAt(t_ns + kStepNs), WrapToRelative(out[c]));
+      EXPECT_EQ(rig.board.encoder(c).PositionAt(t_ns + kFpgaStepNs), WrapToRelative(out[c]));
     }
   }
   EXPECT_EQ(rig.board.data_frames(), 50U);
@@ -113,7 +113,7 @@ TEST(IcoBoardInverse, ExchangeCarriesValuesAndBoardTimeIsFramesTimesStep) {
 
 TEST(IcoBoardInverse, DigitalPinsTravelBothWays) {
   TwinRig rig;
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
   rig.board.SetDigitalInputs({true, false, false, true});
   rig.driver.SetDigitalOutputs({false, true, true, false});
   TwinInputs in;
@@ -126,7 +126,7 @@ TEST(IcoBoardInverse, FaultInjectionIsDetectedAndValuesAreHeld) {
   TwinRig rig;
   RampSource source;
   rig.board.SetPwmSource(&source);
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
   TwinInputs in;
   ASSERT_TRUE(rig.driver.Exchange({100, 0, 0, 0}, in).ok());
   ASSERT_TRUE(rig.driver.Exchange({100, 0, 0, 0}, in).ok());  // non-zero ramp from k = 1 on
@@ -165,9 +165,9 @@ TEST(IcoBoardInverse, FaultInjectionIsDetectedAndValuesAreHeld) {
 
   // A stuck encoder emits nothing, whatever is sent.
   rig.board.faults().stick_encoder = true;
-  const std::int32_t frozen = rig.board.encoder(0).PositionAt(rig.board.time_ns() + kStepNs);
+  const std::int32_t frozen = rig.board.encoder(0).PositionAt(rig.board.time_ns() + kFpgaStepNs);
   ASSERT_TRUE(rig.driver.Exchange({4000, 0, 0, 0}, in).ok());
-  EXPECT_EQ(rig.board.encoder(0).PositionAt(rig.board.time_ns() + kStepNs), frozen);
+  EXPECT_EQ(rig.board.encoder(0).PositionAt(rig.board.time_ns() + kFpgaStepNs), frozen);
   rig.board.faults().stick_encoder = false;
 
   // A board that lost its INIT is a fault, not a value (RESET's answer waits in the register,
@@ -185,8 +185,8 @@ TEST(IcoBoardInverse, FaultInjectionIsDetectedAndValuesAreHeld) {
 
 TEST(IcoBoardInverse, ChangesBeyondThePulseLimitAreReported) {
   TwinRig rig;
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
-  const auto limit = static_cast<std::int32_t>(MaxCountsPerStep(kStepNs, ClockDividerForStep(kStepNs)));
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
+  const auto limit = static_cast<std::int32_t>(MaxCountsPerStep(kFpgaStepNs, ClockDividerForStep(kFpgaStepNs)));
   TwinInputs in;
   ExchangeStatus s = rig.driver.Exchange({limit, 0, 0, 0}, in);
   EXPECT_TRUE(s.ok());
@@ -206,7 +206,7 @@ TEST(IcoBoardLink, EveryDamagedRequestBitIsCountedAsCorruptedNotMissed) {
   TwinRig rig;
   RampSource source;
   rig.board.SetPwmSource(&source);
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
   TwinInputs in;
   ASSERT_TRUE(rig.driver.Exchange({10, 20, 30, 40}, in).ok());
   ASSERT_TRUE(rig.driver.Exchange({10, 20, 30, 40}, in).ok());
@@ -226,8 +226,8 @@ TEST(IcoBoardLink, EveryDamagedRequestBitIsCountedAsCorruptedNotMissed) {
 
 TEST(IcoBoardInverse, AFailedExchangeDoesNotMoveThePulseLimitReference) {
   TwinRig rig;
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
-  const auto limit = static_cast<std::int32_t>(MaxCountsPerStep(kStepNs, ClockDividerForStep(kStepNs)));
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
+  const auto limit = static_cast<std::int32_t>(MaxCountsPerStep(kFpgaStepNs, ClockDividerForStep(kFpgaStepNs)));
   TwinInputs in;
   rig.board.faults().corrupt_requests = 1;
   EXPECT_EQ(rig.driver.Exchange({limit, 0, 0, 0}, in).code, ExchangeStatus::Code::kCorrupted);
@@ -246,7 +246,7 @@ TEST(IcoBoardLink, TestFrameEchoes) {
   const std::array<std::uint8_t, 8> pattern = {1, 2, 3, 4, 0xF0, 0x0F, 0xAA, 0x55};
   ASSERT_TRUE(rig.driver.Test(pattern, echo).ok());  // TEST works before INIT
   EXPECT_EQ(echo, pattern);
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
   TwinInputs in;
   ASSERT_TRUE(rig.driver.Exchange({1, 2, 3, 4}, in).ok());
   ASSERT_TRUE(rig.driver.Test(pattern, echo).ok());
@@ -306,7 +306,7 @@ TEST(EmulatedFpga, EcsAndTwinBoardsWiredInOneProcess) {
   IcoBoardInverse twin(twin_bus);
   constexpr std::int64_t kEcsStep = 1'000'000;
   ASSERT_TRUE(ecs.Init(kEcsStep).ok);
-  ASSERT_TRUE(twin.Init(kStepNs).ok);
+  ASSERT_TRUE(twin.Init(kFpgaStepNs).ok);
 
   EcsInputs ecs_in;
   TwinInputs twin_in;
@@ -335,13 +335,13 @@ TEST(IcoBoard, PerCycleExchangeAllocatesNothing) {
   RampSource source;
   source.times.reserve(3000);
   rig.board.SetPwmSource(&source);
-  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_TRUE(rig.driver.Init(kFpgaStepNs).ok);
   EmulatedFpga ecs_board(Image::kIcoboard);
   EmulatorToReaderLink lines(rig.board);  // the ECS readers decode the twin's edges
   ecs_board.SetEncoderSource(&lines);
   EmulatedSpiBus ecs_bus(ecs_board);
   IcoBoard ecs(ecs_bus);
-  ASSERT_TRUE(ecs.Init(kStepNs).ok);
+  ASSERT_TRUE(ecs.Init(kFpgaStepNs).ok);
   TwinInputs twin_in;
   EcsInputs ecs_in;
   std::array<std::uint8_t, 8> echo{};

@@ -16,14 +16,14 @@
 namespace hiltwin::io {
 namespace {
 
-constexpr std::int64_t kStepNs = 1'000'000;  // 1 kHz twin
+constexpr std::int64_t kLinesStepNs = 1'000'000;  // 1 kHz twin
 
 using Targets = std::array<std::int32_t, kChannels>;
 
 /// Four emulator channels sampled together, as on the twin board.
 class Emulators {
  public:
-  explicit Emulators(std::int64_t step_ns = kStepNs) {
+  explicit Emulators(std::int64_t step_ns = kLinesStepNs) {
     for (auto& e : emulators_) e.Configure(step_ns, ClockDividerForStep(step_ns));
   }
   std::array<PulseSegment, kChannels> Sample(const Targets& targets, std::int64_t t_ns) {
@@ -69,9 +69,9 @@ TEST(EncoderLineReader, CountsAreDecodedEdgesUpToTheReadTime) {
   lines.Add(twin.Sample({0, 0, 0, 0}, 0));  // INIT
   EncoderLineReader reader;
   reader.Update(lines, 0, false);
-  lines.Add(twin.Sample({1000, -1000, 8191, -8192}, kStepNs));
+  lines.Add(twin.Sample({1000, -1000, 8191, -8192}, kLinesStepNs));
   const PulseSegment& ch0 = lines.periods.back().channels[0];
-  for (const std::int64_t t : {kStepNs, kStepNs + 1, kStepNs + 250'000, kStepNs + 777'777, 2 * kStepNs}) {
+  for (const std::int64_t t : {kLinesStepNs, kLinesStepNs + 1, kLinesStepNs + 250'000, kLinesStepNs + 777'777, 2 * kLinesStepNs}) {
     reader.Update(lines, t, false);
     const auto edges = static_cast<std::int32_t>(ch0.EdgesBy(t));
     EXPECT_EQ(reader.relative_counts(0), edges) << t;
@@ -94,8 +94,8 @@ TEST(EncoderLineReader, AnEarlySampleCancelsTheRestOfThePeriodWithoutErrors) {
   reader.Update(lines, 0, false);
   lines.Add(twin.Sample({1000, 1000, 1000, 1000}, 0));
   // Wall-clock jitter: the next sample comes half-way; the emulator starts from what it emitted.
-  lines.Add(twin.Sample({-500, 3000, 1000, 0}, kStepNs / 2));
-  reader.Update(lines, 3 * kStepNs, false);
+  lines.Add(twin.Sample({-500, 3000, 1000, 0}, kLinesStepNs / 2));
+  reader.Update(lines, 3 * kLinesStepNs, false);
   EXPECT_EQ(reader.relative_counts(0), -500);
   EXPECT_EQ(reader.relative_counts(1), 3000);
   EXPECT_EQ(reader.relative_counts(2), 1000);
@@ -104,7 +104,7 @@ TEST(EncoderLineReader, AnEarlySampleCancelsTheRestOfThePeriodWithoutErrors) {
   // Exactly the edges emitted: period 2 up to the early sample, then all of period 3.
   std::uint64_t emitted = 0;
   for (std::size_t c = 0; c < kChannels; ++c) {
-    emitted += lines.periods[1].channels[c].EdgesBy(kStepNs / 2) + lines.periods[2].channels[c].pulses;
+    emitted += lines.periods[1].channels[c].EdgesBy(kLinesStepNs / 2) + lines.periods[2].channels[c].pulses;
   }
   EXPECT_EQ(reader.counters().edges, emitted);
 }
@@ -117,11 +117,11 @@ TEST(EncoderLineReader, EdgesAfterAWireTwinsSampleInProgressWaitForItsPeriod) {
   EncoderLineReader reader;
   reader.Update(lines, 0, false);
   lines.known_until = 300'000;  // the twin began a sample then; its period is not published yet
-  reader.Update(lines, kStepNs, false);
+  reader.Update(lines, kLinesStepNs, false);
   EXPECT_EQ(reader.relative_counts(0), static_cast<std::int32_t>(lines.periods[1].channels[0].EdgesBy(300'000)));
   lines.Add(twin.Sample({0, 0, 0, 0}, 300'000));  // it turns back at 300 us
   lines.known_until = std::numeric_limits<std::int64_t>::max();
-  reader.Update(lines, 2 * kStepNs, false);
+  reader.Update(lines, 2 * kLinesStepNs, false);
   EXPECT_EQ(reader.relative_counts(0), 0);
   EXPECT_EQ(Errors(reader), 0U);
 }
@@ -133,22 +133,22 @@ TEST(EncoderLineReader, AFrozenInputMiscountsAndCountsAnIllegalTransition) {
   EncoderLineReader reader;
   reader.Update(lines, 0, false);
   lines.Add(twin.Sample({6, 0, 0, 0}, 0));
-  reader.Update(lines, kStepNs, /*stuck=*/true);  // six edges pass unseen
+  reader.Update(lines, kLinesStepNs, /*stuck=*/true);  // six edges pass unseen
   EXPECT_EQ(reader.relative_counts(0), 0);
-  lines.Add(twin.Sample({7, 0, 0, 0}, kStepNs));
-  reader.Update(lines, 2 * kStepNs, false);  // released: 0 -> 7 ≡ 3 (mod 4) reads as one down
+  lines.Add(twin.Sample({7, 0, 0, 0}, kLinesStepNs));
+  reader.Update(lines, 2 * kLinesStepNs, false);  // released: 0 -> 7 ≡ 3 (mod 4) reads as one down
   EXPECT_EQ(reader.relative_counts(0), -1);
-  lines.Add(twin.Sample({9, 0, 0, 0}, 2 * kStepNs));
-  reader.Update(lines, 3 * kStepNs, false);  // legal again: -1 + 2
+  lines.Add(twin.Sample({9, 0, 0, 0}, 2 * kLinesStepNs));
+  reader.Update(lines, 3 * kLinesStepNs, false);  // legal again: -1 + 2
   EXPECT_EQ(reader.relative_counts(0), 1);
   EXPECT_EQ(reader.counters().illegal_transitions, 0U);
 
   // Frozen while the lines move one count, released for the next: the reader sees them jump two
   // states (9 -> 11), both lines at once, which no decoder can count.
-  lines.Add(twin.Sample({10, 0, 0, 0}, 3 * kStepNs));
-  reader.Update(lines, 4 * kStepNs, true);
-  lines.Add(twin.Sample({11, 0, 0, 0}, 4 * kStepNs));
-  reader.Update(lines, 5 * kStepNs, false);
+  lines.Add(twin.Sample({10, 0, 0, 0}, 3 * kLinesStepNs));
+  reader.Update(lines, 4 * kLinesStepNs, true);
+  lines.Add(twin.Sample({11, 0, 0, 0}, 4 * kLinesStepNs));
+  reader.Update(lines, 5 * kLinesStepNs, false);
   EXPECT_EQ(reader.counters().illegal_transitions, 1U);
   EXPECT_EQ(reader.relative_counts(0), 1);  // the two counts are lost
 }
@@ -162,7 +162,7 @@ TEST(EncoderLineReader, EdgesCloserThanTheSynchroniserAreCountedTooFast) {
   lines.Add(fast);
   EncoderLineReader reader;
   reader.Update(lines, 0, false);
-  reader.Update(lines, kStepNs, false);
+  reader.Update(lines, kLinesStepNs, false);
   EXPECT_EQ(reader.relative_counts(0), 100);
   EXPECT_EQ(reader.counters().too_fast_edges, 99U);  // every edge but the first
 }
@@ -178,9 +178,9 @@ TEST(EncoderLineReader, LostHistoryAndATwinRestartAreResyncs) {
   std::int32_t position = 0;
   for (std::uint64_t k = 1; k <= kEncoderLineHistory + 10; ++k) {
     position += 10;
-    lines.OnPeriod(twin.Sample({position, -position, 0, 0}, static_cast<std::int64_t>(k) * kStepNs));
+    lines.OnPeriod(twin.Sample({position, -position, 0, 0}, static_cast<std::int64_t>(k) * kLinesStepNs));
   }
-  reader.Update(lines, static_cast<std::int64_t>(kEncoderLineHistory + 11) * kStepNs, false);
+  reader.Update(lines, static_cast<std::int64_t>(kEncoderLineHistory + 11) * kLinesStepNs, false);
   EXPECT_EQ(reader.counters().resyncs, 1U);
   EXPECT_EQ(reader.relative_counts(0), position);
   EXPECT_EQ(reader.relative_counts(1), -position);
@@ -188,10 +188,10 @@ TEST(EncoderLineReader, LostHistoryAndATwinRestartAreResyncs) {
 
   // The twin re-runs INIT: its emulator starts again from 0.
   twin.Reset();
-  const std::int64_t t = static_cast<std::int64_t>(kEncoderLineHistory + 20) * kStepNs;
+  const std::int64_t t = static_cast<std::int64_t>(kEncoderLineHistory + 20) * kLinesStepNs;
   lines.OnPeriod(twin.Sample({0, 0, 0, 0}, t));
-  lines.OnPeriod(twin.Sample({50, 0, 0, 0}, t + kStepNs));
-  reader.Update(lines, t + 2 * kStepNs, false);
+  lines.OnPeriod(twin.Sample({50, 0, 0, 0}, t + kLinesStepNs));
+  reader.Update(lines, t + 2 * kLinesStepNs, false);
   EXPECT_EQ(reader.counters().resyncs, 2U);
   EXPECT_EQ(reader.relative_counts(0), 50);
   EXPECT_EQ(reader.counters().illegal_transitions + reader.counters().too_fast_edges, 0U);
@@ -205,14 +205,14 @@ TEST(EmulatedFpga, TheEcsBoardReadsTheTwinsPulsesMidPeriod) {
   IcoBoard& ecs = boards.ecs;
   EmulatedFpga& twin_board = boards.twin_board;
   EmulatedFpga& ecs_board = boards.ecs_board;
-  ASSERT_TRUE(twin.Init(kStepNs).ok);
-  ASSERT_TRUE(ecs.Init(kStepNs / 4).ok);
+  ASSERT_TRUE(twin.Init(kLinesStepNs).ok);
+  ASSERT_TRUE(ecs.Init(kLinesStepNs / 4).ok);
   TwinInputs twin_in;
   EcsInputs ecs_in;
   ASSERT_TRUE(twin.Exchange({400, -400, 0, 0}, twin_in).ok());  // period [0, 1 ms): 0 -> 400
   for (int k = 0; k < 4; ++k) {
     ASSERT_TRUE(ecs.Exchange({0, 0, 0, 0}, ecs_in).ok());  // at k · 250 us
-    const std::int64_t t = k * kStepNs / 4;
+    const std::int64_t t = k * kLinesStepNs / 4;
     EXPECT_EQ(ecs_in.counts[0], twin_board.encoder(0).PositionAt(t)) << k;
     EXPECT_EQ(ecs_in.counts[1], twin_board.encoder(1).PositionAt(t)) << k;
   }
@@ -227,7 +227,7 @@ TEST(EmulatedFpga, TheEcsBoardReadsTheTwinsPulsesMidPeriod) {
   ASSERT_TRUE(ecs.Exchange({0, 0, 0, 0}, ecs_in).ok());          // 1.25 ms (next edges at 1.5, 2 ms)
   ecs_board.faults().stick_encoder = false;
   for (int k = 0; k < 6; ++k) ASSERT_TRUE(ecs.Exchange({0, 0, 0, 0}, ecs_in).ok());
-  EXPECT_EQ(twin_board.encoder(0).PositionAt(3 * kStepNs), 402);
+  EXPECT_EQ(twin_board.encoder(0).PositionAt(3 * kLinesStepNs), 402);
   EXPECT_EQ(ecs_in.counts[0], 302);   // edges 301..400 were missed; 401 and 402 counted
   EXPECT_EQ(ecs_in.counts[1], -300);  // likewise: the rest of channel 1's pulses came while frozen
 }

@@ -14,7 +14,7 @@
 namespace hiltwin::io {
 namespace {
 
-constexpr std::int64_t kStepNs = 250'000;  // 4 kHz
+constexpr std::int64_t kPipelineStepNs = 250'000;  // 4 kHz
 constexpr FrameBytes kZeros{};
 
 FrameBytes Request(const Frame& frame, Image image = Image::kIcoboardInverse) {
@@ -91,7 +91,7 @@ TEST(AnswerRegister, TheAnswerSamplesWhenTheRequestIsActedUpon) {
   } source;
   EmulatedFpga board(Image::kIcoboardInverse);
   board.SetPwmSource(&source);
-  ASSERT_EQ(RequestAndFetch(board, Init(1, kStepNs, 4), 2).status & kStatusInitialised,
+  ASSERT_EQ(RequestAndFetch(board, Init(1, kPipelineStepNs, 4), 2).status & kStatusInitialised,
             kStatusInitialised);
   Frame all;
   all.opcode = Opcode::kAll;
@@ -128,7 +128,7 @@ TEST(Fetch, EveryExchangeIsTheRequestThenANoopWithTheNextSequenceNumber) {
   RecordingBus bus(board);
   bus.sent.reserve(16);
   IcoBoardInverse driver(bus);
-  ASSERT_TRUE(driver.Init(kStepNs).ok);
+  ASSERT_TRUE(driver.Init(kPipelineStepNs).ok);
   TwinInputs in;
   ASSERT_TRUE(driver.Exchange({1, 2, 3, 4}, in).ok());
   ASSERT_EQ(bus.sent.size(), 4U);
@@ -189,7 +189,7 @@ TEST(Fetch, AnEarlyFetchReadsTheStaleAnswerAndIsCountedMissed) {
   const ExchangeStatus first = driver.Test({1, 2, 3, 4, 5, 6, 7, 8}, echo);
   EXPECT_EQ(first.code, ExchangeStatus::Code::kMissed);
   EXPECT_STREQ(first.reason, "no answer from the board (MISO idle)");
-  const InitResult init = driver.Init(kStepNs);  // resets the counters
+  const InitResult init = driver.Init(kPipelineStepNs);  // resets the counters
   EXPECT_FALSE(init.ok);
   EXPECT_NE(init.message.find("stale answer"), std::string::npos) << init.message;
   EXPECT_EQ(driver.counters().init_frames_sent, 3U);
@@ -198,7 +198,7 @@ TEST(Fetch, AnEarlyFetchReadsTheStaleAnswerAndIsCountedMissed) {
   EXPECT_TRUE(board.initialised());  // the board did act on INIT: only the answer was early
 
   bus.early = false;
-  ASSERT_TRUE(driver.Init(kStepNs).ok);
+  ASSERT_TRUE(driver.Init(kPipelineStepNs).ok);
   TwinInputs in;
   ASSERT_TRUE(driver.Exchange({5, 0, 0, 0}, in).ok());
   bus.early = true;
@@ -293,7 +293,7 @@ TEST(FaultInjection, TheNextNCountsExchangesThroughTheDriver) {
   EmulatedFpga board(Image::kIcoboardInverse);
   EmulatedSpiBus bus(board);
   IcoBoardInverse driver(bus);
-  ASSERT_TRUE(driver.Init(kStepNs).ok);
+  ASSERT_TRUE(driver.Init(kPipelineStepNs).ok);
   TwinInputs in;
   struct Case {
     std::uint32_t FaultInjection::*hook;

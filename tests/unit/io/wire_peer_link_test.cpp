@@ -16,14 +16,14 @@
 namespace hiltwin::io {
 namespace {
 
-std::string FreshName(const char* tag) {
+std::string FreshPeerName(const char* tag) {
   const std::string name = std::string("utest-peer-") + tag + "-" + std::to_string(::getpid());
   WireBus::Unlink(name);
   return name;
 }
 
 TEST(WirePeerLink, PollSaysWhetherThePeerIsThereAndKeepsThisSideAlive) {
-  const std::string name = FreshName("poll");
+  const std::string name = FreshPeerName("poll");
   WireBus twin(name, Image::kIcoboardInverse);
   EXPECT_EQ(twin.Poll().result, BusResult::kPeerAbsent);
   WireBus ecs(name, Image::kIcoboard);
@@ -35,7 +35,7 @@ TEST(WirePeerLink, PollSaysWhetherThePeerIsThereAndKeepsThisSideAlive) {
 // its real-time set-up (which may outlast the heartbeat timeout), so its peer must neither start
 // against it nor, later, call it lost.
 TEST(WirePeerLink, AnAttachedSideThatHasNotBeatenYetIsAbsentNotUp) {
-  const std::string name = FreshName("setup");
+  const std::string name = FreshPeerName("setup");
   WireBus twin(name, Image::kIcoboardInverse);
   ASSERT_EQ(twin.Poll().result, BusResult::kPeerAbsent);
   WireBus ecs(name, Image::kIcoboard);  // attached, still setting up: no Poll, no transfer
@@ -52,7 +52,7 @@ TEST(WirePeerLink, AnAttachedSideThatHasNotBeatenYetIsAbsentNotUp) {
 }
 
 TEST(WirePeerLink, AnAnnouncedStopReachesThePeerWithItsCause) {
-  const std::string name = FreshName("stop");
+  const std::string name = FreshPeerName("stop");
   WireBus twin_bus(name, Image::kIcoboardInverse);
   WireBus ecs_bus(name, Image::kIcoboard);
   IcoBoard ecs(ecs_bus);
@@ -78,7 +78,7 @@ TEST(WirePeerLink, AnAnnouncedStopReachesThePeerWithItsCause) {
 }
 
 TEST(WirePeerLink, AStoppedPeerThatDetachedStaysStoppedNotLost) {
-  const std::string name = FreshName("detach");
+  const std::string name = FreshPeerName("detach");
   WireBus twin(name, Image::kIcoboardInverse);
   {
     WireBus ecs(name, Image::kIcoboard);
@@ -95,7 +95,7 @@ TEST(WirePeerLink, AStoppedPeerThatDetachedStaysStoppedNotLost) {
 
 TEST(WirePeerLink, OnlyTheWireBackendHasAPeer) {
   EXPECT_EQ(OpenBackend("mock", {})->peer_link(), nullptr);
-  const std::string name = FreshName("backend");
+  const std::string name = FreshPeerName("backend");
   EXPECT_NE(OpenBackend("wire:" + name, {})->peer_link(), nullptr);
 }
 
@@ -103,7 +103,7 @@ TEST(WireBus, AnExchangeIsTheRequestAndItsFetchOnThisSidesBoard) {
   // The driver's request transfer and its NOOP fetch run against this side's board as one
   // exchange: the ALL publishes one encoder period, the fetch none, and the fetch carries the
   // ALL's answer (with the PWM the ECS put on the wire).
-  const std::string name = FreshName("pair");
+  const std::string name = FreshPeerName("pair");
   WireBus twin_bus(name, Image::kIcoboardInverse);
   WireBus ecs_bus(name, Image::kIcoboard);
   IcoBoard ecs(ecs_bus);

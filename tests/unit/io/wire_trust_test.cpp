@@ -30,7 +30,7 @@
 namespace hiltwin::io {
 namespace {
 
-std::string FreshName(const char* tag) {
+std::string FreshTrustName(const char* tag) {
   const std::string name = std::string("utest-trust-") + tag + "-" + std::to_string(::getpid());
   WireBus::Unlink(name);
   return name;
@@ -48,7 +48,7 @@ std::string RefusalOf(const std::function<void()>& make) {
 
 TEST(WireSegmentAccess, AFreshSegmentIsOwnerOnlyWhateverTheUmask) {
   for (const mode_t mask : {mode_t{0}, mode_t{0022}, mode_t{0277}}) {
-    const std::string name = FreshName("fresh");
+    const std::string name = FreshTrustName("fresh");
     const mode_t old_mask = ::umask(mask);
     WireBus bus(name, Image::kIcoboard);
     ::umask(old_mask);
@@ -60,7 +60,7 @@ TEST(WireSegmentAccess, AFreshSegmentIsOwnerOnlyWhateverTheUmask) {
 }
 
 TEST(WireSegmentAccess, ASegmentOthersCanWriteIsRefused) {
-  const std::string name = FreshName("open");
+  const std::string name = FreshTrustName("open");
   const int fd = ::shm_open(WireBus::SegmentName(name).c_str(), O_RDWR | O_CREAT | O_EXCL, 0666);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::fchmod(fd, 0666), 0);
@@ -75,7 +75,7 @@ TEST(WireSegmentAccess, ASegmentOthersCanWriteIsRefused) {
 
 TEST(WireSegmentAccess, ASegmentOfAnotherUserIsRefused) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to give a segment to another user";
-  const std::string name = FreshName("owner");
+  const std::string name = FreshTrustName("owner");
   const int fd = ::shm_open(WireBus::SegmentName(name).c_str(), O_RDWR | O_CREAT | O_EXCL, 0600);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::fchown(fd, 65534, 65534), 0);
@@ -87,7 +87,7 @@ TEST(WireSegmentAccess, ASegmentOfAnotherUserIsRefused) {
 }
 
 TEST(WireSegmentAccess, AForgedLivePidInThisSidesEntryRefusesTheAttach) {
-  const std::string name = FreshName("forged");
+  const std::string name = FreshTrustName("forged");
   WireBus twin(name, Image::kIcoboardInverse);
   {
     WireBus ecs(name, Image::kIcoboard);
@@ -114,7 +114,7 @@ class WireVandal : public ::testing::Test {
     for (char& ch : test) {
       if (ch == '/') ch = '-';  // parameterised tests: "Name/3"
     }
-    name_ = FreshName(test.substr(test.size() > 24 ? test.size() - 24 : 0).c_str());
+    name_ = FreshTrustName(test.substr(test.size() > 24 ? test.size() - 24 : 0).c_str());
     twin_bus_.emplace(name_, Image::kIcoboardInverse);
     ecs_bus_.emplace(name_, Image::kIcoboard);
     twin_.emplace(*twin_bus_);

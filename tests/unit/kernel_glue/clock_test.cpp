@@ -36,19 +36,19 @@ TEST(MonotonicClock, AbsoluteSleepReachesDeadline) {
   EXPECT_FALSE(clock.IsVirtual());
 }
 
-std::atomic<int> g_interruptions{0};
-void CountInterruption(int /*signal*/) { g_interruptions.fetch_add(1); }
+std::atomic<int> g_sleep_interruptions{0};
+void CountSleepInterruption(int /*signal*/) { g_sleep_interruptions.fetch_add(1); }
 
 TEST(MonotonicClock, AbsoluteSleepResumesAfterASignalInterruptsIt) {
   // A handler without SA_RESTART makes clock_nanosleep return EINTR; the sleep must resume
   // towards the same absolute deadline instead of returning early.
   struct sigaction action {};
-  action.sa_handler = CountInterruption;
+  action.sa_handler = CountSleepInterruption;
   sigemptyset(&action.sa_mask);
   action.sa_flags = 0;
   struct sigaction previous {};
   ASSERT_EQ(sigaction(SIGUSR1, &action, &previous), 0);
-  g_interruptions = 0;
+  g_sleep_interruptions = 0;
 
   MonotonicClock clock;
   const TimeNs deadline_ns = clock.NowNs() + 200 * kNsPerMs;
@@ -66,7 +66,7 @@ TEST(MonotonicClock, AbsoluteSleepResumesAfterASignalInterruptsIt) {
   }
   sleeper.join();
   sigaction(SIGUSR1, &previous, nullptr);
-  EXPECT_GE(g_interruptions.load(), 1);
+  EXPECT_GE(g_sleep_interruptions.load(), 1);
   EXPECT_GE(woke_ns, deadline_ns);
 }
 

@@ -208,8 +208,8 @@ TEST(ProcessTiming, WaitForReturnsNothingWhileRunningThenTheStatus) {
   EXPECT_EQ(child.pid(), -1);
 }
 
-std::atomic<int> g_interruptions{0};
-void CountInterruption(int) { g_interruptions.fetch_add(1, std::memory_order_relaxed); }
+std::atomic<int> g_wait_interruptions{0};
+void CountWaitInterruption(int) { g_wait_interruptions.fetch_add(1, std::memory_order_relaxed); }
 
 // Sends SIGUSR2 to the constructing thread every few ms, with a handler installed without
 // SA_RESTART, so every blocking call of that thread fails with EINTR; undone on destruction
@@ -218,7 +218,7 @@ class Interrupter {
  public:
   Interrupter() : target_(pthread_self()) {
     struct sigaction action {};
-    action.sa_handler = CountInterruption;
+    action.sa_handler = CountWaitInterruption;
     sigemptyset(&action.sa_mask);
     action.sa_flags = 0;  // no SA_RESTART
     EXPECT_EQ(sigaction(SIGUSR2, &action, &old_), 0);
@@ -256,7 +256,7 @@ TEST(ProcessTiming, WaitingSurvivesEintr) {
     captured = Sh("sleep 0.3; echo end");
     polled = RunProcess({"sleep", "0.3"}, {}, milliseconds(20'000));
   }
-  EXPECT_GT(g_interruptions.load(), 10);
+  EXPECT_GT(g_wait_interruptions.load(), 10);
   EXPECT_TRUE(blocking.status.Success()) << blocking.status.Describe();
   EXPECT_TRUE(captured.status.Success()) << captured.status.Describe();
   EXPECT_EQ(captured.out, "end\n");

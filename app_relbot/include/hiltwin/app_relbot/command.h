@@ -26,6 +26,12 @@ class CommandError : public std::runtime_error {
   ExitCode code_;
 };
 
+/// Ends a command with ExitCode::kUsage (exit 2): a bad flag, argument or input file, named by
+/// `message`. One definition for every command and run assembly.
+[[noreturn]] inline void ThrowUsage(const std::string& message) {
+  throw CommandError(ExitCode::kUsage, message);
+}
+
 /// A registered subcommand: its CLI11 node and what to run when it was chosen.
 /// `run` returns the process exit code.
 struct Command {
