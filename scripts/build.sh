@@ -1,10 +1,29 @@
 #!/usr/bin/env bash
-# Configures and builds hiltwin into build/ (or $1), warnings as errors.
-# Usage: scripts/build.sh [BUILD_DIR] [extra cmake -D options...]
+# Configures and builds hiltwin into build/ (or BUILD_DIR), warnings as errors.
+# Usage: scripts/build.sh [--run] [BUILD_DIR] [extra cmake -D options...]
+#   --run  only what `hiltwin run` needs: the binary and its libraries, not the tests, the
+#          benchmarks, the gateware or the Verilator model (so not `--io verilated`); a later
+#          full build of the same folder adds them
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+run_only=0
+if [[ ${1:-} == --run ]]; then
+  run_only=1
+  shift
+elif [[ ${1:-} == -h || ${1:-} == --help ]]; then
+  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+  exit 0
+fi
 build_dir=${1:-"$root/build"}
 shift || true
 jobs=$(nproc)
-cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHILTWIN_WERROR=ON "$@" >/dev/null
-cmake --build "$build_dir" -j "$jobs"
+# The co-simulation is on unless --run or the caller's own -D says otherwise (a later -D wins).
+fpga_sim=ON
+((run_only)) && fpga_sim=OFF
+cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHILTWIN_WERROR=ON \
+  -DHILTWIN_FPGA_SIM=$fpga_sim "$@" >/dev/null
+if ((run_only)); then
+  cmake --build "$build_dir" -j "$jobs" --target hiltwin
+else
+  cmake --build "$build_dir" -j "$jobs"
+fi
