@@ -120,12 +120,12 @@ endfunction()
 # session daemon).
 # RT_TESTS: the tests (Suite.Name) that depend on the wall clock also get the label `rt`, so
 # `ctest -L rt` selects exactly the tests a noisy machine can disturb.
-# HILTWIN_TEST_LABELS (a CMake list; empty: all): only the executables that hold a test with one
-# of these labels are built and known to CTest. A stage that runs one label (the TSan stage:
-# concurrency; arm64: unit) then compiles no test it would not run.
 # CONCURRENCY_TESTS: the tests that race threads or processes (lock-free queues, the logger,
 # the wire, telemetry, session threads, two-process pairs) also get the label `concurrency`:
 # the ThreadSanitizer stage runs exactly these (".*": every test of the executable).
+# HILTWIN_TEST_LABELS (a CMake list; empty: all): only the executables that hold a test with one
+# of these labels are built and known to CTest. A stage that runs one label (the TSan stage:
+# concurrency; arm64: unit) then compiles no test it would not run.
 # gtest_discover_tests flattens a list given to PROPERTIES, so the labels and locks are set by
 # a CTest include file that runs after discovery, over the discovered list.
 # Cross-compiled (arm64), discovery runs the test binary at test time, under the emulator,

@@ -353,6 +353,14 @@ bool RunSession::WaitForPeer() {
       HandleTraced(lifecycle_, statemachine::Event::kStopRequest, 0);
       return false;
     }
+    if (status.result == io::BusResult::kPeerStopped) {
+      // The peer came up, ran and ended before this side saw it up (a twin that aborts in its
+      // first cycles on a loaded machine): end now, as a cycle would have, not at the timeout.
+      if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
+      wait_peer_stopped_ = status.reason;
+      HandleTraced(lifecycle_, statemachine::Event::kPeerStopped, 0);
+      return false;
+    }
     const kernel_glue::TimeNs waited_ns = clock.NowNs() - start_ns;
     if (waited_ns >= timeout_ns) {
       if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
@@ -464,7 +472,8 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
   r.period_jitter = stats.period_jitter.Summary();
   const LoopCounts& counts = runner_->counts();
   r.link = {counts.io_errors, counts.peer_absent_cycles, counts.pulse_limit_cycles,
-            config_.peer_name, runner_->peer_stopped() != nullptr ? runner_->peer_stopped() : ""};
+            config_.peer_name,
+            runner_->peer_stopped() != nullptr ? runner_->peer_stopped() : wait_peer_stopped_};
   if (const auto& fault = runner_->fault()) {
     r.fault = RunFault{fault->kind, fault->cycle, fault->reason};
   } else if (wait_fault_) {

@@ -33,8 +33,12 @@ Transition Next(State state, Event event) noexcept {
     case Event::kStopRequest:
       if (Ending(state)) return Ignore(state);
       return To(state, State::kStopping);
-    case Event::kFinishReached:
     case Event::kPeerStopped:
+      // The peer may run, and end, while this side still waits in ready for it to come up
+      // (a peer that aborts in its first cycles): this side ends too, without a cycle.
+      if (state == State::kReady) return To(state, State::kStopping);
+      [[fallthrough]];
+    case Event::kFinishReached:
       // Paused cycles are still released, so the planned releases can run out while paused.
       if (state == State::kRun || state == State::kPaused) return To(state, State::kStopping);
       return Ending(state) ? Ignore(state) : Reject(state);

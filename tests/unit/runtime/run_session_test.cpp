@@ -127,6 +127,9 @@ class FakePeer final : public io::PeerLink {
  public:
   io::BusStatus Poll() noexcept override {
     ++polls;
+    if (stopped_after >= 0 && polls > stopped_after) {
+      return {io::BusResult::kPeerStopped, "wire: the ECS aborted its run on its QoS policy"};
+    }
     if (polls > up_after) return {};
     return {io::BusResult::kPeerAbsent, "wire: no ECS process has attached yet"};
   }
@@ -135,6 +138,7 @@ class FakePeer final : public io::PeerLink {
     announced = cause;
   }
   int up_after = 0;
+  int stopped_after = -1;  ///< >= 0: after this many polls the peer has run and stopped
   int polls = 0;
   int announcements = 0;
   io::StopCause announced = io::StopCause::kNone;
@@ -192,6 +196,27 @@ TEST(RunSessionPeer, APeerThatStopsEndsTheRunCleanlyWithItsReason) {
   EXPECT_EQ(ExitCodeFor(r), ExitCode::kPass);  // judged on what ran
   EXPECT_NE(FormatSummary(r).find("peer       wire: the ECS finished its run"), std::string::npos);
   EXPECT_EQ(ToJson(r)["peer_stopped"], "wire: the ECS finished its run");
+}
+
+// The peer came up, ran and ended between two polls (it aborted in its first cycles on a
+// loaded machine): this side ends at once with the peer's reason, without a cycle, instead of
+// waiting for a peer that will not come again (found by the quick tier run under load).
+TEST(RunSessionPeer, APeerThatEndedWhileThisSideWaitedEndsItWithoutACycle) {
+  ScriptedTask task;
+  FakePeer peer;
+  peer.up_after = 1'000'000;
+  peer.stopped_after = 2;
+  const RunReport r = RunScripted(task, WithPeer(VirtualConfig(200), peer, 5.0));
+  EXPECT_EQ(peer.polls, 3);
+  EXPECT_EQ(r.cycles_run, 0U);
+  EXPECT_EQ(task.live_exchanges + task.safe_exchanges, 0U);
+  EXPECT_EQ(r.stop_reason, StopReason::kPeerStopped);
+  EXPECT_EQ(r.final_state, State::kStopped);
+  EXPECT_EQ(r.link.peer_stopped, "wire: the ECS aborted its run on its QoS policy");
+  EXPECT_FALSE(r.fault.has_value());
+  EXPECT_TRUE(r.outputs_safe);
+  EXPECT_EQ(peer.announced, io::StopCause::kPeerStopped);
+  EXPECT_EQ(ExitCodeFor(r), ExitCode::kPass);
 }
 
 TEST(RunSessionPeer, AnIoFaultIsAnnouncedAsAFault) {

@@ -33,6 +33,7 @@ const std::map<std::pair<State, Event>, State>& Legal() {
       {{S::kInit, E::kModelFault}, S::kError},
       {{S::kReady, E::kStart}, S::kRun},
       {{S::kReady, E::kStopRequest}, S::kStopping},
+      {{S::kReady, E::kPeerStopped}, S::kStopping},  // the peer ran and ended first
       {{S::kReady, E::kIoFault}, S::kError},
       {{S::kReady, E::kModelFault}, S::kError},
       {{S::kRun, E::kPause}, S::kPaused},

@@ -151,6 +151,7 @@ class RunSession {
   std::vector<int> allowed_cpus_;  ///< the process's CPUs, read before anything is pinned
   LoopThreadHooks* hooks_ = nullptr;
   std::optional<RunFault> wait_fault_;  ///< the peer never came
+  const char* wait_peer_stopped_ = "";   ///< the peer ended while this side waited (static text)
   bool ran_ = false;
   /// Last: destroyed first, so its thread has stopped before what it reads goes away.
   std::unique_ptr<TelemetryPublisher> telemetry_;
