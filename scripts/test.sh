@@ -36,8 +36,8 @@ done
 # The matrix's builds keep line tables only (-g1): enough for every sanitizer report and
 # backtrace, and full debug information is much of what compiling costs. The ASan+UBSan build
 # optimises at -O1, as the sanitizers' own documentation advises; the ThreadSanitizer build
-# keeps -O2: at -O1 its wall-clock pairs ran slow enough that a twin's heartbeat went stale
-# (HilCli.EitherSideMayStartFirst, once), and the arm64 build keeps -O2, what a Pi runs. None of
+# keeps -O2, as in the runs where its wall-clock pairs passed, and the arm64 build keeps -O2,
+# what a Pi runs. None of
 # them builds the benchmarks or the gateware (bitstreams, Verilator model): the quick tier has
 # them.
 line_tables=(-DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
