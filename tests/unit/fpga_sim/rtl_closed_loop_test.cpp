@@ -1,6 +1,6 @@
 // The closed-loop HiL test with both boards replaced by their RTL: the RELbot twin (RK4) ->
 // IcoBoardInverse -> verilated twin board -> A/B and PWM wires -> verilated ECS board -> IcoBoard
-// -> the ECS's PID, on one virtual timeline (tests/unit/app_ecs/in_process_hil.h with the boards
+// -> the ECS's PID, on one virtual timeline (tests/unit/app/in_process_hil.h with the boards
 // plugged in). The default closedloop profile (2.5 m) must track within the thesis' 3 mm.
 // The default suite runs its first 2 s (the start of the move: every count, every edge and the
 // tracking bound still checked); the opt-in `long` label runs the whole 12 s profile
@@ -16,7 +16,7 @@
 
 #include <chrono>
 
-#include "../app_ecs/in_process_hil.h"
+#include "../app/in_process_hil.h"
 #include "hiltwin/app_relbot/ecs_gains.h"
 #include "rtl_pair.h"
 

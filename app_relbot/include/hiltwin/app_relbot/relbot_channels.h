@@ -4,7 +4,7 @@
 /// writes `enc1 = right`, `enc2 = left`; the ECS is wired the same way on the real robot. Board
 /// channel n (appendix G's `channel1`, `enc1`, ...) is array index and frame slot n - 1
 /// everywhere in hiltwin (opcodes PWM c = 4 + c and ENC c = 8 + c, docs/spi-protocol.md).
-/// tests/unit/app_run/wheel_channels_test.cpp drives one channel through both boards and checks
+/// tests/unit/app/wheel_channels_test.cpp drives one channel through both boards and checks
 /// which wheel moves and which way the robot turns.
 
 #include <cstddef>

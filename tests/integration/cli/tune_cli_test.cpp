@@ -42,13 +42,13 @@ std::vector<std::string> ThesisVirtual(std::vector<std::string> extra) {
   return argv;
 }
 
-struct BadInput {
+struct TuneBadInput {
   std::vector<std::string> args;
   std::string says;  ///< a part of the message
 };
 
 TEST(TuneCli, BadInputExitsTwoAndSaysWhatIsWrong) {
-  const std::vector<BadInput> cases = {
+  const std::vector<TuneBadInput> cases = {
       {{"--controller-rate", "0"}, "--controller-rate 0"},
       {{"--controller-rate", "-1000"}, "--controller-rate -1000"},
       {{"--candidates", ""}, "--candidates"},
@@ -58,7 +58,7 @@ TEST(TuneCli, BadInputExitsTwoAndSaysWhatIsWrong) {
       {{"--tolerance-m", "-0.001"}, "--tolerance-m"},
       {{"--inject-compute-us", "85"}, "--clock virtual"},
   };
-  for (const BadInput& c : cases) {
+  for (const TuneBadInput& c : cases) {
     const hiltwin::test::RunResult r = Tune(c.args);
     std::string joined;
     for (const std::string& a : c.args) joined += a + " ";
