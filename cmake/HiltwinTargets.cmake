@@ -25,19 +25,24 @@ option(HILTWIN_UNITY_BUILD "Compile each target's sources in batches (unity buil
 set(HILTWIN_UNITY_BATCH 8 CACHE STRING "Sources per unity-build unit")
 set(HILTWIN_TEST_LABELS "" CACHE STRING
     "Build only the test executables with a test of one of these labels (empty: all)")
+set(HILTWIN_TEST_SKIP_LABELS "" CACHE STRING
+    "Build no test executable whose every test has one of these labels")
 function(hiltwin_target_build_speed target)
   set_target_properties(${target} PROPERTIES UNITY_BUILD ${HILTWIN_UNITY_BUILD}
                         UNITY_BUILD_BATCH_SIZE ${HILTWIN_UNITY_BATCH})
 endfunction()
 
-# The tests' own code is compiled for debugging (-Og, still with the build type's debug info),
-# not for speed: a test body is hundreds of expanded assertion macros that -O2 spends most of a
-# test's compile time on (a unity unit of hiltwin_unit_io: 13.0 s at -O2, 6.7 s at -Og), and
-# what a test measures runs in the libraries, which keep the build type's optimisation. A
-# test's results do not change: the code is the same, and no level contracts floating point
-# (-ffp-contract=off, CMakeLists.txt) or uses x87.
-set(HILTWIN_TEST_OPTIMIZATION "-Og" CACHE STRING
-    "Optimisation of the tests' own code (empty: the build type's)")
+# The tests' own code is compiled for debugging (-Og) with line tables (-g1), not for speed: a
+# test body is hundreds of expanded assertion macros that -O2 spends most of a test's compile
+# time on (a unity unit of hiltwin_unit_io: 13.0 s at -O2, 6.7 s at -Og), and full debug
+# information costs another fifth (a unit of the app tests: 15.8 s at -Og -g, 12.4 s at
+# -Og -g1). What a test measures runs in the libraries, which keep the build type's
+# optimisation and debug information; a failing assertion and a sanitizer's backtrace still name
+# file and line. To step through a test's own locals in a debugger, configure with
+# -DHILTWIN_TEST_OPTIMIZATION="-O0;-g". A test's results do not change: the code is the same,
+# and no level contracts floating point (-ffp-contract=off, CMakeLists.txt) or uses x87.
+set(HILTWIN_TEST_OPTIMIZATION "-Og;-g1" CACHE STRING
+    "Optimisation and debug information of the tests' own code (a list; empty: the build type's)")
 function(hiltwin_test_target_flags target)
   hiltwin_target_warnings(${target})
   hiltwin_target_build_speed(${target})
@@ -126,6 +131,8 @@ endfunction()
 # HILTWIN_TEST_LABELS (a CMake list; empty: all): only the executables that hold a test with one
 # of these labels are built and known to CTest. A stage that runs one label (the TSan stage:
 # concurrency; arm64: unit) then compiles no test it would not run.
+# HILTWIN_TEST_SKIP_LABELS (a CMake list): executables whose every test has one of these labels
+# are left out the same way (the sanitizer stage: long, which no stage but the opt-in one runs).
 # gtest_discover_tests flattens a list given to PROPERTIES, so the labels and locks are set by
 # a CTest include file that runs after discovery, over the discovered list.
 # Cross-compiled (arm64), discovery runs the test binary at test time, under the emulator,
@@ -151,6 +158,7 @@ function(hiltwin_add_gtest name)
   if(ARG_CONCURRENCY_TESTS)
     list(APPEND possible_labels concurrency)
   endif()
+  set(wanted TRUE)
   if(NOT HILTWIN_TEST_LABELS STREQUAL "")
     set(wanted FALSE)
     foreach(label IN LISTS possible_labels)
@@ -158,12 +166,17 @@ function(hiltwin_add_gtest name)
         set(wanted TRUE)
       endif()
     endforeach()
-    if(NOT wanted)
-      # Still a target, so its folder can set its properties, but neither built by default nor
-      # known to CTest.
-      set_target_properties(${name} PROPERTIES EXCLUDE_FROM_ALL ON)
-      return()
+  endif()
+  foreach(label IN LISTS labels)  # a label of every test of the executable
+    if(label IN_LIST HILTWIN_TEST_SKIP_LABELS)
+      set(wanted FALSE)
     endif()
+  endforeach()
+  if(NOT wanted)
+    # Still a target, so its folder can set its properties, but neither built by default nor
+    # known to CTest.
+    set_target_properties(${name} PROPERTIES EXCLUDE_FROM_ALL ON)
+    return()
   endif()
   set(extra_properties)
   if(HILTWIN_TSAN)

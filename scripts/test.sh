@@ -92,9 +92,11 @@ tidy_stage() {
   timings+=("clang-tidy (function size)" "$stage_built" "$((SECONDS - checked))")
 }
 
-# ASan+UBSan: the whole default suite but the gateware, which the sanitizers cannot see into.
+# ASan+UBSan: the whole default suite but the gateware, which the sanitizers cannot see into;
+# the executables that hold only long tests (the soaks) are not built.
 asan_stage() {
-  build_stage "$root/build-asan" -DHILTWIN_SANITIZE=ON "${no_extras[@]}" "${asan_flags[@]}"
+  build_stage "$root/build-asan" -DHILTWIN_SANITIZE=ON "${no_extras[@]}" "${asan_flags[@]}" \
+    -DHILTWIN_TEST_SKIP_LABELS=long
   test_stage "ASan+UBSan" "$root/build-asan" -j "$jobs" -LE long
 }
 
@@ -110,8 +112,10 @@ tsan_stage() {
     "${line_tables[@]}" -DHILTWIN_TEST_LABELS=concurrency
   test_stage "TSan (concurrency)" "$root/build-tsan" -j "$jobs" -L concurrency -LE "^(long|rt)$"
   # Left out here (it runs in the quick tier and under ASan): HilCli.EitherSideMayStartFirst
-  # failed 2 runs in 2 under TSan after the unity build, the ECS calling the twin's heartbeat
-  # stale about 240 ms after both started; under investigation (docs/testing.md, Flakiness).
+  # fails under TSan, the ECS calling the twin's heartbeat stale about 240 ms after both
+  # started. The cause is a wire start-up defect, not the test: the twin's INIT exchange beats
+  # before its real-time set-up, which TSan slows past the 250 ms heartbeat (docs/testing.md,
+  # Flakiness); to be fixed with its own test, then run here again.
   test_stage "TSan (concurrency, rt, serial)" "$root/build-tsan" -j 1 -L concurrency -L "^rt$" \
     -LE long -E '^HilCli[.]EitherSideMayStartFirst$'
 }
