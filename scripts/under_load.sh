@@ -24,7 +24,10 @@ while [[ $# -gt 0 ]]; do
     *) echo "under_load: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
-[[ $runs =~ ^[1-9][0-9]*$ ]] || { echo "under_load: --runs wants a positive whole number, not '$runs'" >&2; exit 2; }
+if [[ ! $runs =~ ^[1-9][0-9]*$ ]]; then
+  echo "under_load: --runs wants a positive whole number, not '$runs'" >&2
+  exit 2
+fi
 [[ -f "$build_dir/CTestTestfile.cmake" ]] || {
   echo "under_load: $build_dir holds no tests: build it first (bash scripts/test.sh)" >&2; exit 2; }
 cpus=$(nproc)
