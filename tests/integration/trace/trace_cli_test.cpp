@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -164,11 +166,31 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   const json jitter = ReadJson(out + "/jitter_report.json");
   EXPECT_TRUE(jitter["kernel_recorded"].get<bool>());
   ASSERT_FALSE(jitter["causes"].empty()) << jitter.dump(2);
-  const json& top = jitter["causes"][0];
-  EXPECT_EQ(top["class"], "preempted") << jitter["causes"].dump(2);
-  ASSERT_FALSE(top["culprits"].empty());
-  EXPECT_NE(top["culprits"][0]["name"].get<std::string>().find("hiltwin-hog"), std::string::npos)
-      << top.dump(2);
+  // The hog is the first culprit of the "preempted" class and outweighs every other named
+  // culprit of every class. Not "the top class": the cycles the loop catches up after each
+  // burst are still classed "invisible" (CPU 1, no event in their window), and on a slower
+  // machine they outnumber the burst's own (CI, stop 40: 321 against 232). Issue 35 makes them
+  // inherit the burst's cause ("backlog behind k=N"); until then the class order is the
+  // machine's, not the classifier's.
+  const std::size_t expected_cycles = 2 * 4000 * 3 / 100;  // 2 s at 4 kHz, 3 ms in every 100
+  std::int64_t hog_cycles = 0;
+  std::int64_t other_named_max = 0;
+  std::string other_named;
+  for (const json& cause : jitter["causes"]) {
+    if (cause["class"] == "invisible") continue;
+    for (const json& culprit : cause["culprits"]) {
+      const auto name = culprit["name"].get<std::string>();
+      const auto cycles = culprit["cycles"].get<std::int64_t>();
+      if (cause["class"] == "preempted" && name.find("hiltwin-hog") != std::string::npos) {
+        hog_cycles = cycles;
+      } else if (cycles > other_named_max) {
+        other_named_max = cycles;
+        other_named = name;
+      }
+    }
+  }
+  EXPECT_GE(hog_cycles, static_cast<std::int64_t>(expected_cycles / 2)) << jitter["causes"].dump(2);
+  EXPECT_GT(hog_cycles, other_named_max) << other_named << "\n" << jitter["causes"].dump(2);
   // The misses the competitor caused name it, with its policy and priority (other threads,
   // kernel workers say, may preempt the loop too on a busy machine).
   int named = 0;
