@@ -5,8 +5,9 @@
 # or an undocumented exception; the input that did it is kept and its path printed.
 # The repository's corpus is never written to: new inputs go to a temporary copy.
 #
-# Usage: scripts/fuzz.sh [--long SECONDS] [--build-dir DIR] [--keep DIR] [TARGET...]
+# Usage: scripts/fuzz.sh [--long SECONDS] [--build-dir DIR] [--keep DIR] [--build-only] [TARGET...]
 #   --long SECONDS  run each target this long instead (local hunting; e.g. --long 600)
+#   --build-only    build the targets and stop (scripts/test.sh --prebuild builds them early)
 #   --build-dir DIR the clang build folder (default build-fuzz)
 #   --keep DIR      keep each target's grown corpus in DIR/<target> (to pick new seeds from)
 #   TARGET          spi_frame wire_layout csv_profile csv_log toml_config cli
@@ -19,13 +20,15 @@ all_targets=(spi_frame wire_layout csv_profile csv_log toml_config cli fmu_model
 seconds=5
 build_dir="$root/build-fuzz"
 keep_dir=""
+build_only=0
 targets=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --long) seconds=${2:?--long needs a number of seconds per target}; shift 2 ;;
     --build-dir) build_dir=${2:?--build-dir needs a folder}; shift 2 ;;
     --keep) keep_dir=${2:?--keep needs a folder}; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --build-only) build_only=1; shift ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1 (see scripts/fuzz.sh --help)" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
   esac
@@ -51,6 +54,7 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWith
   -DHILTWIN_WERROR=ON -DHILTWIN_FUZZ=ON -DHILTWIN_BUILD_TESTS=OFF -DHILTWIN_BUILD_BENCH=OFF \
   -DHILTWIN_FPGA=OFF -DHILTWIN_FPGA_SIM=OFF -DHILTWIN_WITH_LTTNG=OFF >/dev/null
 cmake --build "$build_dir" --target hiltwin_fuzzers -j "$(nproc)"
+((build_only)) && exit 0
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/hiltwin-fuzz.XXXXXX")
 trap 'rm -rf "$work"' EXIT

@@ -8,10 +8,15 @@
 #     concurrency: the tests that race threads or processes); arm64 cross-built and run under
 #     qemu (labels unit, install, package); the bounded, seeded libFuzzer run of every parser.
 #   --all: the quick tier, then the matrix.
+#   --prebuild DIR: only the matrix's builds (ASan+UBSan, TSan, arm64, fuzz targets), one after
+#     the other, each leaving DIR/<folder>.done or .failed. .ci/run starts it in the background
+#     at SCHED_IDLE before the quick tier, so the matrix compiles on the CPU the quick tier's and
+#     the matrix's tests leave idle; each matrix stage waits for its tree's mark (named by
+#     HILTWIN_PREBUILD_DIR), then builds what is left.
 # The opt-in label long (the hour-long soak, the 720,000-message and 12 s RTL runs) runs in no
 # stage: ctest --test-dir build -L long. Each stage prints how long it built and tested, and a
 # table of all stages closes the run.
-# Usage: bash scripts/test.sh [--matrix | --all] [--skip-arm64]
+# Usage: bash scripts/test.sh [--matrix | --all | --prebuild DIR] [--skip-arm64]
 #   (the arm64 stage needs bash scripts/setup.sh --cross arm64)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -19,16 +24,22 @@ jobs=$(nproc)
 quick=1
 matrix=0
 arm64=1
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
-for argument in "$@"; do
-  case $argument in
+prebuild_dir=""
+usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
+while (($# > 0)); do
+  case $1 in
     --matrix) quick=0; matrix=1 ;;
     --all) quick=1; matrix=1 ;;
+    --prebuild)
+      [[ -d ${2:-} ]] || { echo "test: --prebuild needs an existing folder for its marks" >&2; exit 2; }
+      prebuild_dir=$(cd "$2" && pwd); shift ;;
     --skip-arm64) arm64=0 ;;
     -h|--help) usage; exit 0 ;;
-    *) echo "test: unknown argument '$argument' (known: --matrix, --all, --skip-arm64, --help)" >&2
+    *) echo "test: unknown argument '$1' (known: --matrix, --all, --prebuild DIR, --skip-arm64," \
+            "--help)" >&2
        exit 2 ;;
   esac
+  shift
 done
 
 # A stage that runs one label builds only the test executables that hold such tests
@@ -45,10 +56,20 @@ line_tables=(-DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
 asan_flags=(-DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
                  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG")
 no_extras=(-DHILTWIN_BUILD_BENCH=OFF -DHILTWIN_FPGA=OFF -DHILTWIN_FPGA_SIM=OFF)
+# Each matrix tree's options, in one place: its stage and --prebuild configure it alike, so the
+# stage's own build finds the prebuilt tree up to date.
+asan_options=(-DHILTWIN_SANITIZE=ON "${no_extras[@]}" "${asan_flags[@]}"
+              -DHILTWIN_TEST_SKIP_LABELS=long)
+tsan_options=(-DHILTWIN_TSAN=ON -DHILTWIN_WITH_LTTNG=OFF "${no_extras[@]}" "${line_tables[@]}"
+              -DHILTWIN_TEST_LABELS=concurrency)
+arm64_options=(--toolchain "$root/cmake/toolchains/aarch64-linux-gnu.cmake" "${no_extras[@]}"
+               "${line_tables[@]}" -DHILTWIN_TEST_LABELS=unit)
 
 timings=()  # one "stage built tested" row per stage, printed at the end
+tidy_pid=""
 finish() {
   local status=$?
+  [[ -z $tidy_pid ]] || kill "$tidy_pid" 2>/dev/null || true
   if ((${#timings[@]} > 0)); then
     echo "== test: stage times (s)"
     printf '%-34s %8s %8s\n' stage built tested
@@ -58,12 +79,54 @@ finish() {
 }
 trap finish EXIT
 
+# The trees --prebuild builds, in the order the matrix uses them.
+prebuild_trees=(build-asan build-tsan build-arm64 build-fuzz)
+if [[ -n $prebuild_dir ]]; then
+  for folder in "${prebuild_trees[@]}"; do
+    case $folder in
+      build-asan) build=(bash "$root/scripts/build.sh" "$root/$folder" "${asan_options[@]}") ;;
+      build-tsan) build=(bash "$root/scripts/build.sh" "$root/$folder" "${tsan_options[@]}") ;;
+      build-arm64) ((arm64)) || continue
+                   build=(bash "$root/scripts/build.sh" "$root/$folder" "${arm64_options[@]}") ;;
+      build-fuzz) build=(bash "$root/scripts/fuzz.sh" --build-only) ;;
+    esac
+    # A failure is only marked: the stage's own build repeats the error where it is read.
+    if "${build[@]}" >"$prebuild_dir/$folder.log" 2>&1; then
+      touch "$prebuild_dir/$folder.done"
+    else
+      touch "$prebuild_dir/$folder.failed"
+    fi
+  done
+  exit 0
+fi
+
 # build_stage DIR -- BUILD_OPTIONS...: configures and builds DIR, recording its build time.
 # test_stage NAME DIR CTEST_OPTIONS...: runs ctest in DIR and records the row.
+# wait_for_prebuild FOLDER: while `--prebuild` (HILTWIN_PREBUILD_DIR) still builds FOLDER, waits
+# for it, so that two builds never share a tree; waiting, this stage leaves it every CPU.
+wait_for_prebuild() {
+  local marks=${HILTWIN_PREBUILD_DIR:-} folder=$1
+  [[ -n $marks && -f $marks/pid && " ${prebuild_trees[*]} " == *" $folder "* ]] || return 0
+  local pid
+  pid=$(<"$marks/pid")
+  if [[ ! -e $marks/$folder.done && ! -e $marks/$folder.failed ]] && kill -0 "$pid" 2>/dev/null
+  then
+    echo "== waiting for the idle-priority build of $folder (scripts/test.sh --prebuild)"
+    while [[ ! -e $marks/$folder.done && ! -e $marks/$folder.failed ]] &&
+          kill -0 "$pid" 2>/dev/null; do
+      sleep 1
+    done
+  fi
+  # Its log says what it built; a failure is repeated by the stage's own build.
+  [[ -e $marks/$folder.failed ]] && echo "== the idle-priority build of $folder failed" \
+                                         "($marks/$folder.log); building it here" || true
+}
+
 build_stage() {
   local build_dir=$1; shift
-  echo "== building $build_dir"
   stage_start=$SECONDS
+  wait_for_prebuild "$(basename "$build_dir")"
+  echo "== building $build_dir"
   bash "$root/scripts/build.sh" "$build_dir" "$@"
   stage_built=$((SECONDS - stage_start))
 }
@@ -82,21 +145,35 @@ quick_tier() {
   test_stage "normal (quick tier)" "$root/build" -j "$jobs" -LE long
 }
 
-tidy_stage() {
+# clang-tidy only reads: it runs at SCHED_IDLE beside the other matrix stages, on the CPU their
+# tests and links leave idle (a waking test preempts it at once), and the matrix collects its
+# verdict at the end. Its row's time is from its start to that verdict.
+tidy_start() {
   # The quick tier's build: its compile commands, and the sources it generates, which clang-tidy
   # parses too. In --matrix alone it is built here when absent.
   stage_built=0
   [[ -f "$root/build/compile_commands.json" ]] || build_stage "$root/build"
-  local checked=$SECONDS
-  bash "$root/scripts/tidy.sh" "$root/build"
-  timings+=("clang-tidy (function size)" "$stage_built" "$((SECONDS - checked))")
+  tidy_built=$stage_built
+  tidy_log=$(mktemp "${TMPDIR:-/tmp}/hiltwin-tidy.XXXXXX")
+  tidy_started=$SECONDS
+  echo "== clang-tidy (function size) at idle priority beside the stages; its verdict comes last"
+  chrt --idle 0 bash "$root/scripts/tidy.sh" "$root/build" >"$tidy_log" 2>&1 &
+  tidy_pid=$!
+}
+tidy_finish() {
+  local status=0
+  wait "$tidy_pid" || status=$?
+  tidy_pid=""
+  cat "$tidy_log"
+  rm -f "$tidy_log"
+  ((status == 0)) || exit "$status"
+  timings+=("clang-tidy (function size, idle CPU)" "$tidy_built" "$((SECONDS - tidy_started))")
 }
 
 # ASan+UBSan: the whole default suite but the gateware, which the sanitizers cannot see into;
 # the executables that hold only long tests (the soaks) are not built.
 asan_stage() {
-  build_stage "$root/build-asan" -DHILTWIN_SANITIZE=ON "${no_extras[@]}" "${asan_flags[@]}" \
-    -DHILTWIN_TEST_SKIP_LABELS=long
+  build_stage "$root/build-asan" "${asan_options[@]}"
   test_stage "ASan+UBSan" "$root/build-asan" -j "$jobs" -LE long
 }
 
@@ -108,8 +185,7 @@ asan_stage() {
 # 250 ms heartbeat (measured: 3 of 17 wire tests failed to start in 5 parallel repeats; none
 # serially).
 tsan_stage() {
-  build_stage "$root/build-tsan" -DHILTWIN_TSAN=ON -DHILTWIN_WITH_LTTNG=OFF "${no_extras[@]}" \
-    "${line_tables[@]}" -DHILTWIN_TEST_LABELS=concurrency
+  build_stage "$root/build-tsan" "${tsan_options[@]}"
   test_stage "TSan (concurrency)" "$root/build-tsan" -j "$jobs" -L concurrency -LE "^(long|rt)$"
   # Left out here (it runs in the quick tier and under ASan): HilCli.EitherSideMayStartFirst
   # fails under TSan, the ECS calling the twin's heartbeat stale about 240 ms after both
@@ -130,24 +206,24 @@ arm64_stage() {
          "--cross arm64 (as root or with sudo), or skip this stage with --skip-arm64" >&2
     exit 1
   fi
-  build_stage "$root/build-arm64" \
-    --toolchain "$root/cmake/toolchains/aarch64-linux-gnu.cmake" "${no_extras[@]}" \
-    "${line_tables[@]}" -DHILTWIN_TEST_LABELS=unit
+  build_stage "$root/build-arm64" "${arm64_options[@]}"
   test_stage "arm64 under qemu (unit, install, package)" "$root/build-arm64" -j "$jobs" \
     -L "^(unit|install|package)$" -LE "^(long|rt|lttng|tracefs)$"
 }
 
 fuzz_stage() {
   local start=$SECONDS
+  wait_for_prebuild build-fuzz
   bash "$root/scripts/fuzz.sh"
   timings+=("fuzz (libFuzzer, every parser)" "-" "$((SECONDS - start))")
 }
 
 ((quick)) && quick_tier
 if ((matrix)); then
-  tidy_stage
+  tidy_start
   asan_stage
   tsan_stage
   ((arm64)) && arm64_stage
   fuzz_stage
+  tidy_finish
 fi
