@@ -72,8 +72,8 @@ finish() {
   [[ -z $tidy_pid ]] || kill "$tidy_pid" 2>/dev/null || true
   if ((${#timings[@]} > 0)); then
     echo "== test: stage times (s)"
-    printf '%-34s %8s %8s\n' stage built tested
-    printf '%-34s %8s %8s\n' "${timings[@]}"
+    printf '%-44s %8s %8s\n' stage built tested
+    printf '%-44s %8s %8s\n' "${timings[@]}"
   fi
   ((status == 0)) && echo "== test: every stage passed" || echo "== test: FAILED (exit $status)" >&2
 }
@@ -147,7 +147,8 @@ quick_tier() {
 
 # clang-tidy only reads: it runs at SCHED_IDLE beside the other matrix stages, on the CPU their
 # tests and links leave idle (a waking test preempts it at once), and the matrix collects its
-# verdict at the end. Its row's time is from its start to that verdict.
+# verdict at the end. Its row's time is its own, from its start to its end, overlapping the
+# other stages' rows.
 tidy_start() {
   # The quick tier's build: its compile commands, and the sources it generates, which clang-tidy
   # parses too. In --matrix alone it is built here when absent.
@@ -155,9 +156,14 @@ tidy_start() {
   [[ -f "$root/build/compile_commands.json" ]] || build_stage "$root/build"
   tidy_built=$stage_built
   tidy_log=$(mktemp "${TMPDIR:-/tmp}/hiltwin-tidy.XXXXXX")
-  tidy_started=$SECONDS
   echo "== clang-tidy (function size) at idle priority beside the stages; its verdict comes last"
-  chrt --idle 0 bash "$root/scripts/tidy.sh" "$root/build" >"$tidy_log" 2>&1 &
+  (
+    started=$SECONDS
+    status=0
+    chrt --idle 0 bash "$root/scripts/tidy.sh" "$root/build" || status=$?
+    echo "$((SECONDS - started))" >"$tidy_log.seconds"
+    exit "$status"
+  ) >"$tidy_log" 2>&1 &
   tidy_pid=$!
 }
 tidy_finish() {
@@ -165,9 +171,9 @@ tidy_finish() {
   wait "$tidy_pid" || status=$?
   tidy_pid=""
   cat "$tidy_log"
-  rm -f "$tidy_log"
+  timings+=("clang-tidy (function size, idle CPU)" "$tidy_built" "$(<"$tidy_log.seconds")")
+  rm -f "$tidy_log" "$tidy_log.seconds"
   ((status == 0)) || exit "$status"
-  timings+=("clang-tidy (function size, idle CPU)" "$tidy_built" "$((SECONDS - tidy_started))")
 }
 
 # ASan+UBSan: the whole default suite but the gateware, which the sanitizers cannot see into;
