@@ -20,7 +20,8 @@ endfunction()
 # a time as one unit, so each batch parses the headers and emits their inline functions once.
 # A file that cannot share a unit sets SKIP_UNITY_BUILD_INCLUSION in its folder's
 # CMakeLists.txt, with the reason. (A precompiled header shared by the tests was measured and
-# dropped: with g++ 12 and -g it is 274 MB and made a test unit twice as slow to compile.)
+# dropped: with g++ 12 and -g it is 274 MB and made a test unit twice as slow to compile. Now
+# that the tests compile at -g1 it saves a seventh of their compile; docs/testing.md.)
 option(HILTWIN_UNITY_BUILD "Compile each target's sources in batches (unity build)" ON)
 set(HILTWIN_UNITY_BATCH 8 CACHE STRING "Sources per unity-build unit")
 set(HILTWIN_TEST_LABELS "" CACHE STRING
