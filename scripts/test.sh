@@ -107,16 +107,14 @@ fi
 wait_for_prebuild() {
   local marks=${HILTWIN_PREBUILD_DIR:-} folder=$1
   [[ -n $marks && -f $marks/pid && " ${prebuild_trees[*]} " == *" $folder "* ]] || return 0
-  local pid
+  local pid said=0
   pid=$(<"$marks/pid")
-  if [[ ! -e $marks/$folder.done && ! -e $marks/$folder.failed ]] && kill -0 "$pid" 2>/dev/null
-  then
-    echo "== waiting for the idle-priority build of $folder (scripts/test.sh --prebuild)"
-    while [[ ! -e $marks/$folder.done && ! -e $marks/$folder.failed ]] &&
-          kill -0 "$pid" 2>/dev/null; do
-      sleep 1
-    done
-  fi
+  while [[ ! -e $marks/$folder.done && ! -e $marks/$folder.failed ]] && kill -0 "$pid" 2>/dev/null
+  do
+    ((said)) || echo "== waiting for the idle-priority build of $folder (scripts/test.sh --prebuild)"
+    said=1
+    sleep 1
+  done
   # Its log says what it built; a failure is repeated by the stage's own build.
   [[ -e $marks/$folder.failed ]] && echo "== the idle-priority build of $folder failed" \
                                          "($marks/$folder.log); building it here" || true

@@ -147,7 +147,12 @@ TEST_F(TraceCli, AnalyzeReadsATraceRecordedByHandWithTheLttngCommand) {
 TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses) {
   if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
   // The competitor: SCHED_FIFO 95 on CPU 1, 3 ms of spinning every 100 ms, above the loop's 80.
-  auto hog = hiltwin::test::Spawn({HILTWIN_HOG, "hiltwin-hog", "1", "95", "3", "97", "20"},
+  constexpr int kSpinMs = 3;
+  constexpr int kSleepMs = 97;
+  constexpr int kTraceSeconds = 2;
+  constexpr int kRateHz = 4000;
+  auto hog = hiltwin::test::Spawn({HILTWIN_HOG, "hiltwin-hog", "1", "95", std::to_string(kSpinMs),
+                                   std::to_string(kSleepMs), "20"},
                                   Path("hog.out"));
   for (int i = 0; i < 100 && !fs::exists(Path("hog.out")); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -157,7 +162,8 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   std::string word;
   if (!(ready >> word) || word != "ready") GTEST_SKIP() << "SCHED_FIFO refused: no competitor";
   const std::string out = Path("trace");
-  const auto r = Hiltwin({"trace", "--kernel", "--output", out, "--duration", "2", "--rate", "4000",
+  const auto r = Hiltwin({"trace", "--kernel", "--output", out, "--duration",
+                          std::to_string(kTraceSeconds), "--rate", std::to_string(kRateHz),
                           "--cpu", "1", "--priority", "80", "--no-progress"});
   if (r.exit_code == 5 && r.err.find("--kernel") != std::string::npos) {
     GTEST_SKIP() << "the kernel cannot be recorded here: " << r.err;
@@ -172,7 +178,9 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   // machine they outnumber the burst's own (CI, stop 40: 321 against 232). Issue 35 makes them
   // inherit the burst's cause ("backlog behind k=N"); until then the class order is the
   // machine's, not the classifier's.
-  const std::size_t expected_cycles = 2 * 4000 * 3 / 100;  // 2 s at 4 kHz, 3 ms in every 100
+  // The cycles the bursts cover: 2 s at 4 kHz, 3 ms in every 100 ms (240).
+  const std::size_t expected_cycles = std::size_t{kTraceSeconds} * kRateHz * kSpinMs /
+                                      (kSpinMs + kSleepMs);
   std::int64_t hog_cycles = 0;
   std::int64_t other_named_max = 0;
   std::string other_named;
