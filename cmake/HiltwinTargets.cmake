@@ -19,9 +19,8 @@ endfunction()
 # compiled again and again. Unity builds: a target's sources are compiled HILTWIN_UNITY_BATCH at
 # a time as one unit, so each batch parses the headers and emits their inline functions once.
 # A file that cannot share a unit sets SKIP_UNITY_BUILD_INCLUSION in its folder's
-# CMakeLists.txt, with the reason. (A precompiled header shared by the tests was measured and
-# dropped: with g++ 12 and -g it is 274 MB and made a test unit twice as slow to compile. Now
-# that the tests compile at -g1 it saves a seventh of their compile; docs/testing.md.)
+# CMakeLists.txt, with the reason. The tests also share one precompiled header
+# (hiltwin_test_pch below).
 option(HILTWIN_UNITY_BUILD "Compile each target's sources in batches (unity build)" ON)
 set(HILTWIN_UNITY_BATCH 8 CACHE STRING "Sources per unity-build unit")
 set(HILTWIN_TEST_LABELS "" CACHE STRING
@@ -50,6 +49,30 @@ function(hiltwin_test_target_flags target)
   if(HILTWIN_TEST_OPTIMIZATION)
     target_compile_options(${target} PRIVATE ${HILTWIN_TEST_OPTIMIZATION})
   endif()
+endfunction()
+
+# One precompiled header for every test executable (REUSE_FROM): the headers nearly every test
+# parses, GoogleTest, gmock, nlohmann-json and the standard library's most used, compiled once
+# per tree instead of once per unit (measured: the tests' compile 486 -> 416 CPU-s at -Og -g1;
+# at -g it was 274 MB and made a unit slower, which is why the tests compile at -g1 first).
+# GCC takes a precompiled header only when the unit's code-generation flags and the macros it
+# uses match, so it is built with the tests' own flags (hiltwin_test_target_flags) and links
+# what defines GoogleTest's macros; an executable with other such flags (one that undefines
+# NDEBUG) passes OWN_FLAGS to hiltwin_add_gtest and parses the headers itself.
+function(hiltwin_test_pch_target)
+  if(TARGET hiltwin_test_pch)
+    return()
+  endif()
+  file(WRITE "${CMAKE_BINARY_DIR}/hiltwin_test_pch.cpp"
+       "// The object of the tests' shared precompiled header (cmake/HiltwinTargets.cmake).\n")
+  add_library(hiltwin_test_pch OBJECT "${CMAKE_BINARY_DIR}/hiltwin_test_pch.cpp")
+  target_link_libraries(hiltwin_test_pch PRIVATE GTest::gtest GTest::gmock
+                        nlohmann_json::nlohmann_json)
+  target_compile_features(hiltwin_test_pch PRIVATE cxx_std_20)
+  hiltwin_test_target_flags(hiltwin_test_pch)
+  target_precompile_headers(hiltwin_test_pch PRIVATE
+    <gtest/gtest.h> <gmock/gmock.h> <nlohmann/json.hpp> <algorithm> <atomic> <chrono> <cstdint>
+    <filesystem> <fstream> <memory> <sstream> <string> <thread> <vector>)
 endfunction()
 
 # Sanitizers are global so that every object, including GoogleTest's main, agrees.
@@ -115,10 +138,12 @@ endfunction()
 
 # hiltwin_add_gtest(<name> SOURCES <files...> LIBS <targets...> LABELS <labels...>
 #                   [RT_TESTS <regex>] [CONCURRENCY_TESTS <regex>] [TIMEOUT s]
-#                   [RESOURCE_LOCK <names...>])
+#                   [RESOURCE_LOCK <names...>] [OWN_FLAGS])
 # A GoogleTest executable whose tests CTest discovers one by one, with labels
 # (unit, integration, rt, concurrency, long, soak) so suites can be chosen with `ctest -L`;
 # docs/testing.md says which stage runs which label.
+# OWN_FLAGS: the executable changes code-generation flags or macros the shared precompiled
+# header depends on (say -UNDEBUG), so it does not use it (hiltwin_test_pch_target).
 # RESOURCE_LOCK: names CTest never runs two holders of at once (`lttng`: the one session
 # daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer). Each
 # name is a label too, so a stage that has no such thing leaves those tests out by name
@@ -139,7 +164,7 @@ endfunction()
 # Cross-compiled (arm64), discovery runs the test binary at test time, under the emulator,
 # not at build time: the build then needs no emulator at all.
 function(hiltwin_add_gtest name)
-  cmake_parse_arguments(ARG "" "TIMEOUT;RT_TESTS;CONCURRENCY_TESTS"
+  cmake_parse_arguments(ARG "OWN_FLAGS" "TIMEOUT;RT_TESTS;CONCURRENCY_TESTS"
                         "SOURCES;LIBS;LABELS;RESOURCE_LOCK" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
@@ -151,6 +176,10 @@ function(hiltwin_add_gtest name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
   hiltwin_test_target_flags(${name})
+  if(NOT ARG_OWN_FLAGS)
+    hiltwin_test_pch_target()
+    target_precompile_headers(${name} REUSE_FROM hiltwin_test_pch)
+  endif()
   set(labels ${ARG_LABELS} ${ARG_RESOURCE_LOCK})
   set(possible_labels ${labels})
   if(ARG_RT_TESTS)
