@@ -49,9 +49,8 @@ done
 # optimises at -Og: the sanitizers' documentation asks for -O1 or more for usable speed, and
 # -Og is GCC's -O1 without the passes that obscure debugging; it compiles the libraries a third
 # faster (two units: 125 -> 87 s) and the suite runs as before (docs/testing.md). The
-# ThreadSanitizer build keeps -O2, as in the runs where its wall-clock pairs passed (at -O1 a
-# HiL pair once missed its heartbeat), and the arm64 build keeps -O2, what a Pi runs, and what
-# keeps its emulated tests short. None of them builds the benchmarks or the gateware
+# ThreadSanitizer build keeps -O2, as in the runs where its wall-clock pairs passed, and the
+# arm64 build keeps -O2, what a Pi runs, and what keeps its emulated tests short. None of them builds the benchmarks or the gateware
 # (bitstreams, Verilator model): the quick tier has them.
 line_tables=(-DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
              -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG")
