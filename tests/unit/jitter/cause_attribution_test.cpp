@@ -306,9 +306,17 @@ TEST(CauseAttribution, ATimingLogCannotBeMatchedToKernelEvents) {
   EXPECT_FALSE(r.warnings.empty());
 }
 
+// 11 s at 20 kHz: 1.1 million kernel events; a tenth under an emulator (HILTWIN_UNDER_EMULATOR,
+// cmake/HiltwinTargets.cmake), where the indexing is the same code on a tenth of the events.
+#ifdef HILTWIN_UNDER_EMULATOR
+constexpr std::uint64_t kMillionRunScale = 10;
+#else
+constexpr std::uint64_t kMillionRunScale = 1;
+#endif
+
 TEST(CauseAttribution, AMillionEventsAreIndexedAndQueriedQuickly) {
   RunSpec spec = KernelRun();
-  spec.releases = 220'000;  // 11 s at 20 kHz: 1.1 million kernel events
+  spec.releases = 220'000 / kMillionRunScale;
   for (std::uint64_t k = 1'000; k < spec.releases; k += 1'000) spec.overrides[k] = {3'000, 60'000};
   const TimingTrace trace = testing::MakeTrace(spec);
   std::map<std::uint64_t, SpecialCycle> special;
@@ -316,11 +324,11 @@ TEST(CauseAttribution, AMillionEventsAreIndexedAndQueriedQuickly) {
     special[k] = IrqInStep(42, "eth0", 5'000, 40'000);
   }
   const KernelTrace kernel = testing::MakeKernel(trace, special);
-  ASSERT_GT(kernel.events.size(), 1'000'000u);
+  ASSERT_GT(kernel.events.size(), 1'000'000u / kMillionRunScale);
   const JitterReport r = AnalyzeJitter(trace, &kernel);
   ASSERT_EQ(r.causes.size(), 1u);
   EXPECT_EQ(r.causes[0].cause, CauseClass::kInterrupt);
-  EXPECT_EQ(r.causes[0].cycles, 219u);
+  EXPECT_EQ(r.causes[0].cycles, (spec.releases - 1) / 1'000);  // k = 1,000 ... 219,000: 219
 }
 
 }  // namespace

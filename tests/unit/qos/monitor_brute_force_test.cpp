@@ -14,7 +14,8 @@
 namespace hiltwin::qos {
 namespace {
 
-#ifdef HILTWIN_UNDER_SANITIZER
+// Shorter where every instruction costs several: instrumented, or emulated (arm64 under qemu).
+#if defined(HILTWIN_UNDER_SANITIZER) || defined(HILTWIN_UNDER_EMULATOR)
 constexpr std::size_t kLength = 1500;
 #else
 constexpr std::size_t kLength = 4000;
