@@ -85,8 +85,8 @@ run_target() {
   echo "$result" >"$work/$target.result"
 }
 # One target per core at a time: each run is single-threaded, and its seed and time bound make
-# it the same run beside another as alone (a target's executions in its time vary with the load, as
-# they do between machines).
+# it the same run beside another as alone (how many inputs it gets through in its time varies
+# with the load, as it does between machines).
 running=0
 for target in "${targets[@]}"; do
   run_target "$target" &

@@ -10,10 +10,9 @@
 #   --all: the quick tier, then the matrix.
 #   --prebuild DIR: only the matrix's builds (ASan+UBSan, TSan, arm64, fuzz targets), in two
 #     chains side by side (ASan then arm64; TSan then fuzz), each leaving DIR/<folder>.done or
-#     .failed. .ci/run starts it in the background
-#     at SCHED_IDLE before the quick tier, so the matrix compiles on the CPU the quick tier's and
-#     the matrix's tests leave idle; each matrix stage waits for its tree's mark (named by
-#     HILTWIN_PREBUILD_DIR), then builds what is left.
+#     .failed. .ci/run starts it in the background at SCHED_IDLE before the quick tier, so the
+#     matrix compiles on the CPU the quick tier's and the matrix's tests leave idle; each matrix
+#     stage waits for its tree's mark (named by HILTWIN_PREBUILD_DIR), then builds what is left.
 # The opt-in label long (the hour-long soak, the 720,000-message and 12 s RTL runs) runs in no
 # stage: ctest --test-dir build -L long. Each stage prints how long it built and tested, and a
 # table of all stages closes the run.
@@ -26,7 +25,7 @@ quick=1
 matrix=0
 arm64=1
 prebuild_dir=""
-usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
 while (($# > 0)); do
   case $1 in
     --matrix) quick=0; matrix=1 ;;
@@ -51,8 +50,8 @@ done
 # -Og is GCC's -O1 without the passes that obscure debugging; it compiles the libraries a third
 # faster (two units: 125 -> 87 s) and the suite runs as before (docs/testing.md). The
 # ThreadSanitizer build keeps -O2, as in the runs where its wall-clock pairs passed, and the
-# arm64 build keeps -O2, what a Pi runs, and what keeps its emulated tests short. None of them builds the benchmarks or the gateware
-# (bitstreams, Verilator model): the quick tier has them.
+# arm64 build keeps -O2, what a Pi runs, and what keeps its emulated tests short. None of them
+# builds the benchmarks or the gateware (bitstreams, Verilator model): the quick tier has them.
 line_tables=(-DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
              -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG")
 asan_flags=(-DCMAKE_C_FLAGS_RELWITHDEBINFO="-Og -g1 -DNDEBUG"
@@ -87,7 +86,7 @@ trap finish EXIT
 # one tree's tail overlaps the other chain's units. Both run at SCHED_IDLE, so they share only
 # what the tests leave.
 prebuild_chains=("build-asan build-arm64" "build-tsan build-fuzz")
-prebuild_trees=(build-asan build-tsan build-arm64 build-fuzz)
+read -ra prebuild_trees <<<"${prebuild_chains[*]}"
 # prebuild_tree FOLDER: builds one matrix tree and leaves DIR/FOLDER.done or .failed.
 prebuild_tree() {
   local folder=$1 build
