@@ -145,8 +145,9 @@ function(hiltwin_add_module name)
 endfunction()
 
 # hiltwin_add_gtest(<name> SOURCES <files...> LIBS <targets...> LABELS <labels...>
-#                   [RT_TESTS <regex>] [CONCURRENCY_TESTS <regex>] [SLOW_TESTS <regex>]
-#                   [TIMEOUT s] [RESOURCE_LOCK <names...>] [OWN_FLAGS])
+#                   [RT_TESTS <regex>] [CONCURRENCY_TESTS <regex>]
+#                   [SLOW_TESTS <regex>=<seconds>...] [TIMEOUT s] [RESOURCE_LOCK <names...>]
+#                   [OWN_FLAGS])
 # A GoogleTest executable whose tests CTest discovers one by one, with labels
 # (unit, integration, rt, concurrency, long, soak) so suites can be chosen with `ctest -L`;
 # docs/testing.md says which stage runs which label.
@@ -162,10 +163,10 @@ endfunction()
 # CONCURRENCY_TESTS: the tests that race threads or processes (lock-free queues, the logger,
 # the wire, telemetry, session threads, two-process pairs) also get the label `concurrency`:
 # the ThreadSanitizer stage runs exactly these (".*": every test of the executable).
-# SLOW_TESTS: the tests that take ten seconds or more in some stage get a COST, so that
-# `ctest -j` starts them first: a fresh clone has no CTestCostData.txt, and CTest otherwise
-# starts them wherever their number falls, leaving one core to run them alone at the end (the
-# quick tier's RTL runs: 86 s and 68 s).
+# SLOW_TESTS: the tests that take ten seconds or more in some stage, each with its seconds in
+# the stage where it is slowest (measured; CTest's COST), so that `ctest -j` starts the longest
+# first: a fresh clone has no CTestCostData.txt, and CTest otherwise starts them wherever their
+# number falls and ends on one core running them alone (the quick tier's RTL runs: 86 s, 68 s).
 # HILTWIN_TEST_LABELS (a CMake list; empty: all): only the executables that hold a test with one
 # of these labels are built and known to CTest. A stage that runs one label (the TSan stage:
 # concurrency; arm64: unit) then compiles no test it would not run.
@@ -175,12 +176,9 @@ endfunction()
 # a CTest include file that runs after discovery, over the discovered list.
 # Cross-compiled (arm64), discovery runs the test binary at test time, under the emulator,
 # not at build time: the build then needs no emulator at all.
-# The COST of a slow test (SLOW_TESTS here, and the gateware's and packaging's tests): above
-# any test's seconds, so that these start first.
-set(HILTWIN_SLOW_TEST_COST 1000)
 function(hiltwin_add_gtest name)
-  cmake_parse_arguments(ARG "OWN_FLAGS" "TIMEOUT;RT_TESTS;CONCURRENCY_TESTS;SLOW_TESTS"
-                        "SOURCES;LIBS;LABELS;RESOURCE_LOCK" ${ARGN})
+  cmake_parse_arguments(ARG "OWN_FLAGS" "TIMEOUT;RT_TESTS;CONCURRENCY_TESTS"
+                        "SOURCES;LIBS;LABELS;RESOURCE_LOCK;SLOW_TESTS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
@@ -261,12 +259,16 @@ function(hiltwin_add_gtest name)
     string(APPEND content " RESOURCE_LOCK \"${ARG_RESOURCE_LOCK}\"")
   endif()
   string(APPEND content ")\n")
-  if(ARG_SLOW_TESTS)
+  foreach(slow IN LISTS ARG_SLOW_TESTS)
+    if(NOT slow MATCHES "^(.+)=([0-9]+)$")
+      message(FATAL_ERROR "hiltwin_add_gtest(${name}): SLOW_TESTS entry '${slow}' is not "
+                          "<regex>=<seconds>")
+    endif()
     string(APPEND content
-      "  if(test MATCHES [=[${ARG_SLOW_TESTS}]=])\n"
-      "    set_tests_properties(\"\${test}\" PROPERTIES COST ${HILTWIN_SLOW_TEST_COST})\n"
+      "  if(test MATCHES [=[${CMAKE_MATCH_1}]=])\n"
+      "    set_tests_properties(\"\${test}\" PROPERTIES COST ${CMAKE_MATCH_2})\n"
       "  endif()\n")
-  endif()
+  endforeach()
   string(APPEND content "endforeach()\n")
   file(WRITE "${script}" "${content}")
   # Appended after gtest_discover_tests's own include file, so it runs after discovery.
