@@ -8,11 +8,12 @@
 #     concurrency: the tests that race threads or processes); arm64 cross-built and run under
 #     qemu (labels unit, install, package); the bounded, seeded libFuzzer run of every parser.
 #   --all: the quick tier, then the matrix.
-#   --prebuild DIR: only the matrix's builds (ASan+UBSan, TSan, arm64, fuzz targets), in two
-#     chains side by side (ASan then arm64; TSan then fuzz), each leaving DIR/<folder>.done or
-#     .failed. .ci/run starts it in the background at SCHED_IDLE before the quick tier, so the
-#     matrix compiles on the CPU the quick tier's and the matrix's tests leave idle; each matrix
-#     stage waits for its tree's mark (named by HILTWIN_PREBUILD_DIR), then builds what is left.
+#   --prebuild DIR: only the matrix's builds (ASan+UBSan, TSan, arm64, fuzz targets), two at a
+#     time, each taken in that order by whichever builder is free, each leaving
+#     DIR/<folder>.done or .failed. .ci/run starts it in the background at SCHED_IDLE before the
+#     quick tier, so the matrix compiles on the CPU the quick tier's and the matrix's tests leave
+#     idle; each matrix stage waits for its tree's mark (named by HILTWIN_PREBUILD_DIR), then
+#     builds what is left.
 # The opt-in label long (the hour-long soak, the 720,000-message and 12 s RTL runs) runs in no
 # stage: ctest --test-dir build -L long. Each stage prints how long it built and tested, and a
 # table of all stages closes the run.
@@ -25,7 +26,7 @@ quick=1
 matrix=0
 arm64=1
 prebuild_dir=""
-usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; }
 while (($# > 0)); do
   case $1 in
     --matrix) quick=0; matrix=1 ;;
@@ -80,13 +81,15 @@ finish() {
 }
 trap finish EXIT
 
-# The trees --prebuild builds, in two chains side by side: each chain's trees in the order the
-# matrix uses them. One chain alone left a core idle for a minute or two at the end of each tree
-# (its last large unit, then its links: measured 400 idle CPU-seconds in a cold run); with two,
-# one tree's tail overlaps the other chain's units. Both run at SCHED_IDLE, so they share only
-# what the tests leave.
-prebuild_chains=("build-asan build-arm64" "build-tsan build-fuzz")
-read -ra prebuild_trees <<<"${prebuild_chains[*]}"
+# The trees --prebuild builds, in the order the matrix uses them, by two builders side by side:
+# each takes the next tree no one has taken yet (a mkdir claim, which only one can win). One
+# builder alone left a core idle for a minute or two at the end of each tree (its last large
+# unit, then its links: 400 idle CPU-seconds in a cold run). Two fixed chains (ASan then arm64,
+# TSan then fuzz) kept both cores busy, but the arm64 tree then began only when the ASan tree
+# was done, 7 minutes after the TSan chain could have taken it, and was the last to finish.
+# Both builders run at SCHED_IDLE, so they share only what the tests leave.
+prebuild_trees=(build-asan build-tsan build-arm64 build-fuzz)
+prebuild_builders=2
 # prebuild_tree FOLDER: builds one matrix tree and leaves DIR/FOLDER.done or .failed.
 prebuild_tree() {
   local folder=$1 build
@@ -104,14 +107,20 @@ prebuild_tree() {
     touch "$prebuild_dir/$folder.failed"
   fi
 }
-if [[ -n $prebuild_dir ]]; then
-  chain_pids=()
-  for chain in "${prebuild_chains[@]}"; do
-    # shellcheck disable=SC2086  # a chain is a list of folder names
-    (for folder in $chain; do prebuild_tree "$folder"; done) &
-    chain_pids+=($!)
+# prebuild_builder: builds, in the matrix's order, every tree it is the first to claim.
+prebuild_builder() {
+  local folder
+  for folder in "${prebuild_trees[@]}"; do
+    if mkdir "$prebuild_dir/$folder.claimed" 2>/dev/null; then prebuild_tree "$folder"; fi
   done
-  wait "${chain_pids[@]}"
+}
+if [[ -n $prebuild_dir ]]; then
+  builder_pids=()
+  for ((builder = 0; builder < prebuild_builders; ++builder)); do
+    prebuild_builder &
+    builder_pids+=($!)
+  done
+  wait "${builder_pids[@]}"
   exit 0
 fi
 
