@@ -47,11 +47,27 @@ dirs="kernel_glue|scheduler|qos|statemachine|io|fpga_sim|tracing|runtime|plant|f
 dirs+="|analysis|trace_capture|app_relbot|tests|bench"
 echo "== tidy: function size (at most 80 lines) in ${#files[@]} files (${#inputs[@]} units)"
 # The tests compile with a GCC precompiled header (cmake/HiltwinTargets.cmake), which clang
-# cannot read: clang-tidy gets the compile commands without it, and each unit then includes
-# the headers itself, as every test source does.
+# cannot read. clang-tidy gets clang's own of the same header, made once here with the GCC
+# header's compile command (the same flags, so the units that use it match it): without it every
+# test unit parses GoogleTest, gmock and nlohmann-json again (a unit of the CLI tests: 9.2 s
+# with them parsed, 7.2 s with the precompiled header, the header's own 4.5 s paid once).
 work=$(mktemp -d "${TMPDIR:-/tmp}/hiltwin-tidy.XXXXXX")
 trap 'rm -rf "$work"' EXIT
-sed -E 's# -Winvalid-pch##g; s# -include [^ "]*/cmake_pch\.hxx##g' \
+pch_command=$(grep -o '"command": "[^"]*-x c++-header[^"]*cmake_pch\.hxx\.cxx"' \
+                "$build_dir/compile_commands.json" | head -1 | cut -d'"' -f4)
+pch_flags=()  # none without tests: no unit names the GCC header then
+if [[ -n $pch_command ]]; then
+  header=$(sed -E 's#.* -include ([^ ]*/cmake_pch\.hxx) .*#\1#' <<<"$pch_command")
+  read -ra clang_pch_command <<<"$(sed -E 's#^[^ ]+#clang++#; s# -Winvalid-pch##; s# -include [^ ]*cmake_pch\.hxx##;
+                                 s# -o [^ ]+# -o '"$work"'/tests.pch#; s# -c [^ ]+$##' <<<"$pch_command")"
+  "${clang_pch_command[@]}" -w "$header" 2>"$work/pch.err" || {
+    cat "$work/pch.err" >&2
+    echo "tidy: clang could not precompile the tests' header $header (above)" >&2
+    exit 1
+  }
+  pch_flags=(-include-pch "$work/tests.pch")
+fi
+sed -E 's# -Winvalid-pch##g; s# -include [^ "]*/cmake_pch\.hxx# '"${pch_flags[*]}"'#g' \
   "$build_dir/compile_commands.json" >"$work/compile_commands.json"
 # -w: the compiler's own warnings are GCC's business (the build has them as errors, and some
 # are GCC-only options clang does not know); the check's findings are not compiler warnings.
