@@ -274,3 +274,46 @@ function(hiltwin_add_gtest name)
   # Appended after gtest_discover_tests's own include file, so it runs after discovery.
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
 endfunction()
+
+# hiltwin_test_paths(<test> NAME=<path> ...): the files a test reads or runs (the hiltwin binary,
+# a helper program, a TOML file of the source tree), as macros NAME that expand to an absolute
+# path found at run time: the path relative to the test program's own folder, resolved against
+# /proc/self/exe (tests/fakes/test_paths.h). A path spelled into the compile command would put
+# the clone's folder into the unit's preprocessed text, where ccache keys on it, and a second
+# clone's test units would all miss the cache (docs/testing.md). <path> is an absolute path or
+# $<TARGET_FILE:target>; an empty one stays "" (the test skips what it names). The macros are
+# defined when the top folder is done: a helper program's folder may come after the test's.
+function(hiltwin_test_paths test)
+  foreach(pair IN LISTS ARGN)
+    if(NOT pair MATCHES "^([A-Z0-9_]+)=(.*)$")
+      message(FATAL_ERROR "hiltwin_test_paths(${test}): '${pair}' is not NAME=PATH")
+    endif()
+    cmake_language(EVAL CODE "cmake_language(DEFER DIRECTORY [[${PROJECT_SOURCE_DIR}]] CALL
+                   hiltwin_define_test_path [[${test}]] [[${CMAKE_MATCH_1}]] [[${CMAKE_MATCH_2}]])")
+  endforeach()
+  target_link_libraries(${test} PRIVATE hiltwin::test_fakes)
+endfunction()
+
+function(hiltwin_define_test_path test name path)
+  if(path STREQUAL "")
+    target_compile_definitions(${test} PRIVATE "${name}=\"\"")
+    return()
+  endif()
+  get_target_property(test_dir ${test} BINARY_DIR)
+  if(path MATCHES "^\\$<TARGET_FILE:([^>]+)>$")
+    set(target ${CMAKE_MATCH_1})
+    get_target_property(target_dir ${target} RUNTIME_OUTPUT_DIRECTORY)
+    if(NOT target_dir)
+      get_target_property(target_dir ${target} BINARY_DIR)
+    endif()
+    file(RELATIVE_PATH relative "${test_dir}" "${target_dir}/_")
+    string(REGEX REPLACE "_$" "$<TARGET_FILE_NAME:${target}>" relative "${relative}")
+  elseif(IS_ABSOLUTE "${path}")
+    file(RELATIVE_PATH relative "${test_dir}" "${path}")
+  else()
+    message(FATAL_ERROR "hiltwin_test_paths(${test}): ${name}=${path} is neither an absolute "
+                        "path nor $<TARGET_FILE:target>")
+  endif()
+  target_compile_definitions(${test} PRIVATE
+                             "${name}=::hiltwin::test::BesideTest(\"${relative}\")")
+endfunction()

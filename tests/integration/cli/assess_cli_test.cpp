@@ -14,6 +14,8 @@
 #include <sstream>
 #include <string>
 
+#include "fakes/test_paths.h"
+
 namespace {
 
 struct Result {

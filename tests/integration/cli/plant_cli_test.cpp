@@ -13,6 +13,7 @@
 
 #include "fakes/csv_table.h"
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 #include "plant_test_support.h"
 
 namespace {

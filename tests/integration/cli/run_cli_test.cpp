@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 

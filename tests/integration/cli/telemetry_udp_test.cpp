@@ -13,6 +13,7 @@
 
 #include "fakes/csv_table.h"
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 #include "fakes/udp_listener.h"
 
 namespace hiltwin {

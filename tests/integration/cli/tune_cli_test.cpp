@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 

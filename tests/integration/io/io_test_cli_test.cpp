@@ -9,6 +9,7 @@
 #include <string>
 #include <thread>
 
+#include "fakes/test_paths.h"
 #include "hiltwin/io/wire_bus.h"
 #include "fakes/process.h"
 

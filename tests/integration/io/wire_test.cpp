@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "fakes/test_paths.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/clock.h"

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 #include "fakes/wire_scratch.h"
 
 namespace {

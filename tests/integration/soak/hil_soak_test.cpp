@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 

@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace hiltwin {
 namespace {

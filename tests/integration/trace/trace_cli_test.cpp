@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fakes/process.h"
+#include "fakes/test_paths.h"
 
 namespace {
 
@@ -122,7 +123,8 @@ TEST_F(TraceCli, AnalyzeReadsATraceRecordedByHandWithTheLttngCommand) {
       {"sh", "-c",
        "echo $$ > '" + pid_file + "'; while [ ! -e '" + pid_file +
            ".go' ]; do sleep 0.05; done; "
-           "exec '" HILTWIN_BINARY "' run --duration 0.5 --clock virtual --no-progress --report '" +
+           "exec '" + std::string(HILTWIN_BINARY) +
+           "' run --duration 0.5 --clock virtual --no-progress --report '" +
            Path("run.json") + "'"},
       Path("run.out"));
   std::string pid;

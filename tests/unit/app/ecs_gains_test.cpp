@@ -1,3 +1,4 @@
+#include "fakes/test_paths.h"
 #include "hiltwin/app_relbot/ecs_gains.h"
 
 #include <gtest/gtest.h>
@@ -13,7 +14,7 @@ namespace {
 // messages a user of this file sees.
 struct EcsGainsFile {
   using Record = PidGains;
-  static constexpr const char* kPath = HILTWIN_ECS_GAINS_TOML;
+  inline static const char* const kPath = HILTWIN_ECS_GAINS_TOML;
   static constexpr auto kParse = ParseEcsGains;
   static constexpr auto kLoad = LoadEcsGains;
   static constexpr auto kValidate = ValidateEcsGains;

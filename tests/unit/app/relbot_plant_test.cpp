@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "fakes/test_paths.h"
 #include "hiltwin/app_relbot/command.h"
 #include "hiltwin/app_relbot/relbot_plant.h"
 #include "hiltwin/app_relbot/twin_build.h"

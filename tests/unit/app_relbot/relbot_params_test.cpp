@@ -1,3 +1,4 @@
+#include "fakes/test_paths.h"
 #include "hiltwin/app_relbot/relbot_params.h"
 
 #include <gtest/gtest.h>
@@ -14,7 +15,7 @@ namespace {
 // a user of this file sees.
 struct RelbotFile {
   using Record = RelbotParams;
-  static constexpr const char* kPath = HILTWIN_RELBOT_TOML;
+  inline static const char* const kPath = HILTWIN_RELBOT_TOML;
   static constexpr auto kParse = ParseRelbotParams;
   static constexpr auto kLoad = LoadRelbotParams;
   static constexpr auto kValidate = ValidateRelbotParams;

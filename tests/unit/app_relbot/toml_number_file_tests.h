@@ -5,7 +5,7 @@
 //
 //   struct File {
 //     using Record = ...;                                // the struct the file fills
-//     static constexpr const char* kPath;                // the shipped file
+//     inline static const char* const kPath;             // the shipped file
 //     static constexpr auto kParse, kLoad, kValidate;    // the file's public functions
 //     static constexpr auto kSpecs, kDefaults;
 //     static constexpr std::string_view kWhatToDo;       // every parse or validate error ends so

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <string>
 
+#include "fakes/test_paths.h"
+
 namespace hiltwin::fmi::test {
 
 inline std::filesystem::path TestFmu(const std::string& name) {

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "fakes/test_paths.h"
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_emulator.h"
 #include "hiltwin/io/frame.h"

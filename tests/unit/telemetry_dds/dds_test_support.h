@@ -11,6 +11,7 @@
 #include <string>
 #include <thread>
 
+#include "fakes/test_paths.h"
 #include "ros_types.h"
 
 namespace hiltwin::test {
@@ -18,7 +19,7 @@ namespace hiltwin::test {
 /// Every DDS test runs over config/cyclonedds-loopback.xml (set before the first participant).
 inline void UseLoopbackDds() {
   // Before any participant exists: Cyclone reads the variable when a domain is created.
-  ::setenv("CYCLONEDDS_URI", "file://" HILTWIN_DDS_CONFIG, 1);  // NOLINT(concurrency-mt-unsafe)
+  ::setenv("CYCLONEDDS_URI", ("file://" + std::string(HILTWIN_DDS_CONFIG)).c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
 }
 
 /// A namespace no other process on this machine uses (a second checkout's tests, say).

@@ -2,6 +2,7 @@
 // of every hiltwin event) in another, and babeltrace2's text output as a second opinion on
 // what reached the disk. Uses a running session daemon if one answers, else starts one (and
 // the session must stop exactly that one). Label `integration`, lock `lttng`.
+#include "fakes/test_paths.h"
 #include "hiltwin/trace_capture/lttng_session.h"
 
 #include <gmock/gmock.h>

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fakes/lttng_fixture.h"
+#include "fakes/test_paths.h"
 #include "hiltwin/analysis/trace_readers.h"
 #include "hiltwin/qos/rules.h"
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fakes/lttng_fixture.h"
+#include "fakes/test_paths.h"
 #include "hiltwin/kernel_glue/process.h"
 
 namespace {
