@@ -47,7 +47,7 @@ packages=(
   dpkg-dev fakeroot file                        # CPack's .deb: dpkg-shlibdeps, file ownership
   help2man groff-base                           # the man page from --help, and its render test
   ccache                                        # the four builds of scripts/test.sh share one cache
-  lld                                           # links three times faster than GNU ld (CMakeLists.txt)
+  lld                                           # links 3x faster than GNU ld (CMakeLists.txt)
 )
 
 # The arm64 cross build: the libraries hiltwin links, as arm64 multiarch packages beside the

@@ -15,8 +15,8 @@ const char* BesideTest(const char* relative) {
   if (inserted) {
     // qemu-user answers /proc/self/exe with the emulated program's path, so this holds under
     // the arm64 stage's emulator too.
-    const std::filesystem::path folder = std::filesystem::read_symlink("/proc/self/exe").parent_path();
-    it->second = (folder / relative).lexically_normal().string();
+    const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe");
+    it->second = (program.parent_path() / relative).lexically_normal().string();
   }
   return it->second.c_str();
 }

@@ -35,7 +35,8 @@ class TelemetryDds : public ::testing::Test {
  protected:
   void SetUp() override {
     // Inherited by every process the test starts (twins, probes, monitor).
-    ::setenv("CYCLONEDDS_URI", ("file://" + std::string(HILTWIN_DDS_CONFIG)).c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
+    const std::string uri = "file://" + std::string(HILTWIN_DDS_CONFIG);
+    ::setenv("CYCLONEDDS_URI", uri.c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
     dir_ = fs::temp_directory_path() /
            ("hiltwin_dds_" + std::to_string(getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());

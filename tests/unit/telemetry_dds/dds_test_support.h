@@ -19,7 +19,8 @@ namespace hiltwin::test {
 /// Every DDS test runs over config/cyclonedds-loopback.xml (set before the first participant).
 inline void UseLoopbackDds() {
   // Before any participant exists: Cyclone reads the variable when a domain is created.
-  ::setenv("CYCLONEDDS_URI", ("file://" + std::string(HILTWIN_DDS_CONFIG)).c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
+  const std::string uri = "file://" + std::string(HILTWIN_DDS_CONFIG);
+  ::setenv("CYCLONEDDS_URI", uri.c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
 }
 
 /// A namespace no other process on this machine uses (a second checkout's tests, say).
