@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/relbot/input_profile.h"
 
 namespace hiltwin::bench {
 

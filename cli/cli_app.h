@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/app_relbot/commands.h"
+#include "commands.h"
 
 namespace hiltwin::app {
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "hiltwin/app_relbot/command.h"
+#include "hiltwin/runs/command.h"
 
 namespace hiltwin::app {
 

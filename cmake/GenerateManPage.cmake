@@ -96,7 +96,7 @@ function(roff_literal out text)
   set(${out} "${text}" PARENT_SCOPE)
 endfunction()
 
-# The commands, from the script's "# Commands: A B ..." line (app_relbot/cli/bash_completion.h):
+# The commands, from the script's "# Commands: A B ..." line (cli/bash_completion.h):
 # the program's own list, so a new command gets its section without touching this file.
 run_program(script completion bash)
 if(NOT script MATCHES "\n# Commands: ([^\n]+)")

@@ -7,10 +7,10 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-# The reusable layers (DESIGN.md "Modules"). The application layers (app_relbot, telemetry,
-# analysis, trace_capture) stay inside the binary: they would pull Cyclone DDS, FFTW and
-# babeltrace into every user's link for nothing a plant or controller needs.
-set(HILTWIN_EXPORTED_MODULES kernel_glue scheduler qos statemachine io tracing runtime plant fmi)
+# The engine and the models (docs/architecture.md, "Tiers"). The RELbot, the tools outside the
+# loop (observe/) and the program (cli/) stay inside the binary: they would pull Cyclone DDS,
+# FFTW and babeltrace into every user's link for nothing a plant or controller needs.
+set(HILTWIN_EXPORTED_MODULES kernel_glue scheduler qos lifecycle io tracing runtime plant fmi)
 set(HILTWIN_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/hiltwin")
 set(HILTWIN_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/hiltwin")
 
@@ -44,7 +44,7 @@ install(TARGETS hiltwin RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}" COMPONENT 
 
 # The documented starting points for --config, --gains and --plant-map, and the Cyclone DDS
 # configuration for machines without multicast (its messages name <hiltwin>/config/).
-file(GLOB relbot_configs "${PROJECT_SOURCE_DIR}/app_relbot/*.toml")
+file(GLOB relbot_configs "${PROJECT_SOURCE_DIR}/relbot/*.toml")
 install(FILES ${relbot_configs} DESTINATION "${HILTWIN_INSTALL_DATADIR}" COMPONENT runtime)
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/config/" DESTINATION "${HILTWIN_INSTALL_DATADIR}/config"
         COMPONENT runtime)

@@ -55,7 +55,7 @@ set(CPACK_COMPONENT_DEV_DESCRIPTION
 CMake package of hiltwin's framework, for plants and controllers built outside
 hiltwin. find_package(hiltwin) gives hiltwin::runtime, hiltwin::io,
 hiltwin::plant, hiltwin::fmi and the layers below them (kernel_glue, scheduler,
-qos, statemachine, tracing).")
+qos, lifecycle, tracing).")
 # hiltwin-dev Depends on hiltwin (= this version): component dependencies become package ones.
 set(CPACK_COMPONENT_DEV_DEPENDS runtime)
 set(CPACK_DEBIAN_ENABLE_COMPONENT_DEPENDS ON)

@@ -1,5 +1,7 @@
 # Shared target set-up: one place for the warning set, sanitizers, modules and tests.
 
+include(${CMAKE_CURRENT_LIST_DIR}/HiltwinTiers.cmake)
+
 # Warning set applied to every target of ours, tests and benchmarks included.
 function(hiltwin_target_warnings target)
   # The C++-only ones apply to C++ sources only, so a C source (a check of a C library's
@@ -116,12 +118,14 @@ endmacro()
 
 # hiltwin_add_module(<name> [DEPS <targets...>] [PRIVATE_DEPS <targets...>])
 # One static library per module folder: sources src/*.cpp, public headers
-# include/hiltwin/<name>/, alias hiltwin::<name>.
+# include/hiltwin/<name>/, alias hiltwin::<name>. Its dependencies obey the tiers
+# (HiltwinTiers.cmake).
 # Installable (cmake/HiltwinInstall.cmake): exported under the same name hiltwin::<name>, the
 # headers come from the source tree only while building (the install rules add
 # <prefix>/include), and users are asked for C++20, which the headers need (std::span).
 function(hiltwin_add_module name)
   cmake_parse_arguments(ARG "" "" "DEPS;PRIVATE_DEPS" ${ARGN})
+  hiltwin_check_tier(${name} ${ARG_DEPS} ${ARG_PRIVATE_DEPS})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp"
        "${CMAKE_CURRENT_SOURCE_DIR}/src/*.c")
   set(target hiltwin_${name})

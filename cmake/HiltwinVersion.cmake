@@ -1,5 +1,5 @@
 # hiltwin_add_version_library(<target>): a static library whose one symbol,
-# hiltwin::app::kVersionText (app_relbot/cli/version.h), is the text of `hiltwin --version`.
+# hiltwin::app::kVersionText (cli/version.h), is the text of `hiltwin --version`.
 # Its source is written at every build by cmake/WriteVersionSource.cmake from `git describe`,
 # so a new commit or a dirty tree shows without reconfiguring.
 function(hiltwin_add_version_library target)
@@ -15,6 +15,6 @@ function(hiltwin_add_version_library target)
     VERBATIM)
   add_library(${target} STATIC "${source}")
   add_dependencies(${target} ${target}_source)
-  target_include_directories(${target} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/cli")
+  target_include_directories(${target} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}")
   hiltwin_target_warnings(${target})
 endfunction()

@@ -11,8 +11,8 @@
 #include <cstdlib>
 
 #include "fuzz_util.h"
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/setpoint_profile.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 
 namespace {
 

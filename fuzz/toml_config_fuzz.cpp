@@ -15,8 +15,8 @@
 #include <span>
 
 #include "fuzz_util.h"
-#include "hiltwin/app_relbot/ecs_gains.h"
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/plant/plant.h"
 #include "hiltwin/plant/plant_map.h"
 

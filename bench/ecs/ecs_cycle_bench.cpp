@@ -16,9 +16,9 @@
 #include <ctime>
 #include <vector>
 
-#include "hiltwin/app_relbot/ecs_gains.h"
-#include "hiltwin/app_relbot/ecs_task.h"
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_task.h"
+#include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/kernel_glue/clock.h"
 

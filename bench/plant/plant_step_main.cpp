@@ -14,8 +14,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "hiltwin/app_relbot/relbot_model.h"
-#include "hiltwin/app_relbot/relbot_plant.h"
+#include "hiltwin/relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_plant.h"
 #include "hiltwin/plant/plant_registry.h"
 #include "bench_stats.h"
 #include "relbot_duty_samples.h"

@@ -20,8 +20,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_model.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_model.h"
 #include "bench_stats.h"
 #include "relbot_duty_samples.h"
 

@@ -12,10 +12,10 @@
 #include <string_view>
 #include <utility>
 
-#include "hiltwin/analysis/assessment.h"
-#include "hiltwin/analysis/csv.h"
-#include "hiltwin/analysis/plot.h"
-#include "hiltwin/app_relbot/commands.h"
+#include "hiltwin/assess/assessment.h"
+#include "hiltwin/tracing/csv.h"
+#include "hiltwin/assess/plot.h"
+#include "commands.h"
 
 namespace hiltwin::app {
 namespace {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "bash_completion.h"
-#include "hiltwin/app_relbot/commands.h"
+#include "commands.h"
 #include "hiltwin/kernel_glue/os_calls.h"
 
 namespace hiltwin::app {

@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "hiltwin/app_relbot/commands.h"
-#include "hiltwin/app_relbot/doctor_format.h"
+#include "commands.h"
+#include "hiltwin/runs/doctor_format.h"
 #include "hiltwin/kernel_glue/rt_probe.h"
 
 namespace hiltwin::app {

@@ -9,14 +9,14 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/app_relbot/commands.h"
-#include "hiltwin/app_relbot/ecs_gains.h"
-#include "hiltwin/app_relbot/ecs_report.h"
-#include "hiltwin/app_relbot/ecs_task.h"
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/session_options.h"
-#include "hiltwin/app_relbot/setpoint_profile.h"
+#include "commands.h"
+#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_report.h"
+#include "hiltwin/relbot/ecs_task.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/runs/session_options.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/runtime/run_session.h"
 

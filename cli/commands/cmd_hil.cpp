@@ -17,11 +17,11 @@
 #include <thread>
 #include <vector>
 
-#include "hiltwin/app_relbot/commands.h"
-#include "hiltwin/app_relbot/hil_report.h"
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/session_options.h"
-#include "hiltwin/app_relbot/setpoint_profile.h"
+#include "commands.h"
+#include "hiltwin/runs/hil_report.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/runs/session_options.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/process.h"
 #include "hiltwin/kernel_glue/stop_signal.h"

@@ -20,7 +20,7 @@
 #include <string>
 #include <utility>
 
-#include "hiltwin/app_relbot/commands.h"
+#include "commands.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/board_pair_check.h"
 #include "hiltwin/io/conversions.h"

@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "hiltwin/app_relbot/commands.h"
+#include "commands.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/telemetry/dds_monitor.h"
 

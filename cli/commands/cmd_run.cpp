@@ -2,8 +2,8 @@
 // with a QoS verdict, a JSON run report and an optional CSV log (DESIGN.md "Contracts").
 #include <memory>
 
-#include "hiltwin/app_relbot/commands.h"
-#include "hiltwin/app_relbot/twin_run.h"
+#include "commands.h"
+#include "hiltwin/runs/twin_run.h"
 
 namespace hiltwin::app {
 namespace {

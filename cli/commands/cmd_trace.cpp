@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "hiltwin/app_relbot/commands.h"
-#include "hiltwin/app_relbot/trace_run.h"
+#include "commands.h"
+#include "hiltwin/runs/trace_run.h"
 
 namespace hiltwin::app {
 namespace {

@@ -12,10 +12,10 @@
 #include <memory>
 #include <string>
 
-#include "hiltwin/analysis/tuning_report.h"
-#include "hiltwin/app_relbot/commands.h"
-#include "hiltwin/app_relbot/session_options.h"
-#include "hiltwin/app_relbot/tune.h"
+#include "hiltwin/tuning/tuning_report.h"
+#include "commands.h"
+#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/tune.h"
 
 namespace hiltwin::app {
 namespace {

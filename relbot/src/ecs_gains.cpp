@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_gains.h"
 
 #include <array>
 

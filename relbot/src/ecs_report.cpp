@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/ecs_report.h"
+#include "hiltwin/relbot/ecs_report.h"
 
 #include <cstdio>
 

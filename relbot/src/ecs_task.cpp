@@ -1,11 +1,11 @@
-#include "hiltwin/app_relbot/ecs_task.h"
+#include "hiltwin/relbot/ecs_task.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "hiltwin/app_relbot/ecs_gains.h"
-#include "hiltwin/app_relbot/relbot_telemetry.h"
+#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/relbot_telemetry.h"
 
 namespace hiltwin::app {
 namespace {

@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/relbot/input_profile.h"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 #include <optional>
 #include <utility>
 
-#include "hiltwin/analysis/csv.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::app {
 namespace {

@@ -1,10 +1,10 @@
-#include "hiltwin/app_relbot/integrator.h"
+#include "hiltwin/relbot/integrator.h"
 
 #include <algorithm>
 #include <cctype>
 #include <string>
 
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/relbot_params.h"
 
 namespace hiltwin::app {
 

@@ -1,9 +1,9 @@
 // An input profile played into the PWM reader (profile_pwm_source.h).
-#include "hiltwin/app_relbot/profile_pwm_source.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
 
 #include <cmath>
 
-#include "hiltwin/app_relbot/relbot_channels.h"
+#include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/kernel_glue/clock.h"
 
 namespace hiltwin::app {

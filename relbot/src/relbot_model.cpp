@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_model.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

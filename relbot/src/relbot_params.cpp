@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/relbot_params.h"
 
 #include <array>
 

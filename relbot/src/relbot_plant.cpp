@@ -1,10 +1,10 @@
 // The RELbot as a plant (relbot_plant.h).
-#include "hiltwin/app_relbot/relbot_plant.h"
+#include "hiltwin/relbot/relbot_plant.h"
 
 #include <mutex>
 
-#include "hiltwin/app_relbot/config_error.h"
-#include "hiltwin/app_relbot/relbot_channels.h"
+#include "hiltwin/relbot/config_error.h"
+#include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/plant/plant_registry.h"
 
 namespace hiltwin::app {

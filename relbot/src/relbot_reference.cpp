@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/relbot_reference.h"
+#include "hiltwin/relbot/relbot_reference.h"
 
 // GCC 12 reports Odeint's copies of its default-constructed (deliberately uninitialised)
 // fixed-size Eigen work vectors in make_dense_output as uninitialised use; they are written

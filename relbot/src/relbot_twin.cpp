@@ -1,5 +1,5 @@
 // The RELbot plant and its twin task owned together (relbot_twin.h).
-#include "hiltwin/app_relbot/relbot_twin.h"
+#include "hiltwin/relbot/relbot_twin.h"
 
 #include <vector>
 

@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/toml_numbers.h"
+#include "hiltwin/relbot/toml_numbers.h"
 
 #include <toml++/toml.h>
 
@@ -9,7 +9,7 @@
 #include <optional>
 #include <sstream>
 
-#include "hiltwin/app_relbot/config_error.h"
+#include "hiltwin/relbot/config_error.h"
 
 namespace hiltwin::app::detail {
 namespace {

@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/doctor_format.h"
+#include "hiltwin/runs/doctor_format.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/hil_report.h"
+#include "hiltwin/runs/hil_report.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/runs/session_options.h"
 
 #include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"

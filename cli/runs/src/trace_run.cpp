@@ -1,6 +1,6 @@
 // `hiltwin trace` (trace_run.h): capture -> the twin run of `hiltwin run` -> stop the capture ->
 // read the trace -> the jitter report and its outputs -> agreement with the run's own report.
-#include "hiltwin/app_relbot/trace_run.h"
+#include "hiltwin/runs/trace_run.h"
 
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -14,13 +14,13 @@
 #include <string>
 #include <system_error>
 
-#include "hiltwin/analysis/csv.h"
-#include "hiltwin/analysis/jitter_outputs.h"
-#include "hiltwin/analysis/kernel_events.h"
-#include "hiltwin/analysis/plot.h"
-#include "hiltwin/analysis/trace_readers.h"
-#include "hiltwin/app_relbot/command.h"
-#include "hiltwin/app_relbot/hil_report.h"
+#include "hiltwin/tracing/csv.h"
+#include "hiltwin/jitter/jitter_outputs.h"
+#include "hiltwin/traces/kernel_events.h"
+#include "hiltwin/report_kit/gnuplot.h"  // PlotError
+#include "hiltwin/traces/trace_readers.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/hil_report.h"
 #include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/trace_capture/capture_error.h"
 #include "hiltwin/trace_capture/kernel_recorder.h"

@@ -1,6 +1,6 @@
-#include "hiltwin/app_relbot/trajectory_recorder.h"
+#include "hiltwin/runs/trajectory_recorder.h"
 
-#include "hiltwin/app_relbot/relbot_plant.h"
+#include "hiltwin/relbot/relbot_plant.h"
 
 namespace hiltwin::app {
 

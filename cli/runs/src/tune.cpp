@@ -1,7 +1,7 @@
 // `hiltwin tune` (tune.h): measure, recommend, validate. The maths is analysis/tuning.h's;
 // this file measures and runs, always through the shared run assembly and the twin of
 // `hiltwin run` (twin_build.h).
-#include "hiltwin/app_relbot/tune.h"
+#include "hiltwin/runs/tune.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,11 +11,11 @@
 #include <memory>
 #include <utility>
 
-#include "hiltwin/app_relbot/command.h"
-#include "hiltwin/app_relbot/relbot_reference.h"
-#include "hiltwin/app_relbot/session_options.h"
-#include "hiltwin/app_relbot/trajectory_recorder.h"
-#include "hiltwin/app_relbot/twin_build.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/relbot/relbot_reference.h"
+#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/trajectory_recorder.h"
+#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/scheduler/executive.h"

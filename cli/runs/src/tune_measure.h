@@ -4,11 +4,11 @@
 
 #include <vector>
 
-#include "hiltwin/analysis/tuning_report.h"
-#include "hiltwin/app_relbot/session_options.h"
-#include "hiltwin/app_relbot/tune.h"
-#include "hiltwin/app_relbot/twin_build.h"
-#include "hiltwin/app_relbot/twin_run.h"
+#include "hiltwin/tuning/tuning_report.h"
+#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/tune.h"
+#include "hiltwin/runs/twin_build.h"
+#include "hiltwin/runs/twin_run.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/scheduler/timing_stats.h"
 

@@ -1,12 +1,12 @@
 // A twin built from `run`'s flags (twin_build.h).
-#include "hiltwin/app_relbot/twin_build.h"
+#include "hiltwin/runs/twin_build.h"
 
 #include <stdexcept>
 #include <vector>
 
-#include "hiltwin/app_relbot/command.h"
-#include "hiltwin/app_relbot/relbot_plant.h"
-#include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/session_options.h"
 #include "hiltwin/fmi/fmu_plant.h"
 #include "hiltwin/plant/plant_registry.h"
 

@@ -1,6 +1,6 @@
 // `hiltwin run` as a function (twin_run.h): flags -> twin -> the shared session assembly ->
 // the run's outcome. cli/cmd_run.cpp and cli/cmd_trace.cpp both call it.
-#include "hiltwin/app_relbot/twin_run.h"
+#include "hiltwin/runs/twin_run.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,11 +10,11 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/app_relbot/command.h"
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/twin_build.h"
-#include "hiltwin/app_relbot/relbot_plant.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/runs/twin_build.h"
+#include "hiltwin/relbot/relbot_plant.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
@@ -134,7 +134,7 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   runtime::RunTask& task = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
   const runtime::RunReport report = RunSessionOf(std::move(config), task);
   PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
-  if (report.fault && report.fault->kind == statemachine::StopReason::kModelFault &&
+  if (report.fault && report.fault->kind == lifecycle::StopReason::kModelFault &&
       o.plant == kRelbotPlantName) {
     std::fprintf(
         stderr,

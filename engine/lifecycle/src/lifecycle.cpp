@@ -1,6 +1,6 @@
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 
-namespace hiltwin::statemachine {
+namespace hiltwin::lifecycle {
 namespace {
 
 constexpr Transition To(State from, State to) noexcept {
@@ -186,4 +186,4 @@ const char* ToString(Outcome outcome) noexcept {
   return "unknown";
 }
 
-}  // namespace hiltwin::statemachine
+}  // namespace hiltwin::lifecycle

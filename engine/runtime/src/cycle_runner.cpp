@@ -7,11 +7,11 @@
 
 namespace hiltwin::runtime {
 
-using statemachine::Event;
-using statemachine::StopReason;
+using lifecycle::Event;
+using lifecycle::StopReason;
 
 CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
-                         statemachine::Lifecycle& lifecycle, qos::QosMonitor& monitor,
+                         lifecycle::Lifecycle& lifecycle, qos::QosMonitor& monitor,
                          const OverrunInjector& injector, const CycleRunnerConfig& config)
     : task_(task),
       clock_(clock),

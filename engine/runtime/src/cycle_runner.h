@@ -19,7 +19,7 @@
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_task.h"
 #include "hiltwin/scheduler/cycle.h"
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
 #include "hiltwin/tracing/spsc_ring.h"
 #include "hiltwin/tracing/timing_log_format.h"
@@ -38,7 +38,7 @@ struct TelemetryTaps {
 
 /// The first fault of a run, as the loop saw it (reason is static text).
 struct LoopFault {
-  statemachine::StopReason kind = statemachine::StopReason::kNone;
+  lifecycle::StopReason kind = lifecycle::StopReason::kNone;
   std::uint64_t cycle = 0;
   const char* reason = "";
 };
@@ -70,7 +70,7 @@ struct CycleRunnerConfig {
 class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleObserver {
  public:
   /// None of the references is owned. Allocates its per-rule bookkeeping here, never later.
-  CycleRunner(RunTask& task, kernel_glue::Clock& clock, statemachine::Lifecycle& lifecycle,
+  CycleRunner(RunTask& task, kernel_glue::Clock& clock, lifecycle::Lifecycle& lifecycle,
               qos::QosMonitor& monitor, const OverrunInjector& injector,
               const CycleRunnerConfig& config);
 
@@ -105,11 +105,11 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   /// Offers this cycle's events to the lifecycle; false when there were none (the state is
   /// unchanged, the common case).
   bool PostEvents(const scheduler::TimingSample& sample) noexcept;
-  void NoteFault(statemachine::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
+  void NoteFault(lifecycle::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
 
   RunTask& task_;
   kernel_glue::Clock& clock_;
-  statemachine::Lifecycle& lifecycle_;
+  lifecycle::Lifecycle& lifecycle_;
   qos::QosMonitor& monitor_;
   const OverrunInjector& injector_;
   tracing::CsvLogger* logger_;
@@ -126,7 +126,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
 
   // This cycle, from Step to OnCycle. Only the loop thread changes the state while the loop
   // runs, so the rules read in Step hold until OnCycle posts events.
-  statemachine::StateRules rules_;
+  lifecycle::StateRules rules_;
   kernel_glue::TimeNs io_ns_ = 0;
   bool stepped_ = false;
   bool io_fault_ = false;

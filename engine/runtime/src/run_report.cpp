@@ -7,7 +7,7 @@ namespace hiltwin::runtime {
 namespace {
 
 using Json = nlohmann::ordered_json;
-using statemachine::StopReason;
+using lifecycle::StopReason;
 
 Json Timing(const scheduler::TimingSummary& s) {
   return {{"min", s.min_ns},   {"mean", s.mean_ns}, {"p50", s.p50_ns}, {"p99", s.p99_ns},
@@ -66,7 +66,7 @@ Json ContractPart(const RunReport& r) {
   Json constraints = Json::array();
   for (const qos::RuleStatus& status : r.constraints) constraints.push_back(Constraint(status));
   return {{"verdict", qos::ToString(r.verdict)},
-          {"stop_reason", statemachine::ToString(r.stop_reason)},
+          {"stop_reason", lifecycle::ToString(r.stop_reason)},
           {"rate_hz", r.rate_hz},
           {"period_ns", r.period_ns},
           {"cycles_planned", r.cycles_planned},
@@ -122,10 +122,10 @@ Json ToJson(const RunReport& r) {
     json["timing_log_rows_lost"] = r.timing_log->rows_lost;
     if (!r.timing_log->error.empty()) json["timing_log_error"] = r.timing_log->error;
   }
-  json["final_state"] = statemachine::ToString(r.final_state);
+  json["final_state"] = lifecycle::ToString(r.final_state);
   json["outputs_safe"] = r.outputs_safe;
   if (r.fault) {
-    json["fault"] = {{"kind", statemachine::ToString(r.fault->kind)},
+    json["fault"] = {{"kind", lifecycle::ToString(r.fault->kind)},
                      {"cycle", r.fault->cycle},
                      {"reason", r.fault->reason}};
   }
@@ -228,7 +228,7 @@ std::string FormatSummary(const RunReport& r) {
   std::string out;
   Append(out, "cycles     %llu of %llu at %.0f Hz (%s clock), stop: %s\n",
          static_cast<ull>(r.cycles_run), static_cast<ull>(r.cycles_planned), r.rate_hz,
-         ToString(r.clock), statemachine::ToString(r.stop_reason));
+         ToString(r.clock), lifecycle::ToString(r.stop_reason));
   if (r.cycles_paused > 0)
     Append(out, "paused     %llu cycles\n", static_cast<ull>(r.cycles_paused));
   AppendMisses(out, r);
@@ -249,7 +249,7 @@ std::string FormatSummary(const RunReport& r) {
   if (r.timing_log) AppendLog(out, "timing log", *r.timing_log);
   if (!l.peer_stopped.empty()) Append(out, "peer       %s\n", l.peer_stopped.c_str());
   if (r.fault) {
-    Append(out, "fault      %s at cycle %llu: %s\n", statemachine::ToString(r.fault->kind),
+    Append(out, "fault      %s at cycle %llu: %s\n", lifecycle::ToString(r.fault->kind),
            static_cast<ull>(r.fault->cycle), r.fault->reason.c_str());
   }
   if (!r.outputs_safe) out += "outputs    the safe outputs could NOT be written: check the link\n";

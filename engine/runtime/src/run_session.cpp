@@ -105,8 +105,8 @@ void TraceLoopStart(const SessionConfig& config, const scheduler::Executive& exe
   }
 }
 
-io::StopCause StopCauseOf(statemachine::StopReason reason) noexcept {
-  using statemachine::StopReason;
+io::StopCause StopCauseOf(lifecycle::StopReason reason) noexcept {
+  using lifecycle::StopReason;
   switch (reason) {
     case StopReason::kFinished:
       return io::StopCause::kFinished;
@@ -199,7 +199,7 @@ RunSession::RunSession(SessionConfig config, RunTask& task)
       std::make_unique<CycleRunner>(task_, *clock_, lifecycle_, monitor_, config_.injector, runner);
   executive_.AddObserver(*runner_);
   if (!config_.telemetry.sinks.empty()) OpenTelemetry();
-  HandleTraced(lifecycle_, statemachine::Event::kConfigured, 0);
+  HandleTraced(lifecycle_, lifecycle::Event::kConfigured, 0);
 }
 
 RunSession::~RunSession() = default;
@@ -285,7 +285,7 @@ RunReport RunSession::Run() {
     result.outputs_safe = true;  // never left the safe outputs
     config_.peer->link->AnnounceStop(StopCauseOf(lifecycle_.stop_reason()));
     StopLoggers();
-    HandleTraced(lifecycle_, statemachine::Event::kDrained, 0);
+    HandleTraced(lifecycle_, lifecycle::Event::kDrained, 0);
     if (telemetry_) telemetry_->Stop();  // the final record: safe_stop or stopped
     return BuildReport(result, 0.0);
   }
@@ -295,7 +295,7 @@ RunReport RunSession::Run() {
   static_cast<void>(kernel_glue::SetCallingThreadCpus(helper_cpus));
   const kernel_glue::MonotonicClock wall;
   const kernel_glue::TimeNs wall_start_ns = wall.NowNs();
-  HandleTraced(lifecycle_, statemachine::Event::kStart, 0);
+  HandleTraced(lifecycle_, lifecycle::Event::kStart, 0);
   result.go = true;
   result.changed.notify_all();
   // The control thread's duty while the loop runs: forward signal commands every 100 ms and
@@ -315,7 +315,7 @@ RunReport RunSession::Run() {
     std::fputc('\n', stderr);
   }
   StopLoggers();
-  HandleTraced(lifecycle_, statemachine::Event::kDrained, executive_.stats().releases);
+  HandleTraced(lifecycle_, lifecycle::Event::kDrained, executive_.stats().releases);
   if (telemetry_) telemetry_->Stop();  // the final record, with the run's last state
   return BuildReport(result, wall_time_s);
 }
@@ -350,7 +350,7 @@ bool RunSession::WaitForPeer() {
       return true;
     }
     if (kernel_glue::StopRequested()) {
-      HandleTraced(lifecycle_, statemachine::Event::kStopRequest, 0);
+      HandleTraced(lifecycle_, lifecycle::Event::kStopRequest, 0);
       return false;
     }
     if (status.result == io::BusResult::kPeerStopped) {
@@ -358,17 +358,17 @@ bool RunSession::WaitForPeer() {
       // first cycles on a loaded machine): end now, as a cycle would have, not at the timeout.
       if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
       wait_peer_stopped_ = status.reason;
-      HandleTraced(lifecycle_, statemachine::Event::kPeerStopped, 0);
+      HandleTraced(lifecycle_, lifecycle::Event::kPeerStopped, 0);
       return false;
     }
     const kernel_glue::TimeNs waited_ns = clock.NowNs() - start_ns;
     if (waited_ns >= timeout_ns) {
       if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
-      wait_fault_ = RunFault{statemachine::StopReason::kIoFault, 0,
+      wait_fault_ = RunFault{lifecycle::StopReason::kIoFault, 0,
                              "no " + config_.peer_name + " came up on " + config_.io + " within " +
                                  Seconds(wait.timeout_s) + " s (" + status.reason +
                                  "); start it with: " + wait.start_hint};
-      HandleTraced(lifecycle_, statemachine::Event::kIoFault, 0);
+      HandleTraced(lifecycle_, lifecycle::Event::kIoFault, 0);
       return false;
     }
     // A countdown: rewritten in place on a terminal, a line every 5 s otherwise.
@@ -407,7 +407,7 @@ void RunSession::PrintProgress() const {
                "misses to failure %s   ",
                static_cast<unsigned long long>(executive_.live().cycles_run.load()),
                static_cast<unsigned long long>(config_.executive.max_cycles),
-               statemachine::ToString(lifecycle_.state()),
+               lifecycle::ToString(lifecycle_.state()),
                static_cast<unsigned long long>(q.deadline_misses),
                static_cast<double>(executive_.live().max_latency_ns.load()) / 1e3,
                qos::ToString(q.verdict), distance.c_str());

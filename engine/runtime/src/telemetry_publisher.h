@@ -20,7 +20,7 @@
 #include "hiltwin/runtime/latest_value.h"
 #include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/scheduler/executive.h"
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/spsc_ring.h"
 
 namespace hiltwin::runtime {
@@ -29,7 +29,7 @@ namespace hiltwin::runtime {
 struct TelemetrySources {
   const qos::QosMonitor& monitor;
   const scheduler::Executive& executive;
-  const statemachine::Lifecycle& lifecycle;
+  const lifecycle::Lifecycle& lifecycle;
 };
 
 /// How the publisher identifies the task in every record.

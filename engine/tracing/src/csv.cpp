@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/csv.h"
+#include "hiltwin/tracing/csv.h"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/assessment.h"
+#include "hiltwin/assess/assessment.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "hiltwin/analysis/series.h"
-#include "string_format.h"
+#include "hiltwin/assess/series.h"
+#include "hiltwin/report_kit/string_format.h"
 
 namespace hiltwin::analysis {
 namespace {

@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/credibility.h"
+#include "hiltwin/assess/credibility.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/cross_checks.h"
+#include "hiltwin/assess/cross_checks.h"
 
 #include <algorithm>
 #include <cmath>

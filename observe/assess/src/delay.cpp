@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/delay.h"
+#include "hiltwin/assess/delay.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/plot.h"
+#include "hiltwin/assess/plot.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "gnuplot_process.h"
+#include "hiltwin/report_kit/gnuplot.h"
 
 namespace hiltwin::analysis {
 namespace {

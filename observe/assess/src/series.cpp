@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/series.h"
+#include "hiltwin/assess/series.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/spectral.h"
+#include "hiltwin/assess/spectral.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 #include <numeric>
 
 #include "cause_attribution.h"
-#include "hiltwin/analysis/jitter_report.h"
+#include "hiltwin/jitter/jitter_report.h"
 #include "jitter_format.h"
 #include "jitter_stats.h"
 

@@ -5,10 +5,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "hiltwin/analysis/jitter_outputs.h"
+#include "hiltwin/jitter/jitter_outputs.h"
 #include "jitter_format.h"
-#include "jitter_svg.h"
-#include "time_units.h"
+#include "hiltwin/report_kit/svg_chart.h"
+#include "hiltwin/report_kit/time_units.h"
 
 namespace hiltwin::analysis {
 namespace {

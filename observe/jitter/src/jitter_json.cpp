@@ -1,7 +1,7 @@
 #include <string>
 
 #include "cause_attribution.h"
-#include "hiltwin/analysis/jitter_outputs.h"
+#include "hiltwin/jitter/jitter_outputs.h"
 #include "hiltwin/scheduler/timing_stats.h"
 #include "jitter_format.h"
 

@@ -4,9 +4,8 @@
 #include <fstream>
 #include <string>
 
-#include "gnuplot_process.h"
-#include "hiltwin/analysis/jitter_outputs.h"
-#include "hiltwin/analysis/plot.h"
+#include "hiltwin/report_kit/gnuplot.h"
+#include "hiltwin/jitter/jitter_outputs.h"
 #include "jitter_format.h"
 
 namespace hiltwin::analysis {

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "hiltwin/analysis/jitter_report.h"
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/jitter/jitter_report.h"
+#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/scheduler/timing_stats.h"
 
 namespace hiltwin::analysis::detail {

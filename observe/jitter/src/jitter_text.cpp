@@ -3,10 +3,10 @@
 #include <cstdio>
 #include <string>
 
-#include "hiltwin/analysis/jitter_outputs.h"
+#include "hiltwin/jitter/jitter_outputs.h"
 #include "jitter_format.h"
-#include "string_format.h"
-#include "time_units.h"
+#include "hiltwin/report_kit/string_format.h"
+#include "hiltwin/report_kit/time_units.h"
 
 namespace hiltwin::analysis {
 namespace {

@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "hiltwin/analysis/jitter_outputs.h"
-#include "time_units.h"
+#include "hiltwin/jitter/jitter_outputs.h"
+#include "hiltwin/report_kit/time_units.h"
 
 namespace hiltwin::analysis {
 namespace {

@@ -1,4 +1,4 @@
-#include "gnuplot_process.h"
+#include "hiltwin/report_kit/gnuplot.h"
 
 #include <unistd.h>
 
@@ -7,8 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "hiltwin/analysis/csv.h"
-#include "hiltwin/analysis/plot.h"
+#include "hiltwin/tracing/csv.h"
 #include "hiltwin/kernel_glue/process.h"
 
 namespace hiltwin::analysis::detail {

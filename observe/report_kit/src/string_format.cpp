@@ -1,4 +1,4 @@
-#include "string_format.h"
+#include "hiltwin/report_kit/string_format.h"
 
 #include <algorithm>
 #include <cstdarg>

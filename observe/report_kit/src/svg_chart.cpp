@@ -1,4 +1,4 @@
-#include "jitter_svg.h"
+#include "hiltwin/report_kit/svg_chart.h"
 
 #include <algorithm>
 #include <cmath>

@@ -145,7 +145,7 @@ void DdsSink::PublishTiming(const runtime::TelemetryRecord& record) noexcept {
   msg.distance_to_violation =
       record.distance_to_violation ? static_cast<std::int64_t>(*record.distance_to_violation) : -1;
   msg.verdict = const_cast<char*>(qos::ToString(record.verdict_so_far));
-  msg.state = const_cast<char*>(statemachine::ToString(record.state));
+  msg.state = const_cast<char*>(lifecycle::ToString(record.state));
   msg.final = record.final;
   Write(timing_writer_, &msg, "timing");
 }

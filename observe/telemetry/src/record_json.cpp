@@ -38,7 +38,7 @@ nlohmann::ordered_json ToJson(const runtime::TelemetryRecord& r) {
       {"ns", r.ns},
       {"role", r.role},
       {"cycle", r.cycle},
-      {"state", statemachine::ToString(r.state)},
+      {"state", lifecycle::ToString(r.state)},
       {"final", r.final},
   };
   if (r.task.has_pose) {

@@ -10,7 +10,7 @@
 #include <mutex>
 #include <vector>
 
-#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/traces/kernel_events.h"
 #include "hiltwin/kernel_glue/thread.h"
 #include "kernel_event_decoder.h"
 #include "tracefs_api.h"

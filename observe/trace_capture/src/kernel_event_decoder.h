@@ -6,7 +6,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/traces/kernel_events.h"
 #include "tracefs_api.h"
 
 namespace hiltwin::trace_capture {

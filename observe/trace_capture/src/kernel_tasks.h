@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/traces/kernel_events.h"
 
 namespace hiltwin::trace_capture {
 

@@ -24,8 +24,8 @@
 #include <utility>
 #include <vector>
 
-#include "hiltwin/analysis/trace_readers.h"
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/traces/trace_readers.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/trace_codes.h"
 #include "trace_reading.h"
 
@@ -39,9 +39,9 @@ constexpr std::string_view kProvider = "hiltwin:";
 constexpr std::int64_t kNoVpid = -1;
 // Codes of the lifecycle enums, from their last enumerator (lifecycle.h has no count).
 constexpr std::uint64_t kStateCount =
-    static_cast<std::uint64_t>(statemachine::State::kSafeStop) + 1;
+    static_cast<std::uint64_t>(lifecycle::State::kSafeStop) + 1;
 constexpr std::uint64_t kEventCount =
-    static_cast<std::uint64_t>(statemachine::Event::kPeerStopped) + 1;
+    static_cast<std::uint64_t>(lifecycle::Event::kPeerStopped) + 1;
 /// bt_graph_run returning AGAIN this often in a row (1 ms apart) means it will not finish.
 constexpr int kMaxGraphRetries = 10'000;
 

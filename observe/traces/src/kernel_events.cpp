@@ -2,7 +2,7 @@
 // a recording, read by `hiltwin trace --analyze`. The reader is a plain line parser, not the
 // general CSV reader: names never hold commas (the writer replaces them), and every bad row
 // must be named by file and line rather than skipped.
-#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/traces/kernel_events.h"
 
 #include <algorithm>
 #include <array>
@@ -14,7 +14,7 @@
 #include <string_view>
 #include <system_error>
 
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/kernel_glue/os_calls.h"
 
 namespace hiltwin::analysis {

@@ -1,5 +1,5 @@
 // ReadTrace: what `hiltwin trace --analyze PATH` reads, chosen by what PATH is.
-#include "hiltwin/analysis/trace_readers.h"
+#include "hiltwin/traces/trace_readers.h"
 
 #include <filesystem>
 #include <string>

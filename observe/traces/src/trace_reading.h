@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/tracing/trace_codes.h"
 

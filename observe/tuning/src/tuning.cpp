@@ -1,4 +1,4 @@
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "string_format.h"
+#include "hiltwin/report_kit/string_format.h"
 
 namespace hiltwin::analysis::detail {
 

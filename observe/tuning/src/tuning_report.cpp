@@ -1,9 +1,9 @@
-#include "hiltwin/analysis/tuning_report.h"
+#include "hiltwin/tuning/tuning_report.h"
 
 #include <string>
 
 #include "tuning_format.h"
-#include "time_units.h"
+#include "hiltwin/report_kit/time_units.h"
 
 namespace hiltwin::analysis {
 namespace {

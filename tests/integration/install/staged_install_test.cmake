@@ -1,5 +1,5 @@
 # Install.StagedPrefixBuildsAnOutOfTreeTwin (cmake -P; CMakeLists.txt here passes the -D values):
-# `cmake --install` of this build folder into an empty prefix, then tests/install/example
+# `cmake --install` of this build folder into an empty prefix, then examples/lag_twin
 # configured, built and run against that prefix with find_package(hiltwin), as a user's own
 # project would be. The example is a plant stepped by the run assembly on the emulated board.
 # In: BUILD_DIR, SOURCE_DIR, WORK_DIR, VERSION, GENERATOR, CXX_COMPILER; TOOLCHAIN_FILE and
@@ -9,7 +9,7 @@ include("${CMAKE_CURRENT_LIST_DIR}/test_steps.cmake")
 hiltwin_test_require_vars(BUILD_DIR SOURCE_DIR WORK_DIR VERSION GENERATOR)
 
 # The targets a plant or controller needs (the issue's contract, cmake/HiltwinInstall.cmake).
-set(required_targets kernel_glue scheduler qos statemachine io tracing runtime plant fmi)
+set(required_targets kernel_glue scheduler qos lifecycle io tracing runtime plant fmi)
 
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
@@ -63,7 +63,7 @@ hiltwin_test_check_version("the installed hiltwin --version" "${stage}/bin/hiltw
 
 # The example as a user builds it: only CMAKE_PREFIX_PATH says where hiltwin is.
 set(example "${WORK_DIR}/example")
-set(configure_args -S "${SOURCE_DIR}/tests/install/example" -B "${example}" -G "${GENERATOR}"
+set(configure_args -S "${SOURCE_DIR}/examples/lag_twin" -B "${example}" -G "${GENERATOR}"
     "-DCMAKE_PREFIX_PATH=${stage}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
     "-DCMAKE_CXX_FLAGS=-Werror")  # the example's own warnings (hiltwin's headers are SYSTEM)
 if(TOOLCHAIN_FILE)
@@ -87,11 +87,11 @@ hiltwin_test_run("build the out-of-tree example" out
 hiltwin_test_run("run the out-of-tree example" out EXIT_CODES 0 3
   COMMAND ${EMULATOR} "${example}/lag_twin")
 hiltwin_test_check_verdict("run the out-of-tree example" "${out}" "${out_EXIT}")
-# tests/install/example/lag_twin.cpp: y = 0.5 (1 - 0.99^1000) after 1000 Euler steps, 499 counts.
+# examples/lag_twin/lag_twin.cpp: y = 0.5 (1 - 0.99^1000) after 1000 Euler steps, 499 counts.
 set(result_line "lag_twin: y = ([0-9.]+) m after ([0-9]+) steps, encoder 1 at (-?[0-9]+) counts")
 if(NOT out MATCHES "${result_line}")
   hiltwin_test_fail("run the out-of-tree example" WHY "no result line in:\n${out}"
-                    HINT "see tests/install/example/lag_twin.cpp")
+                    HINT "see examples/lag_twin/lag_twin.cpp")
 endif()
 set(y "${CMAKE_MATCH_1}")
 set(steps "${CMAKE_MATCH_2}")
@@ -101,6 +101,6 @@ if(NOT steps EQUAL 1000 OR NOT counts EQUAL 499 OR y LESS 0.4999 OR y GREATER 0.
     WHY "y = ${y} m after ${steps} steps at ${counts} counts; expected y in [0.4999, 0.5] "
         "after 1000 steps at 499 counts"
     HINT "the plant map, the emulated board or RunSession no longer behave as "
-         "tests/install/example/lag_twin.cpp says")
+         "examples/lag_twin/lag_twin.cpp says")
 endif()
 message(STATUS "out-of-tree example: y = ${y} m after ${steps} steps, ${counts} counts")

@@ -91,7 +91,7 @@ function(hiltwin_test_check_version what binary)
   string(REPLACE "." "\\." version_pattern "${VERSION}")
   if(NOT out MATCHES "^hiltwin ${version_pattern} ")
     hiltwin_test_fail("${what}" WHY "'${out}' does not start 'hiltwin ${VERSION} '"
-                      HINT "see app_relbot/cli/version.h and cmake/HiltwinVersion.cmake")
+                      HINT "see cli/version.h and cmake/HiltwinVersion.cmake")
   endif()
   string(STRIP "${out}" out)
   message(STATUS "${what}: ${out}")

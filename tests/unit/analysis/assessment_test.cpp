@@ -1,5 +1,5 @@
 // The whole assessment on synthetic curves: alignment, delay compensation, domains, total.
-#include "hiltwin/analysis/assessment.h"
+#include "hiltwin/assess/assessment.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The time-domain score against the thesis's worked numbers (§5.6.2, §7.4.2), its
 // invariants, and the performance domain on responses with known metrics.
-#include "hiltwin/analysis/credibility.h"
+#include "hiltwin/assess/credibility.h"
 
 #include <gtest/gtest.h>
 

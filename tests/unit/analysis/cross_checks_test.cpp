@@ -1,5 +1,5 @@
 // Theil's inequality coefficient and the ISO/TS 18571 rating on curves with known answers.
-#include "hiltwin/analysis/cross_checks.h"
+#include "hiltwin/assess/cross_checks.h"
 
 #include <gtest/gtest.h>
 

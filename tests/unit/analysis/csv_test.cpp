@@ -1,5 +1,5 @@
 // CSV reading: the formats accepted and every bad input named by file, line and column.
-#include "hiltwin/analysis/csv.h"
+#include "hiltwin/tracing/csv.h"
 
 #include <gtest/gtest.h>
 

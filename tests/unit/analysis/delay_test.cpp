@@ -1,5 +1,5 @@
 // Delay estimation: known shifts (whole and fractional samples, both signs) are recovered.
-#include "hiltwin/analysis/delay.h"
+#include "hiltwin/assess/delay.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Welch frequency responses and the frequency-domain score on systems with known answers.
-#include "hiltwin/analysis/spectral.h"
+#include "hiltwin/assess/spectral.h"
 
 #include <gtest/gtest.h>
 

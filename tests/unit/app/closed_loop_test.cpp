@@ -10,7 +10,7 @@
 #include <cmath>
 #include <ostream>
 
-#include "hiltwin/app_relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_gains.h"
 #include "in_process_hil.h"
 
 namespace hiltwin::app::test {

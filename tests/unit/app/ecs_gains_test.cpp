@@ -1,5 +1,5 @@
 #include "fakes/test_paths.h"
-#include "hiltwin/app_relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_gains.h"
 
 #include <gtest/gtest.h>
 

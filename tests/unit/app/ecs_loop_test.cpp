@@ -11,7 +11,7 @@
 
 #include "fakes/alloc_counter.h"
 #include "fakes/loop_allocations.h"
-#include "hiltwin/app_relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
 #include "in_process_hil.h"
@@ -65,7 +65,7 @@ TEST(EcsLoop, ClosedLoopRunsInARunSessionWithoutAllocating) {
   EXPECT_EQ(allocations.count, 0U) << "malloc counted: " << hiltwin::test::MallocIsCounted();
   EXPECT_EQ(report.cycles_run, rig.planned_cycles());
   EXPECT_EQ(report.cycles_run, 12'000U);
-  EXPECT_EQ(report.stop_reason, statemachine::StopReason::kFinished);
+  EXPECT_EQ(report.stop_reason, lifecycle::StopReason::kFinished);
   EXPECT_TRUE(report.outputs_safe);
   ASSERT_TRUE(report.log.has_value());
   EXPECT_EQ(report.log->rows_written, 12'000U);

@@ -1,14 +1,14 @@
 // EcsTask against one emulated ECS board (no twin behind it: the encoder lines stay still, so
 // every count read is 0 and each test knows exactly what the task must send).
-#include "hiltwin/app_relbot/ecs_task.h"
+#include "hiltwin/relbot/ecs_task.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "hiltwin/app_relbot/ecs_gains.h"
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app {

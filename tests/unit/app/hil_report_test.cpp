@@ -1,6 +1,6 @@
 // The combined HiL result: figures are read from the ECS's and the twin's reports, a missing
 // report is "no figures" rather than an error, and the exit code is the worse of the two.
-#include "hiltwin/app_relbot/hil_report.h"
+#include "hiltwin/runs/hil_report.h"
 
 #include <gtest/gtest.h>
 

@@ -22,11 +22,11 @@
 #include <memory>
 #include <optional>
 
-#include "hiltwin/app_relbot/ecs_task.h"
-#include "hiltwin/app_relbot/relbot_model.h"
-#include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/profile_pwm_source.h"
-#include "hiltwin/app_relbot/relbot_twin.h"
+#include "hiltwin/relbot/ecs_task.h"
+#include "hiltwin/relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
+#include "hiltwin/relbot/relbot_twin.h"
 #include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app::test {

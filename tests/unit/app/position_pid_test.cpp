@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/position_pid.h"
+#include "hiltwin/relbot/position_pid.h"
 
 #include <gtest/gtest.h>
 

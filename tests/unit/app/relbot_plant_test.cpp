@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 
 #include "fakes/test_paths.h"
-#include "hiltwin/app_relbot/command.h"
-#include "hiltwin/app_relbot/relbot_plant.h"
-#include "hiltwin/app_relbot/twin_build.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/plant/plant_registry.h"
 
 namespace hiltwin::app {

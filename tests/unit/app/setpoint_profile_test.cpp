@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/setpoint_profile.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,15 +1,15 @@
 // The trajectory recorder inside the real run assembly: it records every cycle's exchange time
 // and wheel positions exactly (virtual clock, charged costs) and never allocates on the loop.
-#include "hiltwin/app_relbot/trajectory_recorder.h"
+#include "hiltwin/runs/trajectory_recorder.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
 #include "fakes/loop_allocations.h"
-#include "hiltwin/app_relbot/session_options.h"
-#include "hiltwin/app_relbot/relbot_plant.h"
-#include "hiltwin/app_relbot/twin_build.h"
+#include "hiltwin/runs/session_options.h"
+#include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {

@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "hiltwin/app_relbot/command.h"
-#include "hiltwin/app_relbot/tune.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/tune.h"
 
 namespace hiltwin::app {
 namespace {

@@ -11,12 +11,12 @@
 
 #include "fakes/alloc_counter.h"
 #include "fakes/loop_allocations.h"
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_model.h"
-#include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/profile_pwm_source.h"
-#include "hiltwin/app_relbot/relbot_channels.h"
-#include "hiltwin/app_relbot/relbot_twin.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
+#include "hiltwin/relbot/relbot_channels.h"
+#include "hiltwin/relbot/relbot_twin.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
@@ -78,8 +78,8 @@ TEST(TwinLoop, RunsTwentyThousandCyclesWithoutAllocating) {
   EXPECT_EQ(report.cycles_run, kCycles);
   EXPECT_GT(report.misses.deadline_misses, 0U);
   EXPECT_EQ(report.misses.releases, report.releases);  // every release is in the one ledger
-  EXPECT_EQ(report.stop_reason, statemachine::StopReason::kFinished);
-  EXPECT_EQ(report.final_state, statemachine::State::kStopped);
+  EXPECT_EQ(report.stop_reason, lifecycle::StopReason::kFinished);
+  EXPECT_EQ(report.final_state, lifecycle::State::kStopped);
   EXPECT_NE(rig.twin.model().Outputs().wheel_left_m, 0.0);
   EXPECT_EQ(rig.twin.model().steps(), kCycles);
   EXPECT_EQ(report.link.io_errors, 0U);

@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/relbot/input_profile.h"
 
 #include <gtest/gtest.h>
 

@@ -12,7 +12,7 @@
 #include <Eigen/Dense>
 
 #include "fakes/alloc_counter.h"
-#include "hiltwin/app_relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_model.h"
 
 namespace hiltwin::app {
 namespace {

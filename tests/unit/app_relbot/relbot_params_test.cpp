@@ -1,5 +1,5 @@
 #include "fakes/test_paths.h"
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/relbot_params.h"
 
 #include <gtest/gtest.h>
 

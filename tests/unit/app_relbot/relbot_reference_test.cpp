@@ -1,4 +1,4 @@
-#include "hiltwin/app_relbot/relbot_reference.h"
+#include "hiltwin/relbot/relbot_reference.h"
 
 #include <gtest/gtest.h>
 

@@ -33,7 +33,7 @@
 #include <string>
 #include <string_view>
 
-#include "hiltwin/app_relbot/config_error.h"
+#include "hiltwin/relbot/config_error.h"
 
 namespace hiltwin::app {
 namespace toml_test {

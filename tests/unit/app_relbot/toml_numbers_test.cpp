@@ -1,14 +1,14 @@
 // toml_numbers.h on its own, with a two-key record. The behaviour the RELbot and ECS files share
 // is tested through their public functions (toml_number_file_tests.h); this covers what neither
 // file uses.
-#include "hiltwin/app_relbot/toml_numbers.h"
+#include "hiltwin/relbot/toml_numbers.h"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <string>
 
-#include "hiltwin/app_relbot/config_error.h"
+#include "hiltwin/relbot/config_error.h"
 
 namespace hiltwin::app {
 namespace {

@@ -17,7 +17,7 @@
 #include <chrono>
 
 #include "../app/in_process_hil.h"
-#include "hiltwin/app_relbot/ecs_gains.h"
+#include "hiltwin/relbot/ecs_gains.h"
 #include "rtl_pair.h"
 
 #ifndef HILTWIN_RTL_LOOP_S

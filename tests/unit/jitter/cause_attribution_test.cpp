@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/jitter_report.h"
+#include "hiltwin/jitter/jitter_report.h"
 #include "jitter_fixtures.h"
 
 namespace hiltwin::analysis {

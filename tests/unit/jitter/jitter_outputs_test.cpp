@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "hiltwin/analysis/jitter_outputs.h"
+#include "hiltwin/jitter/jitter_outputs.h"
 #include "hiltwin/qos/rules.h"
 #include "jitter_fixtures.h"
 

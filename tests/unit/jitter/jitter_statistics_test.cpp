@@ -7,7 +7,7 @@
 #include <numeric>
 #include <vector>
 
-#include "hiltwin/analysis/jitter_report.h"
+#include "hiltwin/jitter/jitter_report.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/scheduler/timing_stats.h"
 #include "jitter_fixtures.h"

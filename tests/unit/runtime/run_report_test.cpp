@@ -9,7 +9,7 @@
 namespace hiltwin::runtime {
 namespace {
 
-using statemachine::StopReason;
+using lifecycle::StopReason;
 
 RunReport Finished(qos::Verdict verdict) {
   RunReport r;
@@ -17,7 +17,7 @@ RunReport Finished(qos::Verdict verdict) {
   r.io = "mock";
   r.verdict = verdict;
   r.stop_reason = StopReason::kFinished;
-  r.final_state = statemachine::State::kStopped;
+  r.final_state = lifecycle::State::kStopped;
   r.rate_hz = 4000.0;
   r.cycles_planned = r.cycles_run = r.releases = 40'000;
   r.misses.releases = 40'000;

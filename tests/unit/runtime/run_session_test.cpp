@@ -18,8 +18,8 @@
 namespace hiltwin::runtime {
 namespace {
 
-using statemachine::State;
-using statemachine::StopReason;
+using lifecycle::State;
+using lifecycle::StopReason;
 
 constexpr std::uint64_t kNever = ~std::uint64_t{0};
 

@@ -21,8 +21,8 @@
 namespace hiltwin::runtime {
 namespace {
 
-using statemachine::State;
-using statemachine::StopReason;
+using lifecycle::State;
+using lifecycle::StopReason;
 
 // ---------------------------------------------------------------------------- the mailbox
 

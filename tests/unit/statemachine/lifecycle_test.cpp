@@ -1,7 +1,7 @@
 // Every (state, event) pair of the lifecycle against a table written out independently here,
 // the stop reasons, the per-state rules, and the seed ECS framework's command sequences.
 
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-namespace hiltwin::statemachine {
+namespace hiltwin::lifecycle {
 namespace {
 
 constexpr std::array kStates = {State::kInit,     State::kReady,   State::kRun,   State::kPaused,
@@ -24,7 +24,7 @@ constexpr std::array kEvents = {Event::kConfigured,  Event::kStart,         Even
 using S = State;
 using E = Event;
 
-// The legal transitions, spelled out one by one (DESIGN "statemachine", lifecycle.h).
+// The legal transitions, spelled out one by one (DESIGN "lifecycle", lifecycle.h).
 const std::map<std::pair<State, Event>, State>& Legal() {
   static const std::map<std::pair<State, Event>, State> table = {
       {{S::kInit, E::kConfigured}, S::kReady},
@@ -254,11 +254,11 @@ TEST(Lifecycle, SeedCommandSequences) {
 }
 
 }  // namespace
-}  // namespace hiltwin::statemachine
+}  // namespace hiltwin::lifecycle
 
-namespace hiltwin::statemachine {
+namespace hiltwin::lifecycle {
 namespace {
 static_assert(noexcept(std::declval<Lifecycle&>().Handle(Event::kStart)));
 static_assert(noexcept(Next(State::kRun, Event::kPause)));
 }  // namespace
-}  // namespace hiltwin::statemachine
+}  // namespace hiltwin::lifecycle

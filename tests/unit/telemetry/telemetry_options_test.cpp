@@ -97,7 +97,7 @@ TEST(RecordJson, HasEveryDocumentedKeyAndNullForADistanceThatCannotFail) {
   r.rate_hz = 4000.0;
   r.time_s = 1.25;
   r.cycle = 5000;
-  r.state = statemachine::State::kRun;
+  r.state = lifecycle::State::kRun;
   r.task.has_pose = true;
   r.task.x_m = 0.5;
   r.task.theta_rad = -0.25;

@@ -32,7 +32,7 @@ runtime::TelemetryRecord Record(const std::string& ns, const std::string& role,
   r.time_s = static_cast<double>(cycle) / 500.0;
   r.cycle = cycle;
   r.cycles_planned = 5000;
-  r.state = statemachine::State::kRun;
+  r.state = lifecycle::State::kRun;
   r.deadline_misses = 2;
   r.latency_p99_us = 55.5;
   r.distance_to_violation = 4;
@@ -81,7 +81,7 @@ TEST_F(DdsMonitorTest, ListsEveryTaskWithItsLatestRecord) {
   EXPECT_EQ(t.latency_p99_us, 55.5);
   EXPECT_EQ(t.distance_to_violation, std::optional<std::uint32_t>(4));
   EXPECT_EQ(t.verdict, "PASS");
-  EXPECT_EQ(t.state, statemachine::ToString(statemachine::State::kRun));
+  EXPECT_EQ(t.state, lifecycle::ToString(lifecycle::State::kRun));
   EXPECT_FALSE(t.final);
   EXPECT_GE(t.age_s, 0.0);
   const MonitorEntry& c = *Find(entries, ecs_ns);

@@ -37,7 +37,7 @@ runtime::TelemetryRecord TwinRecord(const std::string& ns) {
   r.time_s = 12.25;
   r.cycle = 12'250;
   r.cycles_planned = 20'000;
-  r.state = statemachine::State::kRun;
+  r.state = lifecycle::State::kRun;
   r.deadline_misses = 3;
   r.latency_p99_us = 41.5;
   r.latency_max_us = 97.25;
@@ -126,7 +126,7 @@ TEST_F(DdsSinkTest, PublishesExactlyTheRecordsValues) {
   EXPECT_EQ(timing.latency_max_us, 97.25);
   EXPECT_EQ(timing.distance_to_violation, -1);  // nullopt: no rule can fail
   EXPECT_EQ(verdict, "PASS");
-  EXPECT_EQ(state, statemachine::ToString(statemachine::State::kRun));
+  EXPECT_EQ(state, lifecycle::ToString(lifecycle::State::kRun));
   EXPECT_FALSE(timing.final);
 }
 
@@ -141,7 +141,7 @@ TEST_F(DdsSinkTest, TimingCarriesDistanceVerdictAndFinalToALateReader) {
   runtime::TelemetryRecord record = TwinRecord(ns);
   record.distance_to_violation = 7;
   record.verdict_so_far = qos::Verdict::kFlagged;
-  record.state = statemachine::State::kStopped;
+  record.state = lifecycle::State::kStopped;
   record.final = true;
   sink->Publish(record);  // before the reader exists: transient-local keeps it
 

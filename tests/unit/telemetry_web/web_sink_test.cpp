@@ -31,7 +31,7 @@ runtime::TelemetryRecord MakeRecord(double x_m) {
   r.time_s = 1.25;
   r.cycle = 1250;
   r.cycles_planned = 5000;
-  r.state = statemachine::State::kRun;
+  r.state = lifecycle::State::kRun;
   r.latency_p99_us = 12.5;
   r.latency_max_us = 30.0;
   r.latency_samples = 1000;

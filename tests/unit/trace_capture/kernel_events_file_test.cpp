@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "hiltwin/analysis/kernel_events.h"
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/traces/kernel_events.h"
+#include "hiltwin/traces/timing_trace.h"
 
 namespace {
 

@@ -17,7 +17,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/traces/kernel_events.h"
 #include "hiltwin/kernel_glue/thread.h"
 
 namespace {

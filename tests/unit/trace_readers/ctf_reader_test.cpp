@@ -16,7 +16,7 @@
 
 #include "fakes/lttng_fixture.h"
 #include "fakes/test_paths.h"
-#include "hiltwin/analysis/trace_readers.h"
+#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/qos/rules.h"
 
 namespace hiltwin::analysis {

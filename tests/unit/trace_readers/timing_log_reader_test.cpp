@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/trace_readers.h"
+#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
 

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string>
 
-#include "hiltwin/analysis/trace_readers.h"
+#include "hiltwin/traces/trace_readers.h"
 
 namespace hiltwin::analysis {
 namespace {

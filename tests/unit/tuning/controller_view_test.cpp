@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 
 namespace hiltwin::analysis {
 namespace {

@@ -8,7 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 #include "tuning_fixtures.h"
 
 namespace hiltwin::analysis {

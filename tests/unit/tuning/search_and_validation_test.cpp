@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 
 namespace hiltwin::analysis {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cstdint>
 
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 
 namespace hiltwin::analysis::fixtures {
 

@@ -1,7 +1,7 @@
 // The three outputs of one TuneReport: JSON keys and values, the text with its Table 5.1-like
 // table and the deciding bound, and the self-contained HTML plot.
 
-#include "hiltwin/analysis/tuning_report.h"
+#include "hiltwin/tuning/tuning_report.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -10,9 +10,9 @@
 #include <span>
 #include <string_view>
 
-#include "hiltwin/app_relbot/config_error.h"
-#include "hiltwin/app_relbot/position_pid.h"
-#include "hiltwin/app_relbot/toml_numbers.h"
+#include "hiltwin/relbot/config_error.h"
+#include "hiltwin/relbot/position_pid.h"
+#include "hiltwin/relbot/toml_numbers.h"
 
 namespace hiltwin::app {
 

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/app_relbot/ecs_task.h"
+#include "hiltwin/relbot/ecs_task.h"
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_lines.h"
 #include "hiltwin/io/icoboard.h"

@@ -5,7 +5,7 @@
 #include <array>
 #include <cstdint>
 
-#include "hiltwin/app_relbot/input_profile.h"
+#include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app {

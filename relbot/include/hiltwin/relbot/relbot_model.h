@@ -11,8 +11,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "hiltwin/app_relbot/integrator.h"
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/integrator.h"
+#include "hiltwin/relbot/relbot_params.h"
 
 namespace hiltwin::app {
 

@@ -9,8 +9,8 @@
 #include <span>
 #include <string_view>
 
-#include "hiltwin/app_relbot/config_error.h"
-#include "hiltwin/app_relbot/toml_numbers.h"
+#include "hiltwin/relbot/config_error.h"
+#include "hiltwin/relbot/toml_numbers.h"
 #include "hiltwin/io/conversions.h"
 
 namespace hiltwin::app {

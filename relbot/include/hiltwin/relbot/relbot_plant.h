@@ -7,9 +7,9 @@
 #include <optional>
 #include <span>
 
-#include "hiltwin/app_relbot/integrator.h"
-#include "hiltwin/app_relbot/relbot_model.h"
-#include "hiltwin/app_relbot/relbot_params.h"
+#include "hiltwin/relbot/integrator.h"
+#include "hiltwin/relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/plant/plant.h"
 #include "hiltwin/plant/plant_map.h"
 

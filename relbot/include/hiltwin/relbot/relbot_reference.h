@@ -7,8 +7,8 @@
 
 #include <vector>
 
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_model.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_model.h"
 
 namespace hiltwin::app {
 

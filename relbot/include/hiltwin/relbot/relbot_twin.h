@@ -7,8 +7,8 @@
 #include <array>
 #include <cstdint>
 
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/relbot_plant.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_plant.h"
 #include "hiltwin/plant/plant_twin_task.h"
 
 namespace hiltwin::app {

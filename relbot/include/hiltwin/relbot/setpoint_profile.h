@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "hiltwin/app_relbot/input_profile.h"  // ProfileError
+#include "hiltwin/relbot/input_profile.h"  // ProfileError
 
 namespace hiltwin::app {
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/app_relbot/command.h"
+#include "hiltwin/runs/command.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/qos/monitor.h"

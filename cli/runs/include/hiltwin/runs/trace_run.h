@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/jitter_report.h"
-#include "hiltwin/app_relbot/twin_run.h"
+#include "hiltwin/jitter/jitter_report.h"
+#include "hiltwin/runs/twin_run.h"
 #include "hiltwin/runtime/run_report.h"
 
 namespace hiltwin::app {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 #include "hiltwin/plant/plant_twin_task.h"
 #include "hiltwin/runtime/run_task.h"
 

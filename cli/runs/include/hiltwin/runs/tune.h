@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/tuning_report.h"
+#include "hiltwin/tuning/tuning_report.h"
 
 namespace hiltwin::app {
 

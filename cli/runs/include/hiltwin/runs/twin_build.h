@@ -9,11 +9,11 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/app_relbot/input_profile.h"
-#include "hiltwin/app_relbot/integrator.h"
-#include "hiltwin/app_relbot/profile_pwm_source.h"
-#include "hiltwin/app_relbot/relbot_params.h"
-#include "hiltwin/app_relbot/twin_run.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/integrator.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/runs/twin_run.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/kernel_glue/clock.h"

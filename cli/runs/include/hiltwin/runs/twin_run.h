@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/app_relbot/session_options.h"
+#include "hiltwin/runs/session_options.h"
 #include "hiltwin/runtime/run_report.h"
 
 namespace hiltwin::app {

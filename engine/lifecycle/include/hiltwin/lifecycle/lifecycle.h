@@ -54,7 +54,7 @@
 #include <cstdint>
 #include <iterator>
 
-namespace hiltwin::statemachine {
+namespace hiltwin::lifecycle {
 
 enum class State : std::uint8_t {
   kInit,      ///< constructed; configuration, I/O and model being set up
@@ -168,4 +168,4 @@ class Lifecycle {
   StopReason late_fault_ = StopReason::kNone;
 };
 
-}  // namespace hiltwin::statemachine
+}  // namespace hiltwin::lifecycle

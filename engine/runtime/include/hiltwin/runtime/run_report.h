@@ -15,7 +15,7 @@
 #include "hiltwin/runtime/exit_code.h"
 #include "hiltwin/scheduler/overrun_policy.h"
 #include "hiltwin/scheduler/timing_stats.h"
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 
 namespace hiltwin::runtime {
 
@@ -52,7 +52,7 @@ struct LinkFigures {
 
 /// The fault that stopped the run (I/O or model).
 struct RunFault {
-  statemachine::StopReason kind = statemachine::StopReason::kNone;
+  lifecycle::StopReason kind = lifecycle::StopReason::kNone;
   std::uint64_t cycle = 0;
   std::string reason;
 };
@@ -77,9 +77,9 @@ struct RunReport {
   std::vector<std::pair<std::string, std::string>> details;
 
   qos::Verdict verdict = qos::Verdict::kPass;
-  statemachine::StopReason stop_reason = statemachine::StopReason::kNone;
-  statemachine::StopReason fault_while_stopping = statemachine::StopReason::kNone;
-  statemachine::State final_state = statemachine::State::kInit;
+  lifecycle::StopReason stop_reason = lifecycle::StopReason::kNone;
+  lifecycle::StopReason fault_while_stopping = lifecycle::StopReason::kNone;
+  lifecycle::State final_state = lifecycle::State::kInit;
 
   double rate_hz = 0.0;
   std::int64_t period_ns = 0;

@@ -31,7 +31,7 @@
 #include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/runtime/virtual_costs.h"
 #include "hiltwin/scheduler/executive.h"
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
 
 namespace hiltwin::runtime {
@@ -142,7 +142,7 @@ class RunSession {
   SessionConfig config_;
   RunTask& task_;
   std::unique_ptr<kernel_glue::Clock> clock_;
-  statemachine::Lifecycle lifecycle_;
+  lifecycle::Lifecycle lifecycle_;
   qos::QosMonitor monitor_;
   scheduler::Executive executive_;
   std::unique_ptr<tracing::CsvLogger> logger_;

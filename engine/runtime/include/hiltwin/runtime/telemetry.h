@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "hiltwin/qos/monitor.h"
-#include "hiltwin/statemachine/lifecycle.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 
 namespace hiltwin::runtime {
 
@@ -61,7 +61,7 @@ struct TelemetryRecord {
   double time_s = 0.0;               ///< the task's time (the CSV log's first column)
   std::uint64_t cycle = 0;           ///< cycles run so far
   std::uint64_t cycles_planned = 0;  ///< 0: until stopped
-  statemachine::State state = statemachine::State::kInit;
+  lifecycle::State state = lifecycle::State::kInit;
   bool final = false;  ///< the last record of the run (published after the loop)
   // Timing, as the QoS monitor and the loop saw it.
   std::uint64_t deadline_misses = 0;  ///< every miss so far, grace period included

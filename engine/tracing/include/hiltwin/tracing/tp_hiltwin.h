@@ -17,7 +17,7 @@
 ///   hiltwin:qos_violation  {rule, k, distance, violations}
 ///                          a rule's violation count rose at release k; distance: the rule's
 ///                          distance to failure after it (0); violations: the new count
-///   hiltwin:state_transition {k, from, to, event}    lifecycle codes (statemachine enums)
+///   hiltwin:state_transition {k, from, to, event}    lifecycle codes (lifecycle enums)
 ///   hiltwin:io_error       {k, kind}                 IoErrorKind
 /// Once per run, from the loop thread after its last cycle:
 ///   hiltwin:loop_end       {cycles_run, releases}

@@ -1,7 +1,7 @@
 #pragma once
 /// The integer codes the `hiltwin` tracepoints and the timing log carry, beside those that are
-/// another module's enums (qos::RuleKind for qos_rule.kind, statemachine::State and
-/// statemachine::Event for state_transition). Readers map them back and refuse unknown codes.
+/// another module's enums (qos::RuleKind for qos_rule.kind, lifecycle::State and
+/// lifecycle::Event for state_transition). Readers map them back and refuse unknown codes.
 
 #include <cstdint>
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-#include "hiltwin/analysis/csv.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::analysis {
 

@@ -12,12 +12,12 @@
 #include <utility>
 #include <vector>
 
-#include "hiltwin/analysis/assess_option.h"
-#include "hiltwin/analysis/credibility.h"
-#include "hiltwin/analysis/cross_checks.h"
-#include "hiltwin/analysis/csv.h"
-#include "hiltwin/analysis/delay.h"
-#include "hiltwin/analysis/spectral.h"
+#include "hiltwin/assess/assess_option.h"
+#include "hiltwin/assess/credibility.h"
+#include "hiltwin/assess/cross_checks.h"
+#include "hiltwin/tracing/csv.h"
+#include "hiltwin/assess/delay.h"
+#include "hiltwin/assess/spectral.h"
 
 namespace hiltwin::analysis {
 

@@ -2,19 +2,12 @@
 /// `hiltwin assess --plot FILE.png`: both curves and their difference over time, laid out as
 /// thesis fig. 5.3, rendered by gnuplot in a child process.
 
-#include <stdexcept>
 #include <string>
 
-#include "hiltwin/analysis/assessment.h"
+#include "hiltwin/assess/assessment.h"
+#include "hiltwin/report_kit/gnuplot.h"  // PlotError
 
 namespace hiltwin::analysis {
-
-/// gnuplot could not start or did not produce the picture (bad path, no space, ...); carries
-/// its output. Messages name the PNG path and gnuplot; the caller adds its flag.
-class PlotError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// Writes `png_path`: top panel y_s and y_e, bottom panel y_s − y_e raw and delay-compensated.
 /// Long records are thinned to at most `max_points` rows, keeping each bucket's extreme

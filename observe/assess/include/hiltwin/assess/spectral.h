@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/assess_option.h"
-#include "hiltwin/analysis/credibility.h"
+#include "hiltwin/assess/assess_option.h"
+#include "hiltwin/assess/credibility.h"
 
 namespace hiltwin::analysis {
 

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/jitter_report.h"
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/jitter/jitter_report.h"
+#include "hiltwin/traces/timing_trace.h"
 
 namespace hiltwin::analysis {
 

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "hiltwin/analysis/kernel_events.h"
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/traces/kernel_events.h"
+#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/scheduler/timing_stats.h"
 

@@ -1,10 +1,22 @@
 #pragma once
-// Private to the analysis module: what every gnuplot picture needs (a scratch directory for its
-// data, quoting, running gnuplot as a child with a timeout, checking that the PNG appeared).
-// Shared by `assess --plot` (plot.cpp) and the jitter pictures (jitter_plots.cpp).
+/// What every gnuplot picture needs (a scratch directory for its data, quoting, running gnuplot
+/// as a child with a timeout, checking that the PNG appeared). Shared by `assess --plot`
+/// (observe/assess) and the jitter pictures (observe/jitter).
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
+
+namespace hiltwin::analysis {
+
+/// gnuplot could not start or did not produce the picture (bad path, no space, ...); carries
+/// its output. Messages name the PNG path and gnuplot; the caller adds its flag.
+class PlotError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace hiltwin::analysis
 
 namespace hiltwin::analysis::detail {
 

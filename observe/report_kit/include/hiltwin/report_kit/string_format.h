@@ -1,6 +1,6 @@
 #pragma once
-// Private to the analysis module: printf into a std::string of any length, for every text
-// output of the module (assessment, jitter report, tune report).
+/// printf into a std::string of any length, for every text
+/// output of the observe modules (assessment, jitter report, tune report).
 
 #include <string>
 

@@ -1,7 +1,7 @@
 #pragma once
-// Private to the analysis module: just enough SVG for the HTML pages of the jitter report and
-// of `hiltwin tune` (axes with linear or log scales, bars, lines, dots, text), written inline
-// so a page needs nothing from outside: no script, no font, no link.
+/// Just enough SVG for the HTML pages of the jitter report and
+/// of `hiltwin tune` (axes with linear or log scales, bars, lines, dots, text), written inline
+/// so a page needs nothing from outside: no script, no font, no link.
 
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
-// Private to the analysis module: nanoseconds as the microseconds every output prints, one
-// definition for the text, HTML, Perfetto and tune reports.
+/// Nanoseconds as the microseconds every output prints, one
+/// definition for the text, HTML, Perfetto and tune reports.
 
 #include <cstdint>
 

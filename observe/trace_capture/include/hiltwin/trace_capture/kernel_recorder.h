@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/kernel_events.h"
+#include "hiltwin/traces/kernel_events.h"
 
 namespace hiltwin::trace_capture {
 

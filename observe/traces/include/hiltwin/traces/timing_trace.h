@@ -39,7 +39,7 @@ enum class TracedEventKind : std::uint8_t {
   kDeadlineMiss,     ///< a = lateness_ns
   kOverrunInjected,  ///< a = extra_ns
   kQosViolation,     ///< a = rule index, b = violations so far
-  kStateTransition,  ///< a = from, b = to, c = event (statemachine codes)
+  kStateTransition,  ///< a = from, b = to, c = event (lifecycle codes)
   kIoError,          ///< a = tracing::IoErrorKind
 };
 struct TracedEvent {

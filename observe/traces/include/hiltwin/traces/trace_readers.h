@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "hiltwin/analysis/timing_trace.h"
+#include "hiltwin/traces/timing_trace.h"
 
 namespace hiltwin::analysis {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/analysis/tuning.h"
+#include "hiltwin/tuning/tuning.h"
 
 namespace hiltwin::analysis {
 
