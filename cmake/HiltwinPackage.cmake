@@ -54,7 +54,7 @@ set(CPACK_COMPONENT_DEV_DESCRIPTION
     "This package holds the development files: headers, static libraries and the
 CMake package of hiltwin's framework, for plants and controllers built outside
 hiltwin. find_package(hiltwin) gives hiltwin::runtime, hiltwin::io,
-hiltwin::plant, hiltwin::fmi and the layers below them (kernel_glue, scheduler,
+hiltwin::plant, hiltwin::fmi and the layers below them (lockfree, kernel_glue, scheduler,
 qos, lifecycle, tracing).")
 # hiltwin-dev Depends on hiltwin (= this version): component dependencies become package ones.
 set(CPACK_COMPONENT_DEV_DEPENDS runtime)

@@ -19,7 +19,8 @@
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
-#include "hiltwin/runtime/link_fault_injection.h"
+#include "hiltwin/io/link_fault_injection.h"
+#include "hiltwin/runtime/link_faulting_task.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
@@ -66,8 +67,8 @@ std::vector<std::pair<std::string, std::string>> PlantDetails(const Twin& twin) 
 }
 
 /// --inject-link-fault's SPECs, checked against the backend and the run's length (exit 2).
-runtime::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
-  runtime::LinkFaultSchedule schedule;
+io::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
+  io::LinkFaultSchedule schedule;
   if (o.inject_link_faults.empty()) return schedule;
   if (o.session.io != "mock" && o.session.io.rfind("wire:", 0) != 0) {
     ThrowUsage("--inject-link-fault needs an emulated board (--io mock or wire:NAME), not --io " +
@@ -75,7 +76,7 @@ runtime::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
   }
   try {
     for (const std::string& spec : o.inject_link_faults)
-      schedule.Add(runtime::ParseLinkFaultInjection(spec));
+      schedule.Add(io::ParseLinkFaultInjection(spec));
     schedule.CheckFiresWithin(PlannedCycles(o.session));
   } catch (const std::exception& e) {
     ThrowUsage(std::string("--inject-link-fault ") + e.what());
@@ -84,10 +85,10 @@ runtime::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
 }
 
 /// The report's line naming the injected link faults, e.g. "drop-answer,at=4000,count=3".
-std::string DescribeAll(const runtime::LinkFaultSchedule& schedule) {
+std::string DescribeAll(const io::LinkFaultSchedule& schedule) {
   std::string text;
-  for (const runtime::LinkFaultInjection& injection : schedule.injections()) {
-    text += (text.empty() ? "" : "; ") + runtime::Describe(injection);
+  for (const io::LinkFaultInjection& injection : schedule.injections()) {
+    text += (text.empty() ? "" : "; ") + io::Describe(injection);
   }
   return text;
 }
@@ -109,7 +110,7 @@ void CheckTwinRunOptions(const TwinRunOptions& o) {
 TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   o.controller_rate_hz = ControllerRateOf(o);
   Validate(o);
-  const runtime::LinkFaultSchedule link_faults = LinkFaultsOf(o);
+  const io::LinkFaultSchedule link_faults = LinkFaultsOf(o);
   const std::uint64_t planned = PlannedCycles(o.session);
   // Before the first output exists: a stop signal during start-up (building the plant, INIT)
   // then ends the run at its first cycle with a report, instead of killing the process with

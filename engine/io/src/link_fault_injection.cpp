@@ -1,10 +1,10 @@
-#include "hiltwin/runtime/link_fault_injection.h"
+#include "hiltwin/io/link_fault_injection.h"
 
 #include <stdexcept>
 
-#include "spec_items.h"
+#include "hiltwin/kernel_glue/spec_items.h"
 
-namespace hiltwin::runtime {
+namespace hiltwin::io {
 namespace {
 
 using Kind = LinkFaultInjection::Kind;
@@ -48,7 +48,7 @@ void SetKind(std::string_view spec, std::string_view item, LinkFaultInjection& i
 }
 
 std::uint64_t Whole(std::string_view spec, std::string_view key, std::string_view text) {
-  return spec_items::WholeOf(key, text, [&](const std::string& what) { Fail(spec, what); });
+  return kernel_glue::spec_items::WholeOf(key, text, [&](const std::string& what) { Fail(spec, what); });
 }
 
 }  // namespace
@@ -57,7 +57,7 @@ LinkFaultInjection ParseLinkFaultInjection(std::string_view spec) {
   LinkFaultInjection injection;
   bool have_kind = false, have_at = false, have_count = false;
   std::size_t index = 0;
-  spec_items::ForEachItem(spec, [&](std::string_view item) {
+  kernel_glue::spec_items::ForEachItem(spec, [&](std::string_view item) {
     const std::size_t eq = item.find('=');
     if (index++ == 0) {
       if (eq != std::string_view::npos) Fail(spec, "the fault kind comes first");
@@ -113,7 +113,7 @@ void LinkFaultSchedule::CheckFiresWithin(std::uint64_t planned_exchanges) const 
   }
 }
 
-void LinkFaultSchedule::Arm(std::uint64_t exchange, io::FaultInjection& faults) const noexcept {
+void LinkFaultSchedule::Arm(std::uint64_t exchange, FaultInjection& faults) const noexcept {
   for (const LinkFaultInjection& inj : injections()) {
     const auto count = static_cast<std::uint32_t>(inj.count);
     if (inj.kind == Kind::kStuckEncoder) {
@@ -134,9 +134,4 @@ void LinkFaultSchedule::Arm(std::uint64_t exchange, io::FaultInjection& faults) 
   }
 }
 
-io::ExchangeStatus LinkFaultingTask::Exchange(bool live_outputs) noexcept {
-  schedule_.Arm(exchanges_++, board_.faults());
-  return task_.Exchange(live_outputs);
-}
-
-}  // namespace hiltwin::runtime
+}  // namespace hiltwin::io

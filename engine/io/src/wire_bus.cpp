@@ -20,7 +20,7 @@
 #include <thread>
 
 #include "hiltwin/io/conversions.h"
-#include "hiltwin/io/seqlock.h"
+#include "hiltwin/lockfree/seqlock.h"
 #include "hiltwin/io/wire_segment.h"
 
 namespace hiltwin::io {
@@ -188,7 +188,7 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
       words[3] |= Pack16(c, static_cast<std::uint16_t>(channels[c].pulses));
       words[4] |= std::uint64_t{static_cast<std::uint8_t>(channels[c].direction)} << (8U * c);
     }
-    SeqlockWrite(seg_.encoder_periods[index % kEncoderLineHistory], index, words);
+    lockfree::SeqlockWrite(seg_.encoder_periods[index % kEncoderLineHistory], index, words);
     seg_.encoder_newest.store(index, std::memory_order_release);
   }
 
@@ -224,7 +224,7 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
     // torn for good. No retry: an index the reader asks for was complete before
     // encoder_newest named it, so a refusal is a loss (a resync), never a reason to wait.
     std::array<std::uint64_t, kPeriodWords> words{};
-    if (!SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) return false;
+    if (!lockfree::SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) return false;
     if (static_cast<std::int64_t>(words[0]) > now_ns_ + kFutureSlackNs) now_ns_ = clock_.NowNs();
     return DecodePeriod(words, index, now_ns_, out, &guard_);
   }
@@ -233,7 +233,7 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
   bool Peek(std::uint64_t index, std::int64_t now_ns, EncoderPeriod& out) const noexcept {
     std::array<std::uint64_t, kPeriodWords> words{};
     if (index == 0 ||
-        !SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) {
+        !lockfree::SeqlockRead(seg_.encoder_periods[index % kEncoderLineHistory], index, words)) {
       return false;
     }
     return DecodePeriod(words, index, now_ns, out, nullptr);

@@ -14,14 +14,15 @@
 
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/qos/monitor.h"
-#include "hiltwin/runtime/command_queue.h"
-#include "hiltwin/runtime/latest_value.h"
+#include "hiltwin/lockfree/command_queue.h"
+#include "hiltwin/lockfree/latest_value.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_task.h"
+#include "hiltwin/runtime/session_command.h"
 #include "hiltwin/scheduler/cycle.h"
 #include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
-#include "hiltwin/tracing/spsc_ring.h"
+#include "hiltwin/lockfree/spsc_ring.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "hiltwin/tracing/trace_codes.h"
 
@@ -32,8 +33,9 @@ inline constexpr std::size_t kCommandQueueCapacity = 16;
 
 /// Where the loop leaves telemetry for the telemetry thread (telemetry.h); none owned.
 struct TelemetryTaps {
-  LatestValue<LoopSnapshot>* snapshot = nullptr;          ///< written every cycle
-  tracing::SpscQueue<std::int64_t>* latencies = nullptr;  ///< every cycle's wake-up latency, ns
+  lockfree::LatestValue<LoopSnapshot>* snapshot = nullptr;  ///< written every cycle
+  /// Every cycle's wake-up latency, ns.
+  lockfree::SpscQueue<std::int64_t>* latencies = nullptr;
 };
 
 /// The first fault of a run, as the loop saw it (reason is static text).
@@ -137,7 +139,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   LoopCounts counts_;
   std::optional<LoopFault> fault_;
   const char* peer_stopped_ = nullptr;
-  CommandQueue<SessionCommand, kCommandQueueCapacity> commands_;
+  lockfree::CommandQueue<SessionCommand, kCommandQueueCapacity> commands_;
   TelemetryTaps telemetry_;
 };
 

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "spec_items.h"
+#include "hiltwin/kernel_glue/spec_items.h"
 
 namespace hiltwin::runtime {
 namespace {
@@ -16,7 +16,7 @@ constexpr const char* kOverrunForms =
 }
 
 std::uint64_t ParseCount(std::string_view spec, std::string_view key, std::string_view text) {
-  return spec_items::WholeOf(key, text, [&](const std::string& what) { FailOverrun(spec, what); });
+  return kernel_glue::spec_items::WholeOf(key, text, [&](const std::string& what) { FailOverrun(spec, what); });
 }
 
 }  // namespace
@@ -25,7 +25,7 @@ OverrunInjection ParseOverrunInjection(std::string_view spec) {
   OverrunInjection injection;
   bool have_at = false, have_every = false, have_extra = false, have_count = false,
        have_offset = false;
-  spec_items::ForEachItem(spec, [&](std::string_view item) {
+  kernel_glue::spec_items::ForEachItem(spec, [&](std::string_view item) {
     const std::size_t eq = item.find('=');
     if (eq == std::string_view::npos) FailOverrun(spec, "'" + std::string(item) + "' is not key=value");
     const std::string_view key = item.substr(0, eq);

@@ -17,11 +17,12 @@
 #include "cycle_runner.h"
 #include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/qos/monitor.h"
-#include "hiltwin/runtime/latest_value.h"
+#include "hiltwin/lockfree/latest_value.h"
+#include "hiltwin/runtime/session_command.h"
 #include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/scheduler/executive.h"
 #include "hiltwin/lifecycle/lifecycle.h"
-#include "hiltwin/tracing/spsc_ring.h"
+#include "hiltwin/lockfree/spsc_ring.h"
 
 namespace hiltwin::runtime {
 
@@ -78,8 +79,8 @@ class TelemetryPublisher {
   std::function<bool(SessionCommand)> post_;
   CommandPort port_;
 
-  LatestValue<LoopSnapshot> mailbox_;
-  tracing::SpscQueue<std::int64_t> latencies_;
+  lockfree::LatestValue<LoopSnapshot> mailbox_;
+  lockfree::SpscQueue<std::int64_t> latencies_;
   std::vector<std::int64_t> window_ns_;  ///< the last second of latencies, a ring
   std::size_t window_next_ = 0;
   std::size_t window_filled_ = 0;

@@ -17,7 +17,7 @@
 #include <string_view>
 
 #include "hiltwin/fmi/fmi2_abi.h"
-#include "hiltwin/kernel_glue/cache_line.h"
+#include "hiltwin/lockfree/cache_line.h"
 
 namespace hiltwin::fmi {
 
@@ -62,9 +62,9 @@ class FmuLog {
   std::mutex drain_mutex_;
   std::uint64_t dropped_reported_ = 0;  ///< guarded by drain_mutex_
   // Monotonic counts: slot = count % capacity; full when written - read == capacity.
-  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::uint64_t> written_{0};
-  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::uint64_t> read_{0};
-  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::uint64_t> dropped_{0};
+  alignas(lockfree::kCacheLineBytes) std::atomic<std::uint64_t> written_{0};
+  alignas(lockfree::kCacheLineBytes) std::atomic<std::uint64_t> read_{0};
+  alignas(lockfree::kCacheLineBytes) std::atomic<std::uint64_t> dropped_{0};
 };
 
 /// "fmi2Warning" for fmi2Warning, ...; "fmi2Status(N)" spelled by the caller otherwise.

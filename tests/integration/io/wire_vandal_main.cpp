@@ -50,9 +50,9 @@ void Vandalise(WireSegment& segment, const std::string& kind, std::mt19937_64& r
     segment.magic.store(0xBAD);
   } else if (kind == "period") {
     std::array<std::uint64_t, hiltwin::io::wire::kPeriodWords> words{};
-    if (hiltwin::io::SeqlockRead(slot, newest, words)) {
+    if (hiltwin::lockfree::SeqlockRead(slot, newest, words)) {
       words[1] &= 0xFFFF'FFFF'0000'0000ULL;  // divider 0
-      hiltwin::io::SeqlockWrite(slot, newest, words);
+      hiltwin::lockfree::SeqlockWrite(slot, newest, words);
     }
   }
 }

@@ -17,12 +17,16 @@
 
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
-#include "hiltwin/io/seqlock.h"
+#include "hiltwin/lockfree/seqlock.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/clock.h"
 
 namespace hiltwin::io {
 namespace {
+
+using lockfree::SeqlockRead;
+using lockfree::SeqlockSlot;
+using lockfree::SeqlockWrite;
 
 using Words = std::array<std::uint64_t, 5>;
 

@@ -30,6 +30,9 @@
 namespace hiltwin::io {
 namespace {
 
+using lockfree::SeqlockRead;
+using lockfree::SeqlockWrite;
+
 std::string FreshTrustName(const char* tag) {
   const std::string name = std::string("utest-trust-") + tag + "-" + std::to_string(::getpid());
   WireBus::Unlink(name);

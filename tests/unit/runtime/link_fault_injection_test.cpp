@@ -1,4 +1,5 @@
-#include "hiltwin/runtime/link_fault_injection.h"
+#include "hiltwin/io/link_fault_injection.h"
+#include "hiltwin/runtime/link_faulting_task.h"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,10 @@
 namespace hiltwin::runtime {
 namespace {
 
+using io::Describe;
+using io::LinkFaultInjection;
+using io::LinkFaultSchedule;
+using io::ParseLinkFaultInjection;
 using Kind = LinkFaultInjection::Kind;
 
 TEST(LinkFaultInjection, ParsesKindsAndDefaults) {

@@ -14,14 +14,16 @@
 #include <vector>
 
 #include "fakes/loop_allocations.h"
-#include "hiltwin/runtime/command_queue.h"
-#include "hiltwin/runtime/latest_value.h"
+#include "hiltwin/lockfree/command_queue.h"
+#include "hiltwin/lockfree/latest_value.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::runtime {
 namespace {
 
 using lifecycle::State;
+using lockfree::CommandQueue;
+using lockfree::LatestValue;
 using lifecycle::StopReason;
 
 // ---------------------------------------------------------------------------- the mailbox

@@ -1,4 +1,4 @@
-#include "hiltwin/tracing/spsc_ring.h"
+#include "hiltwin/lockfree/spsc_ring.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 
 #include "fakes/alloc_counter.h"
 
-namespace hiltwin::tracing {
+namespace hiltwin::lockfree {
 namespace {
 
 #if defined(HILTWIN_UNDER_SANITIZER)
@@ -126,4 +126,4 @@ TEST(SpscQueue, ConcurrentProducerConsumerLosesAndReordersNothing) {
 }
 
 }  // namespace
-}  // namespace hiltwin::tracing
+}  // namespace hiltwin::lockfree

@@ -2,7 +2,7 @@
 /// Fault injection on the FPGA link: corrupted, dropped and delayed SPI frames and a stuck
 /// encoder, armed on the emulated board (mock and wire backends) at chosen exchanges, so a
 /// user can watch what the run does with a broken link (docs/reliability.md's fault matrix).
-/// The board's own hooks (io::FaultInjection) do the damage; this only decides when.
+/// The board's own hooks (FaultInjection) do the damage; this only decides when.
 ///
 /// SPEC forms (comma-separated, repeatable flag):
 ///   KIND,at=K[,count=N]   KIND: corrupt-request | corrupt-answer | drop-answer |
@@ -21,9 +21,8 @@
 #include <vector>
 
 #include "hiltwin/io/emulated_fpga.h"
-#include "hiltwin/runtime/run_task.h"
 
-namespace hiltwin::runtime {
+namespace hiltwin::io {
 
 struct LinkFaultInjection {
   enum class Kind : std::uint8_t {
@@ -56,7 +55,7 @@ class LinkFaultSchedule {
   void CheckFiresWithin(std::uint64_t planned_exchanges) const;
   /// Arms `faults` for exchange `exchange`: frame faults at their first exchange (the board
   /// consumes one per frame), the stuck encoder on and off at its edges. Real-time path.
-  void Arm(std::uint64_t exchange, io::FaultInjection& faults) const noexcept;
+  void Arm(std::uint64_t exchange, FaultInjection& faults) const noexcept;
   [[nodiscard]] bool empty() const noexcept { return size_ == 0; }
   [[nodiscard]] std::span<const LinkFaultInjection> injections() const noexcept {
     return {injections_.data(), size_};
@@ -67,32 +66,4 @@ class LinkFaultSchedule {
   std::size_t size_ = 0;
 };
 
-/// Wraps a task so that its board's faults are armed before each exchange. Everything else
-/// is the wrapped task's. The board must outlive the wrapper.
-class LinkFaultingTask final : public RunTask {
- public:
-  LinkFaultingTask(RunTask& task, io::EmulatedFpga& board, LinkFaultSchedule schedule) noexcept
-      : task_(task), board_(board), schedule_(schedule) {}
-
-  io::ExchangeStatus Exchange(bool live_outputs) noexcept override;
-  StepStatus Step(const scheduler::CycleContext& context) noexcept override {
-    return task_.Step(context);
-  }
-  [[nodiscard]] std::vector<std::string> LogColumns() const override { return task_.LogColumns(); }
-  [[nodiscard]] double LogTimeS() const noexcept override { return task_.LogTimeS(); }
-  void FillLogRow(std::span<double> values) const noexcept override { task_.FillLogRow(values); }
-  [[nodiscard]] TelemetryShape TelemetryShapeOf() const override {
-    return task_.TelemetryShapeOf();
-  }
-  void FillTelemetry(TaskTelemetry& out) const noexcept override { task_.FillTelemetry(out); }
-  /// Exchanges made so far.
-  [[nodiscard]] std::uint64_t exchanges() const noexcept { return exchanges_; }
-
- private:
-  RunTask& task_;
-  io::EmulatedFpga& board_;
-  LinkFaultSchedule schedule_;
-  std::uint64_t exchanges_ = 0;
-};
-
-}  // namespace hiltwin::runtime
+}  // namespace hiltwin::io

@@ -10,7 +10,7 @@
 #include <limits>
 
 #include "hiltwin/io/encoder_lines.h"
-#include "hiltwin/io/seqlock.h"
+#include "hiltwin/lockfree/seqlock.h"
 
 namespace hiltwin::io {
 
@@ -45,7 +45,7 @@ struct WireSide {
 };
 
 /// One encoder period in the ring: a single-writer seqlock whose tag is the period's index.
-using WirePeriod = SeqlockSlot<wire::kPeriodWords>;
+using WirePeriod = lockfree::SeqlockSlot<wire::kPeriodWords>;
 
 /// The shared segment. Zero-filled memory is a valid initial state of every field.
 struct WireSegment {

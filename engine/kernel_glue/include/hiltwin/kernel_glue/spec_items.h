@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-namespace hiltwin::runtime::spec_items {
+namespace hiltwin::kernel_glue::spec_items {
 
 /// Calls `item(text)` for each comma-separated item of `spec`, in order (empty items included,
 /// so "a,,b" is caught by the caller's checks rather than silently skipped).
@@ -39,4 +39,4 @@ std::uint64_t WholeOf(std::string_view key, std::string_view text, Fail&& fail) 
   return value;
 }
 
-}  // namespace hiltwin::runtime::spec_items
+}  // namespace hiltwin::kernel_glue::spec_items

@@ -4,11 +4,11 @@
 
 #include <cstddef>
 
-namespace hiltwin::kernel_glue {
+namespace hiltwin::lockfree {
 
 /// 64 bytes on both machines hiltwin targets: x86-64 and the Raspberry Pi 4's Cortex-A72 (its L1
 /// and L2 lines are 64 bytes). Not std::hardware_destructive_interference_size: g++ ties that
 /// to -mtune and warns when a header uses it, as the value would then be part of the ABI.
 inline constexpr std::size_t kCacheLineBytes = 64;
 
-}  // namespace hiltwin::kernel_glue
+}  // namespace hiltwin::lockfree

@@ -1,8 +1,8 @@
 #pragma once
-/// Commands from other threads to a running session (signal forwarding, telemetry sinks,
-/// tests), kept in the order they were sent. A bounded queue after Dmitry Vyukov's: every slot
-/// carries a sequence number, producers claim a slot with one compare-exchange, the consumer
-/// (the loop, after its cycle) takes slots in order. Nothing allocates after construction;
+/// Commands from other threads to one consumer (a running session's loop takes signal
+/// forwarding, telemetry sinks and tests' commands), kept in the order they were sent. A
+/// bounded queue after Dmitry Vyukov's: every slot carries a sequence number, producers claim a
+/// slot with one compare-exchange, the consumer (the loop, after its cycle) takes slots in order. Nothing allocates after construction;
 /// the consumer never waits (a slot a producer has claimed but not yet filled reads as empty,
 /// and is taken next cycle), and a full queue refuses the command rather than blocking.
 
@@ -11,12 +11,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "hiltwin/kernel_glue/cache_line.h"
+#include "hiltwin/lockfree/cache_line.h"
 
-namespace hiltwin::runtime {
-
-/// What another thread may ask of a running session.
-enum class SessionCommand : std::uint8_t { kStop, kPause, kResume };
+namespace hiltwin::lockfree {
 
 template <typename T, std::size_t kCapacity>
 class CommandQueue {
@@ -73,8 +70,8 @@ class CommandQueue {
     T value{};
   };
   std::array<Cell, kCapacity> cells_;
-  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::size_t> enqueue_{0};
-  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::size_t> dequeue_{0};
+  alignas(kCacheLineBytes) std::atomic<std::size_t> enqueue_{0};
+  alignas(kCacheLineBytes) std::atomic<std::size_t> dequeue_{0};
 };
 
-}  // namespace hiltwin::runtime
+}  // namespace hiltwin::lockfree

@@ -11,9 +11,9 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "hiltwin/kernel_glue/cache_line.h"
+#include "hiltwin/lockfree/cache_line.h"
 
-namespace hiltwin::runtime {
+namespace hiltwin::lockfree {
 
 template <typename T>
 class LatestValue {
@@ -46,14 +46,14 @@ class LatestValue {
   static constexpr std::uint8_t kIndexMask = 0x3;
   static constexpr std::uint8_t kFresh = 0x4;
   /// One cache line each at least, so the writer's stores never share a line with the reader.
-  struct alignas(kernel_glue::kCacheLineBytes) Slot {
+  struct alignas(kCacheLineBytes) Slot {
     T value{};
   };
   std::array<Slot, 3> slots_{};
-  alignas(kernel_glue::kCacheLineBytes) std::atomic<std::uint8_t> middle_{1};
-  alignas(kernel_glue::kCacheLineBytes) std::uint8_t back_ = 0;   // writer's
+  alignas(kCacheLineBytes) std::atomic<std::uint8_t> middle_{1};
+  alignas(kCacheLineBytes) std::uint8_t back_ = 0;   // writer's
   std::uint64_t published_ = 0;                                   // writer's
-  alignas(kernel_glue::kCacheLineBytes) std::uint8_t front_ = 2;  // reader's
+  alignas(kCacheLineBytes) std::uint8_t front_ = 2;  // reader's
 };
 
-}  // namespace hiltwin::runtime
+}  // namespace hiltwin::lockfree

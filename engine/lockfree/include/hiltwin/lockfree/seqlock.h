@@ -28,7 +28,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace hiltwin::io {
+namespace hiltwin::lockfree {
 
 template <std::size_t kWords>
 struct SeqlockSlot {
@@ -57,4 +57,4 @@ bool SeqlockRead(const SeqlockSlot<kWords>& slot, std::uint64_t tag,
   return slot.sequence.load(std::memory_order_relaxed) == before;
 }
 
-}  // namespace hiltwin::io
+}  // namespace hiltwin::lockfree

@@ -1,6 +1,8 @@
 #pragma once
-/// Lock-free single-producer/single-consumer ring: the index logic (SpscRing, independent of
-/// element type and capacity, as ETL's queue_spsc_atomic base) and a typed queue on top of it.
+/// Lock-free single-producer/single-consumer ring after L. Lamport ("Specifying concurrent
+/// program modules", 1983): each index is written by one side only, published with release and
+/// read with acquire. The index logic (SpscRing, independent of element type and capacity, as
+/// ETL's queue_spsc_atomic base) and a typed queue on top of it.
 
 #include <atomic>
 #include <cstddef>
@@ -10,12 +12,11 @@
 #include <string>
 #include <type_traits>
 
-#include "hiltwin/kernel_glue/cache_line.h"
+#include "hiltwin/lockfree/cache_line.h"
 
-namespace hiltwin::tracing {
+namespace hiltwin::lockfree {
 
 /// Bytes that keep the producer's and the consumer's indices off each other's cache line.
-using kernel_glue::kCacheLineBytes;
 
 /// Claim/publish/release index logic over `capacity` slots stored by the owner. Indices are
 /// free-running 64-bit counters (they never wrap in practice), the slot is `index & mask`.
@@ -128,4 +129,4 @@ class SpscQueue {
   std::atomic<std::uint64_t> drops_{0};
 };
 
-}  // namespace hiltwin::tracing
+}  // namespace hiltwin::lockfree

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/io/icoboard.h"
+#include "hiltwin/io/exchange_status.h"
 #include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/scheduler/cycle.h"
 

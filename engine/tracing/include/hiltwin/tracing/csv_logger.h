@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "hiltwin/kernel_glue/thread.h"
-#include "hiltwin/tracing/spsc_ring.h"
+#include "hiltwin/lockfree/spsc_ring.h"
 
 namespace hiltwin::tracing {
 
@@ -132,7 +132,7 @@ class CsvLogger {
 
   // Producer side. Counters are written by the producer only (plain load+store, no RMW) and
   // read by anyone.
-  SpscRing ring_;
+  lockfree::SpscRing ring_;
   std::unique_ptr<double[]> rows_;
   std::uint32_t decimation_countdown_ = 0;
   std::atomic<std::uint64_t> offered_{0};

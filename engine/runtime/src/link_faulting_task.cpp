@@ -1,0 +1,10 @@
+#include "hiltwin/runtime/link_faulting_task.h"
+
+namespace hiltwin::runtime {
+
+io::ExchangeStatus LinkFaultingTask::Exchange(bool live_outputs) noexcept {
+  schedule_.Arm(exchanges_++, board_.faults());
+  return task_.Exchange(live_outputs);
+}
+
+}  // namespace hiltwin::runtime
