@@ -1,10 +1,15 @@
 #pragma once
 // Figures the benchmarks share: the median and the minimum over rounds (rounds alternate
-// between a figure and its peer, so both see the same machine), and the RELbot's openloop
-// duties as the benches drive the model with them.
+// between a figure and its peer, so both see the same machine), nanoseconds per item, and the
+// step benchmarks' two arguments. The RELbot's openloop duties and the timed RELbot step loop
+// are in relbot_duty_samples.h.
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
 #include <vector>
 
 namespace hiltwin::bench {
@@ -16,6 +21,33 @@ inline double Median(std::vector<double> values) {
 
 inline double MinOf(const std::vector<double>& values) {
   return *std::min_element(values.begin(), values.end());
+}
+
+using BenchClock = std::chrono::steady_clock;
+
+/// Nanoseconds per item between two readings of the clock.
+inline double NsPer(BenchClock::time_point start, BenchClock::time_point end, long items) {
+  return std::chrono::duration<double, std::nano>(end - start).count() /
+         static_cast<double>(items);
+}
+
+struct StepsAndRounds {
+  long steps = 1'000'000;  ///< timed steps per round and variant
+  int rounds = 9;          ///< rounds; each runs every variant once, in turn
+};
+
+/// The step benchmarks' arguments, [steps_per_round] [rounds] (argv[1], argv[2]); nothing, with
+/// the usage on stderr, when either is not a positive number. `more` names further arguments.
+inline std::optional<StepsAndRounds> ParseStepsAndRounds(int argc, char** argv,
+                                                         const char* more = "") {
+  StepsAndRounds parsed;
+  if (argc > 1) parsed.steps = std::strtol(argv[1], nullptr, 10);
+  if (argc > 2) parsed.rounds = std::atoi(argv[2]);
+  if (parsed.steps <= 0 || parsed.rounds <= 0) {
+    std::fprintf(stderr, "usage: %s [steps_per_round > 0] [rounds > 0]%s\n", argv[0], more);
+    return std::nullopt;
+  }
+  return parsed;
 }
 
 }  // namespace hiltwin::bench

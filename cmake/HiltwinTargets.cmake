@@ -148,6 +148,36 @@ function(hiltwin_add_module name)
   add_library(hiltwin::${name} ALIAS ${target})
 endfunction()
 
+# Under TSan a report fails the test at once (and in every hiltwin process it starts, which
+# inherit the variable); tests/tsan.supp names the uninstrumented libraries whose reports are
+# noise. Every test's ENVIRONMENT property, ours and plain add_test ones alike.
+set(HILTWIN_TSAN_TEST_ENVIRONMENT)
+if(HILTWIN_TSAN)
+  set(HILTWIN_TSAN_TEST_ENVIRONMENT ENVIRONMENT "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/\
+tests/tsan.supp:halt_on_error=1:second_deadlock_stack=1")
+endif()
+
+# hiltwin_labels_wanted(<out_var> "<labels some test has>" "<labels every test has>"): whether
+# this build keeps such tests: HILTWIN_TEST_LABELS (empty: all) names a label some test has, and
+# HILTWIN_TEST_SKIP_LABELS names none of the labels every test has.
+function(hiltwin_labels_wanted out_var some every)
+  set(wanted TRUE)
+  if(NOT HILTWIN_TEST_LABELS STREQUAL "")
+    set(wanted FALSE)
+    foreach(label IN LISTS some)
+      if(label IN_LIST HILTWIN_TEST_LABELS)
+        set(wanted TRUE)
+      endif()
+    endforeach()
+  endif()
+  foreach(label IN LISTS every)
+    if(label IN_LIST HILTWIN_TEST_SKIP_LABELS)
+      set(wanted FALSE)
+    endif()
+  endforeach()
+  set(${out_var} ${wanted} PARENT_SCOPE)
+endfunction()
+
 # hiltwin_add_gtest(<name> SOURCES <files...> LIBS <targets...> LABELS <labels...>
 #                   [RT_TESTS <regex>] [CONCURRENCY_TESTS <regex>]
 #                   [SLOW_TESTS <regex>=<seconds>...] [TIMEOUT s] [RESOURCE_LOCK <names...>]
@@ -205,33 +235,14 @@ function(hiltwin_add_gtest name)
   if(ARG_CONCURRENCY_TESTS)
     list(APPEND possible_labels concurrency)
   endif()
-  set(wanted TRUE)
-  if(NOT HILTWIN_TEST_LABELS STREQUAL "")
-    set(wanted FALSE)
-    foreach(label IN LISTS possible_labels)
-      if(label IN_LIST HILTWIN_TEST_LABELS)
-        set(wanted TRUE)
-      endif()
-    endforeach()
-  endif()
-  foreach(label IN LISTS labels)  # a label of every test of the executable
-    if(label IN_LIST HILTWIN_TEST_SKIP_LABELS)
-      set(wanted FALSE)
-    endif()
-  endforeach()
+  hiltwin_labels_wanted(wanted "${possible_labels}" "${labels}")
   if(NOT wanted)
     # Still a target, so its folder can set its properties, but neither built by default nor
     # known to CTest.
     set_target_properties(${name} PROPERTIES EXCLUDE_FROM_ALL ON)
     return()
   endif()
-  set(extra_properties)
-  if(HILTWIN_TSAN)
-    # A report fails the test at once (and in every hiltwin process it starts, which inherit
-    # the variable); tests/tsan.supp names the uninstrumented libraries whose reports are noise.
-    list(APPEND extra_properties ENVIRONMENT
-         "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/tsan.supp:halt_on_error=1:second_deadlock_stack=1")
-  endif()
+  set(extra_properties ${HILTWIN_TSAN_TEST_ENVIRONMENT})
   set(discovery_mode POST_BUILD)
   if(CMAKE_CROSSCOMPILING)
     set(discovery_mode PRE_TEST)

@@ -13,8 +13,9 @@ set(HILTWIN_TIER_MAY_USE_observe engine observe)
 set(HILTWIN_TIER_MAY_USE_cli engine board models relbot observe cli)
 
 # hiltwin_check_tier(<module> <dependencies...>): records the tier of <module> (from the folder
-# being configured) and refuses any hiltwin::<dep> whose tier <module>'s may not use. Targets
-# that are not modules (Threads::Threads, hiltwin_fpga_rtl, ...) are not checked.
+# being configured) and refuses any module among the dependencies whose tier <module>'s may
+# not use. Targets that are not modules (Threads::Threads, hiltwin_fpga_rtl, ...) are not
+# checked.
 function(hiltwin_check_tier name)
   file(RELATIVE_PATH folder "${PROJECT_SOURCE_DIR}" "${CMAKE_CURRENT_SOURCE_DIR}")
   string(REGEX MATCH "^[^/]+" tier "${folder}")
@@ -25,11 +26,16 @@ function(hiltwin_check_tier name)
   endif()
   set_property(GLOBAL PROPERTY HILTWIN_TIER_OF_${name} ${tier})
   foreach(dep IN LISTS ARGN)
-    if(NOT dep MATCHES "^hiltwin::(.+)$")
+    # A module is listed as hiltwin::<name> or by its target, hiltwin_<name>. Only the alias
+    # must name a module; hiltwin_fpga_rtl and the like are not modules and are not checked.
+    if(NOT dep MATCHES "^hiltwin(::|_)(.+)$")
       continue()
     endif()
-    set(used ${CMAKE_MATCH_1})
+    set(used ${CMAKE_MATCH_2})
     get_property(used_tier GLOBAL PROPERTY HILTWIN_TIER_OF_${used})
+    if(NOT used_tier AND CMAKE_MATCH_1 STREQUAL "_")
+      continue()
+    endif()
     if(NOT used_tier)
       message(FATAL_ERROR "module ${name} (${folder}/) lists hiltwin::${used}, which is not a "
                           "module added before it: add its folder earlier in "

@@ -1,4 +1,4 @@
-// The `hiltwin` command line (app_relbot/cli): argv goes through the same CLI11 app main.cpp
+// The `hiltwin` command line (cli/): argv goes through the same CLI11 app main.cpp
 // builds (BuildCliApp, every subcommand registered) and its parse step only; no command runs.
 // CLI11 reports every bad command line as a CLI::ParseError (help and version requests are
 // ParseErrors too), which main.cpp turns into exit code 2; anything else escaping the parse

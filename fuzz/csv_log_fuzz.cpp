@@ -1,6 +1,6 @@
 // The log readers of the analysis module: ParseCsv (curves for `hiltwin assess`, any hiltwin
-// CSV log; analysis/csv.h, documents InputError) and ReadTimingLog (`hiltwin trace --analyze
-// FILE` on a `--timing-log`; analysis/trace_readers.h, documents TraceReadError).
+// CSV log; tracing/csv.h, documents InputError) and ReadTimingLog (`hiltwin trace --analyze
+// FILE` on a `--timing-log`; traces/trace_readers.h, documents TraceReadError).
 //
 // Input: byte 0 chooses the reader (0: ParseCsv for curves, 1: ParseCsv for signal knots with
 // a layout check that wants a header, 2 and 3: ReadTimingLog); the rest is the file.

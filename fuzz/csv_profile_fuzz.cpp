@@ -1,4 +1,4 @@
-// CSV input profiles (`hiltwin run --input FILE`, app_relbot/input_profile.h) and setpoint
+// CSV input profiles (`hiltwin run --input FILE`, relbot/input_profile.h) and setpoint
 // profiles (`hiltwin ecs --setpoints FILE`, setpoint_profile.h). Both parsers document
 // ProfileError only; a profile they accept is then played (At() is noexcept and must give
 // finite values within the documented range).

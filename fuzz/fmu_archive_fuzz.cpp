@@ -1,4 +1,4 @@
-// An FMU's zip archive (fmi/src/fmu_archive.h): UnpackedFmu unpacks it into a private folder
+// An FMU's zip archive (models/fmi/src/fmu_archive.h): UnpackedFmu unpacks it into a private folder
 // and documents plant::PlantError naming the file and the entry. The input is written to a
 // scratch .fmu; TMPDIR points the unpacking into this process's scratch folder. Checked: every
 // file it unpacked lies inside its folder (no entry escapes), and the folder is gone after.

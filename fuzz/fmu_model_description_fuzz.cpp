@@ -1,4 +1,4 @@
-// An FMU's modelDescription.xml (fmi/src/model_description.h): ReadModelDescription documents
+// An FMU's modelDescription.xml (models/fmi/src/model_description.h): ReadModelDescription documents
 // plant::PlantError with file:line for everything it refuses. It reads a file, so each input
 // is written to a scratch file first. What it accepts must hold what it promises: a
 // modelIdentifier, a guid, and every variable named once.

@@ -1,6 +1,6 @@
-// The TOML configuration files: RELbot parameters (relbot.toml, app_relbot/relbot_params.h)
+// The TOML configuration files: RELbot parameters (relbot.toml, relbot/relbot_params.h)
 // and ECS gains (ecs_gains.toml, ecs_gains.h), both documenting ConfigError, and plant maps
-// (app_relbot/relbot_map.toml and --plant-map files, plant/plant_map.h), documenting
+// (relbot/relbot_map.toml and --plant-map files, plant/plant_map.h), documenting
 // PlantMapError. What a reader accepts must pass its own validator (a value the parser let in
 // but the validator refuses would reach the model unchecked elsewhere).
 //

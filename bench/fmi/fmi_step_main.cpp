@@ -20,7 +20,7 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Clock = hiltwin::bench::BenchClock;
 using hiltwin::bench::Median;
 constexpr double kStepS = 1e-3;
 constexpr std::size_t kInputSamples = 1024;  // a varying input, so nothing is constant-folded
@@ -46,7 +46,7 @@ double TimeAdapter(hiltwin::plant::Plant& plant, const std::vector<double>& inpu
   }
   const auto end = Clock::now();
   g_sink = g_sink + y[0] + (ok ? 0.0 : 1.0);
-  return std::chrono::duration<double, std::nano>(end - start).count() / static_cast<double>(steps);
+  return hiltwin::bench::NsPer(start, end, steps);
 }
 
 double TimeDirect(hiltwin::fmi::FmuPlant& plant, const std::vector<double>& inputs, long steps) {
@@ -65,19 +65,16 @@ double TimeDirect(hiltwin::fmi::FmuPlant& plant, const std::vector<double>& inpu
   }
   const auto end = Clock::now();
   g_sink = g_sink + y[0] + (ok ? 0.0 : 1.0);
-  return std::chrono::duration<double, std::nano>(end - start).count() / static_cast<double>(steps);
+  return hiltwin::bench::NsPer(start, end, steps);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) try {
-  const long steps = argc > 1 ? std::strtol(argv[1], nullptr, 10) : 1'000'000L;
-  const int rounds = argc > 2 ? std::atoi(argv[2]) : 9;
+  const auto arguments = hiltwin::bench::ParseStepsAndRounds(argc, argv, " [fmu]");
+  if (!arguments) return 2;
+  const auto [steps, rounds] = *arguments;
   const char* fmu_path = argc > 3 ? argv[3] : HILTWIN_BENCH_FMU;
-  if (steps <= 0 || rounds <= 0) {
-    std::fprintf(stderr, "usage: %s [steps_per_round > 0] [rounds > 0] [fmu]\n", argv[0]);
-    return 2;
-  }
   const auto plant = hiltwin::fmi::OpenFmu(fmu_path);
   if (plant->Info().inputs.size() != 1 || plant->Info().outputs.size() != 1) {
     std::fprintf(stderr, "%s: the benchmark needs an FMU with one Real input and one output\n",

@@ -23,29 +23,13 @@
 namespace {
 
 using hiltwin::app::Duty;
-using Clock = std::chrono::steady_clock;
+using Clock = hiltwin::bench::BenchClock;
 using hiltwin::bench::Median;
 using hiltwin::bench::MinOf;
 
 constexpr double kStepS = 2.5e-4;  // 4 kHz, the thesis's RELbot twin rate
 
 volatile double g_sink = 0.0;  // keeps the results observable
-
-double NsPerStep(Clock::time_point start, Clock::time_point end, long steps) {
-  return std::chrono::duration<double, std::nano>(end - start).count() / static_cast<double>(steps);
-}
-
-double TimeDirect(hiltwin::app::RelbotModel& model, const std::vector<Duty>& duty, long steps) {
-  model.Reset();
-  const auto start = Clock::now();
-  for (long k = 0; k < steps; ++k) {
-    const Duty& d = duty[static_cast<std::size_t>(k / 4) % duty.size()];
-    model.Step(d.left, d.right);
-  }
-  const auto end = Clock::now();
-  g_sink = g_sink + model.Outputs().wheel_left_m;
-  return NsPerStep(start, end, steps);
-}
 
 double TimeInterface(hiltwin::plant::Plant& plant, const std::vector<Duty>& duty, long steps) {
   std::array<double, 5> y{};
@@ -60,18 +44,15 @@ double TimeInterface(hiltwin::plant::Plant& plant, const std::vector<Duty>& duty
   }
   const auto end = Clock::now();
   g_sink = g_sink + y[0];
-  return NsPerStep(start, end, steps);
+  return hiltwin::bench::NsPer(start, end, steps);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const long steps = argc > 1 ? std::strtol(argv[1], nullptr, 10) : 1'000'000L;
-  const int rounds = argc > 2 ? std::atoi(argv[2]) : 9;
-  if (steps <= 0 || rounds <= 0) {
-    std::fprintf(stderr, "usage: %s [steps_per_round > 0] [rounds > 0]\n", argv[0]);
-    return 2;
-  }
+  const auto arguments = hiltwin::bench::ParseStepsAndRounds(argc, argv);
+  if (!arguments) return 2;
+  const auto [steps, rounds] = *arguments;
   const std::vector<Duty> duty = hiltwin::bench::OpenLoopDutiesAt1kHz();
   hiltwin::app::RegisterRelbotPlant();
   const std::unique_ptr<hiltwin::plant::Plant> plant =
@@ -80,12 +61,12 @@ int main(int argc, char** argv) {
   plant->Start(kStepS, y0);
   hiltwin::app::RelbotModel model(hiltwin::app::RelbotParams{}, hiltwin::app::Integrator::kRk4,
                                   kStepS);
-  (void)TimeDirect(model, duty, steps / 4);  // warm-up: caches, predictors, CPU frequency
+  (void)hiltwin::bench::TimeRelbotSteps(model, duty, steps / 4, g_sink);  // warm-up: caches, predictors, CPU frequency
   (void)TimeInterface(*plant, duty, steps / 4);
   std::vector<double> direct_ns;
   std::vector<double> interface_ns;
   for (int r = 0; r < rounds; ++r) {
-    direct_ns.push_back(TimeDirect(model, duty, steps));
+    direct_ns.push_back(hiltwin::bench::TimeRelbotSteps(model, duty, steps, g_sink));
     interface_ns.push_back(TimeInterface(*plant, duty, steps));
   }
   const double direct = Median(direct_ns);

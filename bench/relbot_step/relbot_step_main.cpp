@@ -29,24 +29,13 @@ namespace {
 
 using hiltwin::app::Duty;
 using hiltwin::app::RelbotState;
-using Clock = std::chrono::steady_clock;
+using Clock = hiltwin::bench::BenchClock;
 using hiltwin::bench::Median;
+using hiltwin::bench::NsPer;
 
 constexpr double kStepS = 2.5e-4;  // 4 kHz, the thesis's RELbot twin rate
 
 volatile double g_sink = 0.0;  // keeps the results observable
-
-double TimeHiltwin(hiltwin::app::RelbotModel& model, const std::vector<Duty>& duty, long steps) {
-  model.Reset();
-  const auto start = Clock::now();
-  for (long k = 0; k < steps; ++k) {
-    const Duty& d = duty[static_cast<std::size_t>(k / 4) % duty.size()];
-    model.Step(d.left, d.right);
-  }
-  const auto end = Clock::now();
-  g_sink = g_sink + model.Outputs().wheel_left_m;
-  return std::chrono::duration<double, std::nano>(end - start).count() / static_cast<double>(steps);
-}
 
 double TimeOdeint(const hiltwin::app::RelbotCoefficients& c, const std::vector<Duty>& duty,
                   long steps) {
@@ -69,7 +58,7 @@ double TimeOdeint(const hiltwin::app::RelbotCoefficients& c, const std::vector<D
   }
   const auto end = Clock::now();
   g_sink = g_sink + x[hiltwin::app::relbot_state::kWheelPositionLeftM];
-  return std::chrono::duration<double, std::nano>(end - start).count() / static_cast<double>(steps);
+  return NsPer(start, end, steps);
 }
 
 double TimeDerivative(const hiltwin::app::RelbotCoefficients& c, long evaluations) {
@@ -83,19 +72,19 @@ double TimeDerivative(const hiltwin::app::RelbotCoefficients& c, long evaluation
   }
   const auto end = Clock::now();
   g_sink = g_sink + x[hiltwin::app::relbot_state::kHeadingRad];
-  return std::chrono::duration<double, std::nano>(end - start).count() /
-         static_cast<double>(evaluations);
+  return NsPer(start, end, evaluations);
+}
+
+double TimeHiltwin(hiltwin::app::RelbotModel& model, const std::vector<Duty>& duty, long steps) {
+  return hiltwin::bench::TimeRelbotSteps(model, duty, steps, g_sink);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const long steps = argc > 1 ? std::strtol(argv[1], nullptr, 10) : 1'000'000L;
-  const int rounds = argc > 2 ? std::atoi(argv[2]) : 9;
-  if (steps <= 0 || rounds <= 0) {
-    std::fprintf(stderr, "usage: %s [steps_per_round > 0] [rounds > 0]\n", argv[0]);
-    return 2;
-  }
+  const auto arguments = hiltwin::bench::ParseStepsAndRounds(argc, argv);
+  if (!arguments) return 2;
+  const auto [steps, rounds] = *arguments;
   const std::vector<Duty> duty = hiltwin::bench::OpenLoopDutiesAt1kHz();
   const hiltwin::app::RelbotParams params;
   hiltwin::app::RelbotModel rk4(params, hiltwin::app::Integrator::kRk4, kStepS);

@@ -5,7 +5,7 @@
 namespace hiltwin::app {
 namespace {
 
-// File order of app_relbot/ecs_gains.toml. Ranges reject negative gains (a sign error turns
+// File order of relbot/ecs_gains.toml. Ranges reject negative gains (a sign error turns
 // negative feedback into positive) and values no RELbot-sized loop can use (a unit slip, e.g.
 // a gain per millimetre written as per metre); they do not judge the tuning.
 constexpr std::array<EcsGainSpec, 5> kSpecs{{
@@ -20,7 +20,7 @@ constexpr TomlNumbersWording kWording{
     .value_name = "ECS gain",
     .file_name = "ECS gains file",
     .expected_tables = "pid and output",
-    .file_hint = "app_relbot/ecs_gains.toml lists every key with its unit and the tuned value",
+    .file_hint = "relbot/ecs_gains.toml lists every key with its unit and the tuned value",
     .fallback = "run without a gains file to use the built-in gains",
 };
 

@@ -5,7 +5,7 @@
 namespace hiltwin::app {
 namespace {
 
-// File order of app_relbot/relbot.toml. Ranges reject what is not physical (negative masses,
+// File order of relbot/relbot.toml. Ranges reject what is not physical (negative masses,
 // zero resistance) and what is certainly a unit slip (a 1 km wheel); they do not judge taste.
 constexpr std::array<ParamSpec, 21> kSpecs{{
     {"supply", "voltage_v", &RelbotParams::supply_voltage_v, 0.0, true, 1000.0},
@@ -43,7 +43,7 @@ constexpr TomlNumbersWording kWording{
     .value_name = "RELbot parameter",
     .file_name = "RELbot parameter file",
     .expected_tables = "supply, motor, gear, encoder, wheel, body, contact, castor",
-    .file_hint = "app_relbot/relbot.toml lists every key with its unit and a documented value",
+    .file_hint = "relbot/relbot.toml lists every key with its unit and a documented value",
     .fallback = "run without a parameter file to use the built-in set",
 };
 

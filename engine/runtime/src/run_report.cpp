@@ -61,7 +61,7 @@ Json QosPart(const RunReport& r) {
           {"abort_cycle", OrNull(m.abort_cycle)}};
 }
 
-// The keys DESIGN.md's contract names, in its order.
+// The keys the contract names (docs/architecture.md, "Run report"), in its order.
 Json ContractPart(const RunReport& r) {
   Json constraints = Json::array();
   for (const qos::RuleStatus& status : r.constraints) constraints.push_back(Constraint(status));

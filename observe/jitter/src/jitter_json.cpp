@@ -10,7 +10,7 @@ namespace {
 
 using nlohmann::ordered_json;
 
-// Same shape as the run report's timing figures (runtime/src/run_report.cpp), plus the bins.
+// Same shape as the run report's timing figures (engine/runtime/src/run_report.cpp), plus the bins.
 ordered_json DistributionJson(const Distribution& d) {
   const scheduler::TimingSummary& s = d.summary;
   ordered_json out = {{"count", s.count}, {"min", s.min_ns}, {"mean", s.mean_ns},

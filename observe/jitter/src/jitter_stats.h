@@ -1,7 +1,7 @@
 #pragma once
 // Private to the analysis module: the jitter report's figures from a trace's cycles, fed
-// exactly as the executive feeds the run report's (scheduler/src/executive.cpp Account) and
-// counted exactly as the QoS ledger counts misses (runtime/src/cycle_runner.cpp RecordQos).
+// exactly as the executive feeds the run report's (engine/scheduler/src/executive.cpp Account) and
+// counted exactly as the QoS ledger counts misses (engine/runtime/src/cycle_runner.cpp RecordQos).
 
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// The live page (telemetry/web/index.html), embedded at build time so the binary serves it
+// The live page (observe/telemetry/web/index.html), embedded at build time so the binary serves it
 // with no file beside it.
 
 #include <string_view>

@@ -1,7 +1,7 @@
 #pragma once
 // httplib's task queue on hiltwin's threads. httplib's own ThreadPool starts std::threads
 // that inherit their creator's policy and CPU set; these workers are kernel_glue::NamedThreads
-// (SCHED_OTHER, named, DESIGN.md "the framework creates every thread"), and their number is
+// (SCHED_OTHER, named, docs/architecture.md "Real-time rules"), and their number is
 // fixed, so a crowd of browsers queues instead of spawning threads.
 
 #include <httplib.h>

@@ -1,4 +1,4 @@
-// Raw tracefs records to KernelEvents (field meanings in analysis/kernel_events.h).
+// Raw tracefs records to KernelEvents (field meanings in traces/kernel_events.h).
 #include "kernel_event_decoder.h"
 
 #include <array>

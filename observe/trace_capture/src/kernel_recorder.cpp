@@ -1,5 +1,5 @@
 // The kernel recorder: access check, its own tracefs instance, the collector thread, and at
-// the end the two files of analysis/kernel_events.h.
+// the end the two files of traces/kernel_events.h.
 #include "hiltwin/trace_capture/kernel_recorder.h"
 
 #include <unistd.h>

@@ -76,7 +76,8 @@ LogFile ReadLog(const std::string& path) {
   return log;
 }
 
-/// The exit code DESIGN.md's contract gives a report (docs/lifecycle.md for the faults).
+/// The exit code the contract gives a report (docs/architecture.md, "Exit codes"; docs/lifecycle.md
+/// for the faults).
 int ExpectedExitCode(const Json& report) {
   const std::string stop = report["stop_reason"];
   if (stop == "io_fault" || report.contains("log_error")) return 5;

@@ -73,7 +73,7 @@ endfunction()
 function(hiltwin_test_check_verdict what output exit_code)
   if(NOT output MATCHES "(^|\n)verdict +([A-Z]+)")
     hiltwin_test_fail("${what}" WHY "no 'verdict' line in the summary:\n${output}"
-                      HINT "see FormatSummary in runtime/src/run_report.cpp")
+                      HINT "see FormatSummary in engine/runtime/src/run_report.cpp")
   endif()
   set(verdict "${CMAKE_MATCH_2}")
   if(NOT (exit_code EQUAL 0 AND verdict STREQUAL "PASS") AND

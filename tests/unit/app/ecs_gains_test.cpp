@@ -10,7 +10,7 @@
 namespace hiltwin::app {
 namespace {
 
-// app_relbot/ecs_gains.toml through the behaviour every TOML number file shares, with the
+// relbot/ecs_gains.toml through the behaviour every TOML number file shares, with the
 // messages a user of this file sees.
 struct EcsGainsFile {
   using Record = PidGains;
@@ -22,7 +22,7 @@ struct EcsGainsFile {
   static constexpr auto kDefaults = DefaultEcsGains;
 
   static constexpr std::string_view kWhatToDo =
-      "fix it in the file (app_relbot/ecs_gains.toml lists every key with its unit and the tuned "
+      "fix it in the file (relbot/ecs_gains.toml lists every key with its unit and the tuned "
       "value), or run without a gains file to use the built-in gains";
   static constexpr std::string_view kExpectedTables = "pid and output";
   static constexpr std::string_view kUnknownTable = "feedforward";

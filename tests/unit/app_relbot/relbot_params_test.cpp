@@ -11,7 +11,7 @@
 namespace hiltwin::app {
 namespace {
 
-// app_relbot/relbot.toml through the behaviour every TOML number file shares, with the messages
+// relbot/relbot.toml through the behaviour every TOML number file shares, with the messages
 // a user of this file sees.
 struct RelbotFile {
   using Record = RelbotParams;
@@ -23,7 +23,7 @@ struct RelbotFile {
   static constexpr auto kDefaults = DefaultRelbotParams;
 
   static constexpr std::string_view kWhatToDo =
-      "fix it in the file (app_relbot/relbot.toml lists every key with its unit and a documented "
+      "fix it in the file (relbot/relbot.toml lists every key with its unit and a documented "
       "value), or run without a parameter file to use the built-in set";
   static constexpr std::string_view kExpectedTables =
       "supply, motor, gear, encoder, wheel, body, contact, castor";

@@ -1,5 +1,5 @@
 #pragma once
-// What every TOML number file (app_relbot/toml_numbers.h: relbot.toml, ecs_gains.toml) must do,
+// What every TOML number file (relbot/toml_numbers.h: relbot.toml, ecs_gains.toml) must do,
 // written once as a type-parameterised suite. A file's own test instantiates it with a traits
 // type that names the file's functions and the exact messages its users see:
 //

@@ -24,7 +24,7 @@ constexpr std::array kEvents = {Event::kConfigured,  Event::kStart,         Even
 using S = State;
 using E = Event;
 
-// The legal transitions, spelled out one by one (DESIGN "lifecycle", lifecycle.h).
+// The legal transitions, spelled out one by one (docs/lifecycle.md, lifecycle.h).
 const std::map<std::pair<State, Event>, State>& Legal() {
   static const std::map<std::pair<State, Event>, State> table = {
       {{S::kInit, E::kConfigured}, S::kReady},

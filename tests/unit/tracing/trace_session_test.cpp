@@ -1,6 +1,6 @@
 // Records a real LTTng trace of the hiltwin provider: session daemon, session, emitter
 // process, babeltrace2's text as a second opinion on the fields (hiltwin itself reads CTF
-// through libbabeltrace2, analysis/trace_readers.h). Label `integration`. The daemon and session
+// through libbabeltrace2, traces/trace_readers.h). Label `integration`. The daemon and session
 // come from the shared LTTng fixture (tests/fakes/lttng_fixture.h).
 #include <gtest/gtest.h>
 

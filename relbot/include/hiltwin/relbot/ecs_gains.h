@@ -1,5 +1,5 @@
 #pragma once
-/// The ECS's controller gains and output limit and their TOML file (app_relbot/ecs_gains.toml),
+/// The ECS's controller gains and output limit and their TOML file (relbot/ecs_gains.toml),
 /// read like relbot.toml by toml_numbers.h: every key carries its unit, every key is required,
 /// unknown keys are rejected, values are range-checked, and every error is a ConfigError that
 /// says "file:line:column: key: what is wrong; what to do". The built-in gains (DefaultEcsGains)
@@ -23,7 +23,7 @@ using EcsGainSpec = TomlNumberSpec<PidGains>;
 [[nodiscard]] std::span<const EcsGainSpec> EcsGainSpecs() noexcept;
 
 /// The built-in gains, tuned on the in-process closed loop (RELbot twin at 4 kHz, ECS at
-/// 1 kHz, `closedloop` profile); identical to app_relbot/ecs_gains.toml.
+/// 1 kHz, `closedloop` profile); identical to relbot/ecs_gains.toml.
 [[nodiscard]] PidGains DefaultEcsGains() noexcept;
 
 /// Checks every value is finite and within its range; throws ConfigError naming

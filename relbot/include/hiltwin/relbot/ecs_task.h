@@ -1,9 +1,9 @@
 #pragma once
-/// The RELbot's embedded control system (ECS) as a run task: the same code drives the twin
-/// (mock or wire backend) or the real robot (spidev), through the ECS image of the IcoBoard.
-/// Per cycle (DESIGN.md "One cycle, as data flows"): one full-duplex exchange (the duty the
-/// last step computed goes out, the encoder counts come in), then one step that computes the
-/// duty for the next exchange. Two modes:
+/// The RELbot's embedded control system (ECS) as a run task: the same code drives the twin (mock or
+/// wire backend) or the real robot (spidev), through the ECS image of the IcoBoard. Per cycle
+/// (docs/architecture.md, "One cycle, as data flows"): one full-duplex exchange (the duty the last
+/// step computed goes out, the encoder counts come in), then one step that computes the duty for
+/// the next exchange. Two modes:
 ///
 /// - closed loop (default): wheel position setpoints from a SetpointProfile, one PositionPid
 ///   per wheel, tracking-error statistics (thesis §7.2, appendix E). The PID gets the setpoint

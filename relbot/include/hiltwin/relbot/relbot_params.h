@@ -1,5 +1,5 @@
 #pragma once
-/// Physical parameters of the RELbot plant model and their TOML file (app_relbot/relbot.toml).
+/// Physical parameters of the RELbot plant model and their TOML file (relbot/relbot.toml).
 /// The thesis publishes no parameter values; the defaults are plausible for a ~2 kg two-wheel
 /// robot with 12 V geared DC motors and quadrature encoders (see docs/relbot-model.md and the
 /// comment on every key in relbot.toml). The defaults below and relbot.toml must agree; a unit
@@ -46,7 +46,7 @@ using ParamSpec = TomlNumberSpec<RelbotParams>;
 /// Every parameter, in file order. The loader, the validator and the tests iterate this.
 [[nodiscard]] std::span<const ParamSpec> RelbotParamSpecs() noexcept;
 
-/// The built-in parameter set (identical to app_relbot/relbot.toml).
+/// The built-in parameter set (identical to relbot/relbot.toml).
 [[nodiscard]] inline RelbotParams DefaultRelbotParams() noexcept { return RelbotParams{}; }
 
 /// Checks every value is finite and within its range; throws ConfigError naming

@@ -2,7 +2,7 @@
 /// The RELbot as a plant (plant/plant.h): inputs the two duties, outputs both wheels' travel
 /// and the pose. Its board I/O (which channel is which wheel, metres -> encoder counts,
 /// thesis appendix G) is a plant map like any other plant's: RelbotDefaultMap, the same as the
-/// shipped app_relbot/relbot_map.toml for the default parameters.
+/// shipped relbot/relbot_map.toml for the default parameters.
 
 #include <optional>
 #include <span>

@@ -1,6 +1,6 @@
 #pragma once
-/// Process exit codes of every hiltwin command (DESIGN.md "Contracts"); users' scripts and CI
-/// rely on these numbers.
+/// Process exit codes of every hiltwin command (docs/architecture.md, "Exit codes"); users' scripts
+/// and CI rely on these numbers.
 
 namespace hiltwin::runtime {
 

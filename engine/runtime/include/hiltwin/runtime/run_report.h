@@ -1,6 +1,6 @@
 #pragma once
-/// The typed run report (DESIGN.md "Run report"). RunSession fills it once, after the loop;
-/// the JSON file, the text summary, the problem lines and the exit code are all derived from
+/// The typed run report (docs/architecture.md, "Run report"). RunSession fills it once, after the
+/// loop; the JSON file, the text summary, the problem lines and the exit code are all derived from
 /// it here, so no two outputs can disagree and nothing is read back from JSON.
 
 #include <cstdint>
@@ -110,7 +110,8 @@ struct RunReport {
   std::optional<kernel_glue::RtSetupRecord> rt_setup;  ///< absent on the virtual clock
 };
 
-/// The JSON report. Keys of DESIGN.md's contract come first and keep their names.
+/// The JSON report. Keys of the contract (docs/architecture.md, "Run report") come first and keep
+/// their names.
 [[nodiscard]] nlohmann::ordered_json ToJson(const RunReport& report);
 
 /// A short human summary for stdout (a few lines, ends with the verdict).

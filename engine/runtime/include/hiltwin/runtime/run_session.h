@@ -1,12 +1,11 @@
 #pragma once
-/// One run assembly for every command (DESIGN.md "runtime"). Given a validated configuration
-/// and a task, a RunSession owns, in this order: the executive, the QoS monitor (the one miss
-/// ledger), the lifecycle, the CSV logger; then, in Run(), the loop thread (created through
-/// kernel_glue::NamedThread, raised to SCHED_FIFO and pinned by the RT set-up on itself),
-/// the logger's writer thread (SCHED_OTHER on the CPUs the loop does not use), the loop, the
-/// safe outputs, the drain, and the typed RunReport. The calling (control) thread stays
-/// SCHED_OTHER and prints the progress line; no other thread exists. docs/architecture.md
-/// draws it.
+/// One run assembly for every command (docs/architecture.md, "The run assembly"). Given a validated
+/// configuration and a task, a RunSession owns, in this order: the executive, the QoS monitor (the
+/// one miss ledger), the lifecycle, the CSV logger; then, in Run(), the loop thread (created
+/// through kernel_glue::NamedThread, raised to SCHED_FIFO and pinned by the RT set-up on itself),
+/// the logger's writer thread (SCHED_OTHER on the CPUs the loop does not use), the loop, the safe
+/// outputs, the drain, and the typed RunReport. The calling (control) thread stays SCHED_OTHER and
+/// prints the progress line; no other thread exists. Its section draws it.
 
 #include <atomic>
 #include <cstdint>

@@ -1,12 +1,11 @@
 #pragma once
-/// Live telemetry out of a running session, and commands into it (DESIGN.md "Where users
-/// outgrow one machine"). The loop writes a LoopSnapshot into a latest-value mailbox every
+/// Live telemetry out of a running session, and commands into it (docs/architecture.md, "Where
+/// users outgrow one machine"). The loop writes a LoopSnapshot into a latest-value mailbox every
 /// cycle (latest_value.h: never blocks, never allocates) and pushes the cycle's wake-up latency
 /// into a ring; a non-RT thread (`hiltwin-telem`, SCHED_OTHER) reads both at
-/// TelemetryConfig::rate_hz, builds one TelemetryRecord, and hands it to every sink (DDS, UDP,
-/// the web page). Commands that arrive through a sink go through a lock-free queue to the loop,
-/// which offers them to the lifecycle after its current cycle; the loop never waits on the
-/// network.
+/// TelemetryConfig::rate_hz, builds one TelemetryRecord, and hands it to every sink (DDS, UDP, the
+/// web page). Commands that arrive through a sink go through a lock-free queue to the loop, which
+/// offers them to the lifecycle after its current cycle; the loop never waits on the network.
 
 #include <array>
 #include <cstdint>

@@ -17,7 +17,7 @@
 
 namespace hiltwin::scheduler {
 
-/// Accepted update rates (DESIGN/issue: 1 Hz – 50 kHz).
+/// Accepted update rates (docs/architecture.md, "Commands": 1 Hz – 50 kHz).
 constexpr double kMinRateHz = 1.0;
 constexpr double kMaxRateHz = 50'000.0;
 

@@ -2,10 +2,10 @@
 /// Real-time-safe CSV data logger: the loop offers rows with TryLog (no allocation, no lock,
 /// no system call), a non-real-time writer thread drains a lock-free queue to the file.
 ///
-/// File format (DESIGN.md "Logs", docs/logs.md): a header row `time_s,<column>,...`, then one row per logged
-/// cycle, plain comma-separated, numbers in the shortest form that parses back to the same
-/// double (std::to_chars), non-finite values as NaN/Inf/-Inf. 20-sim's DataFromFile and
-/// MATLAB's readmatrix/readtable read it directly.
+/// File format (docs/architecture.md "Logs", docs/logs.md): a header row `time_s,<column>,...`,
+/// then one row per logged cycle, plain comma-separated, numbers in the shortest form that parses
+/// back to the same double (std::to_chars), non-finite values as NaN/Inf/-Inf. 20-sim's
+/// DataFromFile and MATLAB's readmatrix/readtable read it directly.
 ///
 /// Accounting (an invariant the tests hold it to): every row the decimation selects ends as
 /// exactly one of written (its bytes were accepted by the kernel: it is in the file), dropped

@@ -1,7 +1,8 @@
 #pragma once
 /// The timing log (`hiltwin run --timing-log FILE`): every cycle's time stamps, written by the
-/// RT-safe CsvLogger, read back by `hiltwin trace --analyze FILE` (analysis/timing_log_reader).
-/// It is the LTTng trace's `cycle` events for users who may not trace. The format, in full:
+/// RT-safe CsvLogger, read back by `hiltwin trace --analyze FILE` (observe/traces:
+/// timing_log_reader.cpp). It is the LTTng trace's `cycle` events for users who may not trace. The
+/// format, in full:
 ///
 ///   # hiltwin timing log 1
 ///   # period_ns=50000

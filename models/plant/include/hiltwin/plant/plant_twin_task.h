@@ -1,5 +1,5 @@
 #pragma once
-/// Any plant as a twin run task (DESIGN.md "One cycle, as data flows"): one full-duplex
+/// Any plant as a twin run task (docs/architecture.md, "One cycle, as data flows"): one full-duplex
 /// exchange with the board (PWM duty in, the encoder counts computed last cycle out), the
 /// plant map's input processing, the plant's step, and the map's output processing into the
 /// counts for the next exchange. Timing, QoS, tracing, logging and the lifecycle are the run

@@ -25,7 +25,7 @@ struct HistogramBin {
 };
 
 /// One timing quantity over the cycles the executive accounts it for — every cycle run, paused
-/// and grace cycles included, as the run report's figures (scheduler/src/executive.cpp):
+/// and grace cycles included, as the run report's figures (engine/scheduler/src/executive.cpp):
 /// latency only of cycles whose loop was asleep at the release (not of catch-up cycles);
 /// period jitter only between neighbouring cycles (not the first, not after skipped releases).
 /// The same log-linear histogram and percentile rule (scheduler::TimingStats), so the two agree

@@ -4,7 +4,7 @@
 /// decided it; from the validation runs to the highest rate that passes QoS and the rate where
 /// the error stops improving. Pure functions on typed records, so every figure can be tested
 /// on synthetic measurements. The JSON, the text and the HTML plot all derive from TuneReport
-/// (tuning_report.h); the measuring and the runs are the command's (app_relbot/tune.h).
+/// (tuning_report.h); the measuring and the runs are the command's (cli/runs: hiltwin/runs/tune.h).
 
 #include <cstdint>
 #include <functional>
