@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "unit/app_relbot/toml_number_file_tests.h"
+#include "unit/relbot/toml_number_file_tests.h"
 
 namespace hiltwin::app {
 namespace {
