@@ -4,10 +4,29 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <memory>
+#include <sstream>
+#include <string>
 
 #include "version.h"
 
 namespace hiltwin::app {
+namespace {
+
+/// `hiltwin --help` lists each command on one line, the first of its description; the rest of
+/// the paragraph is the command's own --help (a list of nine paragraphs hid the list).
+class OneLinePerCommand : public CLI::Formatter {
+ public:
+  std::string make_subcommand(const CLI::App* sub) const override {
+    const std::string& description = sub->get_description();
+    std::ostringstream out;
+    CLI::detail::format_help(out, sub->get_display_name(true),
+                             description.substr(0, description.find('\n')), column_width_);
+    return out.str();
+  }
+};
+
+}  // namespace
 
 std::vector<CommandEntry>& CommandRegistry() {
   static std::vector<CommandEntry> registry;  // function-local: safe during static init
@@ -31,7 +50,8 @@ std::unique_ptr<CliApp> BuildCliApp() {
   app.require_subcommand(1);
   app.fallthrough();  // --log-level may also follow the command
   app.set_version_flag("--version", kVersionText);
-  app.footer("Run 'hiltwin <command> --help' for the flags of one command.");
+  app.footer("Run 'hiltwin <command> --help' for what one command does and its flags.");
+  app.formatter(std::make_shared<OneLinePerCommand>());
 
   std::string& log_level = cli->log_level;
   app.add_option("--log-level", log_level,

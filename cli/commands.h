@@ -1,5 +1,5 @@
 #pragma once
-/// Registry of `hiltwin` subcommands. Each app_relbot/cli/cmd_<name>.cpp registers itself with
+/// Registry of `hiltwin` subcommands. Each cli/commands/cmd_<name>.cpp registers itself with
 /// HILTWIN_REGISTER_COMMAND, so adding a command touches no shared file. The cli/ sources are
 /// compiled straight into the executable, so the linker never drops a registration.
 
@@ -13,7 +13,7 @@ namespace hiltwin::app {
 using CommandFactory = Command (*)(CLI::App& parent);
 
 struct CommandEntry {
-  int order;  ///< position in `hiltwin --help` (DESIGN.md's table order)
+  int order;  ///< position in `hiltwin --help` (docs/architecture.md's table of commands)
   CommandFactory factory;
 };
 

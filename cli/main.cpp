@@ -1,5 +1,5 @@
 // The single `hiltwin` binary: parses the command line, runs the chosen subcommand and maps
-// every failure to the documented exit codes (DESIGN.md "Contracts").
+// every failure to the documented exit codes (docs/architecture.md, "Exit codes").
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 

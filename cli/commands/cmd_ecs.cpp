@@ -15,17 +15,26 @@
 #include "hiltwin/relbot/ecs_task.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/runs/session_options.h"
 #include "hiltwin/relbot/setpoint_profile.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/runtime/run_session.h"
+#include "session_flags.h"
 
 namespace hiltwin::app {
 namespace {
 
-/// `ecs`'s own flags beside the shared ones.
-struct EcsOptions {
-  SessionOptions session;
+/// What the controller does: follow setpoints with its PIDs, or play a duty profile.
+enum class EcsMode { kClosedLoop, kOpenLoop };
+
+/// --mode's word for it, as the start line and the report say it.
+const char* ToString(EcsMode mode) {
+  return mode == EcsMode::kClosedLoop ? "closedloop" : "openloop";
+}
+
+/// `ecs`'s own flags beside the shared ones, as the command line gave them.
+struct EcsFlags {
+  SessionFlags session;
   bool duration_given = false;
   std::string mode = "closedloop";
   std::string setpoint = "closedloop";
@@ -33,6 +42,35 @@ struct EcsOptions {
   std::string gains_path;
   std::string config_path;
 };
+
+/// `ecs`'s typed configuration.
+struct EcsOptions {
+  SessionSettings session;
+  bool duration_given = false;
+  EcsMode mode = EcsMode::kClosedLoop;
+  std::string setpoint;  ///< closed loop: a built-in profile's name or a CSV file
+  std::string input;     ///< open loop: a built-in profile's name or a CSV file
+  std::string gains_path;
+  std::string config_path;
+};
+
+/// How the controller's runs name themselves; its default (m,k) rule is judged at its own rate.
+SessionRole EcsRole(double rate_hz) {
+  return {"ecs", "twin", "hiltwin run", rate_hz, "controller"};
+}
+
+/// The flags, read once (exit 2 naming the flag).
+EcsOptions EcsOptionsFrom(const EcsFlags& f) {
+  EcsOptions o;
+  o.session = SessionSettingsFrom(f.session, EcsRole(f.session.rate_hz));
+  o.duration_given = f.duration_given;
+  o.mode = f.mode == "openloop" ? EcsMode::kOpenLoop : EcsMode::kClosedLoop;  // CLI11-checked
+  o.setpoint = f.setpoint;
+  o.input = f.input;
+  o.gains_path = f.gains_path;
+  o.config_path = f.config_path;
+  return o;
+}
 
 /// The controller behind its board, built from the flags; owns everything the task uses.
 struct Ecs {
@@ -50,7 +88,7 @@ void LoadEcsConfiguration(const EcsOptions& o, Ecs& ecs) {
   try {
     if (!o.config_path.empty()) ecs.params = LoadRelbotParams(o.config_path);
     if (!o.gains_path.empty()) ecs.gains = LoadEcsGains(o.gains_path);
-    if (o.mode == "closedloop") {
+    if (o.mode == EcsMode::kClosedLoop) {
       ecs.setpoints.emplace(LoadSetpointProfile(o.setpoint));
       ecs.profile_name = ecs.setpoints->name();
     } else {
@@ -90,10 +128,10 @@ void PrintStartLines(const EcsOptions& o, std::uint64_t planned, const std::stri
   std::fprintf(stdout,
                "hiltwin ecs: RELbot controller (%s, %s) at %.0f Hz for %.3f s (%llu cycles), "
                "io %s, %s clock\n",
-               o.mode.c_str(), profile.c_str(), o.session.rate_hz, o.session.duration_s,
-               static_cast<unsigned long long>(planned), o.session.io.c_str(),
-               o.session.clock.c_str());
-  if (o.session.io == "mock") {
+               ToString(o.mode), profile.c_str(), o.session.rate_hz, o.session.duration_s,
+               static_cast<unsigned long long>(planned), o.session.io_text.c_str(),
+               runtime::ToString(o.session.clock));
+  if (o.session.io.kind == io::BackendSpec::Kind::kMock) {
     std::fprintf(stdout,
                  "note: the mock board has no plant behind it, so the encoders stay at 0; drive "
                  "the twin with --io wire:NAME and `hiltwin run --io wire:NAME`, or use `hiltwin "
@@ -105,21 +143,18 @@ void PrintStartLines(const EcsOptions& o, std::uint64_t planned, const std::stri
 }
 
 int RunEcs(EcsOptions o) {
-  const kernel_glue::TimeNs period_ns = [&] {
-    ValidateSessionOptions(o.session);  // the rate first: the period depends on it
-    return kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
-  }();
+  const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   kernel_glue::InstallStopSignalHandlers();  // before any output exists: as `run` does
   ReportFile report_file(o.session.report_path);
   const std::unique_ptr<Ecs> ecs = BuildEcs(o, period_ns);
   // By default the run lasts as long as its profile: the setpoints end settled.
   if (!o.duration_given) o.session.duration_s = ecs->task->length_s();
-  ValidateSessionOptions(o.session);
+  ValidateSessionSettings(o.session);
   const std::uint64_t planned = PlannedCycles(o.session);
-  const SessionRole role{"ecs", "twin", "hiltwin run", o.session.rate_hz, "controller"};
+  const SessionRole role = EcsRole(o.session.rate_hz);
   runtime::SessionConfig config = MakeSessionConfig(o.session, role, *ecs->backend);
   config.task_name = "RELbot ECS";
-  config.details = {{"mode", o.mode}, {"profile", ecs->profile_name}};
+  config.details = {{"mode", ToString(o.mode)}, {"profile", ecs->profile_name}};
   config.on_ready = [o, planned, profile = ecs->profile_name](
                         const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, profile, rt);
@@ -133,7 +168,7 @@ int RunEcs(EcsOptions o) {
 }
 
 Command AddEcsCommand(CLI::App& parent) {
-  auto o = std::make_shared<EcsOptions>();
+  auto o = std::make_shared<EcsFlags>();
   o->session.rate_hz = 1000.0;
   CLI::App* app = parent.add_subcommand(
       "ecs",
@@ -145,7 +180,7 @@ Command AddEcsCommand(CLI::App& parent) {
       "or the robot (--io spidev:/dev/spidev0.0). Default (m,k) rule: (1,2), never two misses\n"
       "in a row. Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 internal.\n"
       "SIGINT/SIGTERM stop it cleanly, SIGUSR1 pauses (zero duty), SIGUSR2 resumes.");
-  AddSessionOptions(*app, o->session);
+  AddSessionFlags(*app, o->session);
   app->get_option("--duration")
       ->description("run length in seconds (default: the profile's length)")
       ->each([o](const std::string&) { o->duration_given = true; });
@@ -159,10 +194,10 @@ Command AddEcsCommand(CLI::App& parent) {
                   "open loop: built-in openloop, or a CSV duty file time,left,right")
       ->capture_default_str();
   app->add_option("--gains", o->gains_path,
-                  "PID gains and limits (TOML, see app_relbot/ecs_gains.toml; default: built in)");
+                  "PID gains and limits (TOML, see relbot/ecs_gains.toml; default: built in)");
   app->add_option("--config", o->config_path,
-                  "RELbot parameter file for the wheel geometry (TOML, app_relbot/relbot.toml)");
-  return {app, [o] { return RunEcs(*o); }};
+                  "RELbot parameter file for the wheel geometry (TOML, relbot/relbot.toml)");
+  return {app, [o] { return RunEcs(EcsOptionsFrom(*o)); }};
 }
 
 }  // namespace

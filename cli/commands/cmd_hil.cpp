@@ -20,12 +20,13 @@
 #include "commands.h"
 #include "hiltwin/runs/hil_report.h"
 #include "hiltwin/relbot/input_profile.h"
-#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/process.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/scheduler/executive.h"
+#include "session_flags.h"
 
 namespace hiltwin::app {
 namespace {
@@ -325,8 +326,9 @@ Command AddHilCommand(CLI::App& parent) {
   auto o = std::make_shared<HilOptions>();
   CLI::App* app = parent.add_subcommand(
       "hil",
-      "Closed-loop HiL on one machine: the twin (`hiltwin run`) and the controller (`hiltwin\n"
-      "ecs`) as two processes on a fresh wire, one combined summary and report.\n"
+      "Closed-loop HiL on one machine: twin and controller as two processes on one wire.\n"
+      "The twin (`hiltwin run`) and the controller (`hiltwin ecs`) run on a fresh wire; one\n"
+      "combined summary and report.\n"
       "The twin runs 2 s longer than the ECS, so the ECS's finish ends the pair. Exit: the worse\n"
       "of the two sides' codes (0 < 3 FLAGGED < 4 ABORTED < 5 I/O < 2 bad input < 1 internal).");
   app->add_option("--twin-rate", o->twin_rate_hz, "twin update rate in Hz")->capture_default_str();
@@ -340,7 +342,7 @@ Command AddHilCommand(CLI::App& parent) {
       ->capture_default_str();
   app->add_option("--input", o->input, "open loop: openloop or CSV time,left,right")
       ->capture_default_str();
-  app->add_option("--gains", o->gains_path, "PID gains (TOML, app_relbot/ecs_gains.toml)");
+  app->add_option("--gains", o->gains_path, "PID gains (TOML, relbot/ecs_gains.toml)");
   app->add_option("--config", o->config_path, "RELbot parameters (TOML), for both sides");
   app->add_option("--twin-qos", o->twin_qos, "twin (m,k) rule M:K (repeatable)");
   app->add_option("--ecs-qos", o->ecs_qos, "controller (m,k) rule M:K (repeatable)");
@@ -360,7 +362,7 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--wait-peer", o->wait_peer_s, "how long each side waits for the other, s")
       ->capture_default_str();
   app->add_flag("--no-progress", o->no_progress, "no progress line on the terminal");
-  AddTelemetryOptions(*app, o->telemetry);
+  AddTelemetryFlags(*app, o->telemetry);
   return {app, [o] { return RunHil(*o); }};
 }
 

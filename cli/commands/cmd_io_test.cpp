@@ -31,7 +31,8 @@
 namespace hiltwin::app {
 namespace {
 
-struct IoTestOptions {
+/// io-test's flags as the command line gave them.
+struct IoTestFlags {
   std::string io = "mock";
   std::string image = "icoboard_inverse";
   std::string board_image;
@@ -39,6 +40,20 @@ struct IoTestOptions {
   double rate_hz = 1000.0;
   double wait_peer_s = 0.0;
   std::string inject_fault;
+  bool json = false;
+};
+
+/// io-test's typed configuration: the flags read once (IoTestOptionsFrom).
+struct IoTestOptions {
+  io::BackendSpec io;
+  std::string io_text = "mock";  ///< --io as given: for messages and the summary
+  io::Image image = io::Image::kIcoboardInverse;  ///< the image this side's driver needs
+  std::optional<io::Image> board_image;  ///< mock: the image its board carries (default: image)
+  std::int64_t frames = 1000;
+  double rate_hz = 1000.0;
+  double wait_peer_s = 0.0;
+  std::optional<io::LinkFault> fault;  ///< --inject-fault (mock only)
+  std::string fault_text;              ///< --inject-fault as given, for the failure's message
   bool json = false;
 };
 
@@ -147,7 +162,7 @@ const char* SideName(io::Image image) { return image == io::Image::kIcoboard ? "
 
 /// The way out when the other side of a wire is missing: the command that starts it.
 std::string NoPeerAdvice(const IoTestOptions& options, io::Image image, bool waited) {
-  return std::string("start the other side first, e.g. `hiltwin io-test --io ") + options.io +
+  return std::string("start the other side first, e.g. `hiltwin io-test --io ") + options.io_text +
          " --image " + io::ToString(io::Counterpart(image)) + " --frames 100000` in another " +
          "terminal, " +
          (waited ? "or wait longer with a larger --wait-peer"
@@ -168,7 +183,7 @@ void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image
       char seconds[32];
       std::snprintf(seconds, sizeof seconds, "%g", options.wait_peer_s);
       throw CommandError(ExitCode::kIo, std::string("no ") + SideName(io::Counterpart(image)) +
-                                            " process attached to " + options.io + " within " +
+                                            " process attached to " + options.io_text + " within " +
                                             seconds + " s (--wait-peer); " +
                                             NoPeerAdvice(options, image, true));
     }
@@ -176,36 +191,36 @@ void WaitForPeer(io::IoBackend& backend, const IoTestOptions& options, io::Image
   }
 }
 
-/// Checks the flags against the backend kind (exit 2 for usage); returns the kind.
-io::BackendSpec::Kind CheckBackendFlags(const IoTestOptions& options) {
+/// --io, and the flags checked against its kind (exit 2 for usage).
+io::BackendSpec IoTestBackendOf(const IoTestFlags& f) {
   io::BackendSpec spec;
   try {
-    spec = io::ParseBackendSpec(options.io);
+    spec = io::ParseBackendSpec(f.io);
   } catch (const io::ConfigError& e) {
     throw CommandError(ExitCode::kUsage, std::string("--io: ") + e.what());
   }
   const bool mock = spec.kind == io::BackendSpec::Kind::kMock;
-  if (!options.board_image.empty() && !mock) {
+  if (!f.board_image.empty() && !mock) {
     const bool rtl = spec.kind == io::BackendSpec::Kind::kVerilated;
     throw CommandError(ExitCode::kUsage,
-                       "--board-image " + options.board_image + " only applies to --io mock; " +
+                       "--board-image " + f.board_image + " only applies to --io mock; " +
                            (rtl ? "the RTL board's image is chosen with --io verilated:IMAGE "
                                   "(icoboard or icoboard_inverse)"
                                 : "a wired or real board carries its own image (drop "
                                   "--board-image)"));
   }
-  if (options.wait_peer_s > 0.0 && spec.kind != io::BackendSpec::Kind::kWire) {
+  if (f.wait_peer_s > 0.0 && spec.kind != io::BackendSpec::Kind::kWire) {
     throw CommandError(ExitCode::kUsage,
                        "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a "
                        "real board's peer cannot be seen from here (drop --wait-peer)");
   }
-  if (!options.inject_fault.empty() && !mock) {
+  if (!f.inject_fault.empty() && !mock) {
     throw CommandError(
         ExitCode::kUsage,
         "--inject-fault only applies to --io mock, whose boards run in this process; "
         "a wired or real board cannot be made to fail from here (drop --inject-fault)");
   }
-  return spec.kind;
+  return spec;
 }
 
 /// Opens a wire or spidev backend (exit 2 for usage, 5 for I/O).
@@ -215,9 +230,9 @@ std::unique_ptr<io::IoBackend> OpenIoTestBackend(const IoTestOptions& options, i
   try {
     return io::OpenBackend(options.io, backend_options);
   } catch (const io::ConfigError& e) {
-    throw CommandError(ExitCode::kUsage, std::string("--io ") + options.io + ": " + e.what());
+    throw CommandError(ExitCode::kUsage, std::string("--io ") + options.io_text + ": " + e.what());
   } catch (const std::exception& e) {
-    throw CommandError(ExitCode::kIo, std::string(e.what()) + " (--io " + options.io + ")");
+    throw CommandError(ExitCode::kIo, std::string(e.what()) + " (--io " + options.io_text + ")");
   }
 }
 
@@ -343,8 +358,7 @@ const char* RunPairSteps(io::BoardPairCheck& pair, std::int64_t frames, Summary&
 /// Over mock: both boards and drivers in this process; `image` says whose counters lead.
 IoTestOutcome RunMock(const IoTestOptions& options, io::Image image, std::int64_t period_ns,
                       const io::LinkFault& fault) {
-  const io::Image board_image =
-      options.board_image.empty() ? image : *io::ParseImage(options.board_image);
+  const io::Image board_image = options.board_image.value_or(image);
   const bool twin_side = image == io::Image::kIcoboardInverse;
   auto pair =
       std::make_unique<io::BoardPairCheck>(twin_side ? board_image : io::Image::kIcoboardInverse,
@@ -445,7 +459,7 @@ void AddMockJson(nlohmann::json& j, const IoTestOptions& options, const MockFigu
   j["encoder_wraps_up"] = t.wraps_up;
   j["encoder_wraps_down"] = t.wraps_down;
   nlohmann::json other;
-  other["image"] = io::ToString(io::Counterpart(*io::ParseImage(options.image)));
+  other["image"] = io::ToString(io::Counterpart(options.image));
   other["board_identity"] = m.counterpart_identity;
   AddCounters(other, m.counterpart);
   j["counterpart"] = other;
@@ -453,8 +467,8 @@ void AddMockJson(nlohmann::json& j, const IoTestOptions& options, const MockFigu
 
 void PrintJson(const IoTestOptions& options, const IoTestOutcome& o) {
   nlohmann::json j;
-  j["backend"] = options.io;
-  j["image"] = options.image;
+  j["backend"] = options.io_text;
+  j["image"] = io::ToString(options.image);
   j["board_identity"] = o.init.identity;
   j["rate_hz"] = options.rate_hz;
   AddCounters(j, o.counters);
@@ -486,7 +500,7 @@ void PrintMockText(const IoTestOptions& options, const MockFigures& m, std::uint
   std::printf(
       "  other side        %s (identity %u): %llu of %llu data frames received, %llu "
       "corrupted, %llu missed\n",
-      io::ToString(io::Counterpart(*io::ParseImage(options.image))),
+      io::ToString(io::Counterpart(options.image)),
       static_cast<unsigned>(m.counterpart_identity), static_cast<ull>(c.frames_received),
       static_cast<ull>(c.frames_sent), static_cast<ull>(c.frames_corrupted),
       static_cast<ull>(c.frames_missed));
@@ -504,9 +518,10 @@ void PrintMockText(const IoTestOptions& options, const MockFigures& m, std::uint
 }
 
 void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
-  std::printf("io-test over %s%s, image %s (board identity %u), %.0f Hz\n", options.io.c_str(),
+  std::printf("io-test over %s%s, image %s (board identity %u), %.0f Hz\n",
+              options.io_text.c_str(),
               o.mock ? " (twin and ECS boards in this process, unpaced)" : "",
-              options.image.c_str(), static_cast<unsigned>(o.init.identity), options.rate_hz);
+              io::ToString(options.image), static_cast<unsigned>(o.init.identity), options.rate_hz);
   const io::LinkCounters& c = o.counters;
   PrintFrameLine("frames sent", c.frames_sent, c.init_frames_sent, c.test_frames_sent);
   PrintFrameLine("frames received", c.frames_received, c.init_frames_received,
@@ -551,10 +566,10 @@ std::string MockFailure(const IoTestOptions& options, const MockFigures& m) {
   } else {
     what = "the link had errors (see the summary above)";
   }
-  return what + (options.inject_fault.empty()
+  return what + (!options.fault
                      ? "; on a mock link no wire can fail, so this is a bug in the board model or "
                        "the drivers: report it with this output"
-                     : "; this is what --inject-fault " + options.inject_fault + " should cause");
+                     : "; this is what --inject-fault " + options.fault_text + " should cause");
 }
 
 /// Exit 5 with what went wrong and the way out; returns when the test passed.
@@ -562,14 +577,14 @@ void ThrowUnlessPassed(const IoTestOptions& options, io::Image image, const IoTe
   const Summary& summary = o.summary;
   if (summary.fault != nullptr) {
     throw CommandError(ExitCode::kIo,
-                       std::string("link fault on ") + options.io + ": " + summary.fault);
+                       std::string("link fault on ") + options.io_text + ": " + summary.fault);
   }
   if (summary.frames_peer_absent > 0) {
     const std::string other = SideName(io::Counterpart(image));
     const std::string what = summary.frames_peer_absent == summary.frames
-                                 ? "no " + other + " process was attached to " + options.io +
+                                 ? "no " + other + " process was attached to " + options.io_text +
                                        " during the whole run, so " + "nothing crossed the wire"
-                                 : "no " + other + " process was attached to " + options.io +
+                                 : "no " + other + " process was attached to " + options.io_text +
                                        " for " + std::to_string(summary.frames_peer_absent) +
                                        " of " + std::to_string(summary.frames) +
                                        " frames, which tested nothing";
@@ -585,16 +600,29 @@ void ThrowUnlessPassed(const IoTestOptions& options, io::Image image, const IoTe
                      "checked)");
 }
 
+/// The flags, read once, in the order they are checked (exit 2 naming the flag).
+IoTestOptions IoTestOptionsFrom(const IoTestFlags& f) {
+  IoTestOptions o;
+  o.image = io::ParseImage(f.image).value_or(io::Image::kIcoboardInverse);  // CLI11-checked
+  o.io = IoTestBackendOf(f);
+  o.io_text = f.io;
+  if (!f.board_image.empty()) o.board_image = io::ParseImage(f.board_image);  // CLI11-checked
+  o.frames = f.frames;
+  o.rate_hz = f.rate_hz;
+  o.wait_peer_s = f.wait_peer_s;
+  if (!f.inject_fault.empty()) o.fault = ParseLinkFault(f.inject_fault, f.frames);
+  o.fault_text = f.inject_fault;
+  o.json = f.json;
+  return o;
+}
+
 int RunIoTest(const IoTestOptions& options) {
-  const io::Image image = *io::ParseImage(options.image);
-  const bool mock = CheckBackendFlags(options) == io::BackendSpec::Kind::kMock;
-  const io::LinkFault fault = options.inject_fault.empty()
-                                  ? io::LinkFault{}
-                                  : ParseLinkFault(options.inject_fault, options.frames);
+  const io::Image image = options.image;
+  const bool mock = options.io.kind == io::BackendSpec::Kind::kMock;
   const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(options.rate_hz);
   IoTestOutcome outcome;
   if (mock) {
-    outcome = RunMock(options, image, period_ns, fault);
+    outcome = RunMock(options, image, period_ns, options.fault.value_or(io::LinkFault{}));
   } else {
     const std::unique_ptr<io::IoBackend> backend = OpenIoTestBackend(options, image);
     if (options.wait_peer_s > 0.0) WaitForPeer(*backend, options, image);
@@ -609,7 +637,7 @@ int RunIoTest(const IoTestOptions& options) {
   return static_cast<int>(ExitCode::kPass);
 }
 
-void AddIoTestOptions(CLI::App* app, IoTestOptions& options) {
+void AddIoTestFlags(CLI::App* app, IoTestFlags& options) {
   app->add_option("--io", options.io, std::string("backend: ") + io::kBackendForms)
       ->capture_default_str();
   app->add_option("--image", options.image,
@@ -646,23 +674,22 @@ void AddIoTestOptions(CLI::App* app, IoTestOptions& options) {
 }
 
 Command AddIoTestCommand(CLI::App& parent) {
-  auto options = std::make_shared<IoTestOptions>();
+  auto flags = std::make_shared<IoTestFlags>();
   CLI::App* app = parent.add_subcommand(
       "io-test", "Bring-up test of the FPGA link: INIT, identity check, N frames, errors counted");
   app->description(
-      "Bring-up test of the FPGA link: sends INIT (with the step size from --rate), checks the\n"
-      "board's identity (icoboard = ECS image, icoboard_inverse = twin image), then N data frames\n"
-      "with a known pattern (a TEST loop-back after every 3rd) and prints frames sent/received/\n"
-      "corrupted/missed (data, INIT and TEST apart) and count errors. Over mock both boards run\n"
-      "here, joined by their wires, unpaced: the ECS must decode the twin's encoder pattern edge\n"
-      "by edge and the twin read the ECS's PWM, counted as messages sent/received/missed (thesis\n"
-      "Table 5.2: --frames 720000). Over wire:NAME or spidev the other side must run io-test too:\n"
-      "its pattern is checked on arrival. Exit 0 only without errors; 5 on an I/O error, the "
-      "wrong\n"
-      "image, a lost message or a wire with no peer; 2 on bad usage. Frames: "
-      "docs/spi-protocol.md.");
-  AddIoTestOptions(app, *options);
-  return Command{app, [options] { return RunIoTest(*options); }};
+      "Bring-up test of the FPGA link: INIT, identity check, N frames, errors counted.\n"
+      "Sends INIT (with the step size from --rate), checks the board's identity (icoboard = ECS\n"
+      "image, icoboard_inverse = twin image), then N data frames with a known pattern (a TEST\n"
+      "loop-back after every 3rd) and prints frames sent/received/corrupted/missed (data, INIT\n"
+      "and TEST apart) and count errors. Over mock both boards run here, joined by their wires,\n"
+      "unpaced: the ECS must decode the twin's encoder pattern edge by edge and the twin read the\n"
+      "ECS's PWM, counted as messages sent/received/missed (thesis Table 5.2: --frames 720000).\n"
+      "Over wire:NAME or spidev the other side must run io-test too: its pattern is checked on\n"
+      "arrival. Exit 0 only without errors; 5 on an I/O error, the wrong image, a lost message or\n"
+      "a wire with no peer; 2 on bad usage. Frames: docs/spi-protocol.md.");
+  AddIoTestFlags(app, *flags);
+  return Command{app, [flags] { return RunIoTest(IoTestOptionsFrom(*flags)); }};
 }
 
 }  // namespace

@@ -1,25 +1,26 @@
 // `hiltwin run`: the RELbot twin in real time (or on the virtual clock) behind the FPGA link,
-// with a QoS verdict, a JSON run report and an optional CSV log (DESIGN.md "Contracts").
+// with a QoS verdict, a JSON run report and an optional CSV log (docs/architecture.md, "Contracts").
 #include <memory>
 
 #include "commands.h"
 #include "hiltwin/runs/twin_run.h"
+#include "session_flags.h"
 
 namespace hiltwin::app {
 namespace {
 
 Command AddRunCommand(CLI::App& parent) {
-  auto o = std::make_shared<TwinRunOptions>();
+  auto flags = std::make_shared<TwinRunFlags>();
   CLI::App* app = parent.add_subcommand(
       "run",
-      "Run the RELbot twin with a QoS verdict.\n"
+      "Run a twin with a QoS verdict: the RELbot, or any plant with --plant.\n"
       "The twin runs at --rate behind the FPGA link (--io) and is driven by --input played into\n"
       "the emulated board's PWM reader at --input-rate (mock) or by a controller (wire/spidev).\n"
       "Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault/internal.\n"
       "While it runs: SIGINT/SIGTERM stop it cleanly (report and log written), SIGUSR1 pauses\n"
       "(link kept, safe outputs, model frozen, not judged) and SIGUSR2 resumes.");
-  AddTwinRunOptions(*app, *o);
-  return {app, [o] { return RunTwin(*o).exit_code; }};
+  AddTwinRunFlags(*app, *flags);
+  return {app, [flags] { return RunTwin(TwinRunOptionsFrom(*flags, "run")).exit_code; }};
 }
 
 }  // namespace

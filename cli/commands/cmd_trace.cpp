@@ -1,11 +1,13 @@
 // `hiltwin trace`: record the twin's run with LTTng (and the kernel's scheduler events with
 // --kernel) and write a jitter report that names the cause of each late cycle; or analyse a
-// recording or timing log made earlier (--analyze). Flags -> TraceOptions -> trace_run.h.
+// recording or timing log made earlier (--analyze). Flags -> TraceOptions -> trace_run.h; the
+// run's flags are read only for a run (--analyze refuses them unread).
 #include <memory>
 #include <string>
 
 #include "commands.h"
 #include "hiltwin/runs/trace_run.h"
+#include "session_flags.h"
 
 namespace hiltwin::app {
 namespace {
@@ -28,10 +30,11 @@ void RefuseRunFlagsWithAnalyze(const CLI::App& app) {
 
 Command AddTraceCommand(CLI::App& parent) {
   auto o = std::make_shared<TraceOptions>();
+  auto run_flags = std::make_shared<TwinRunFlags>();
   CLI::App* app = parent.add_subcommand(
       "trace",
-      "Run the RELbot twin exactly as 'hiltwin run' does, inside an LTTng recording, and write a\n"
-      "jitter report into --output DIR: wake-up latency, period jitter, compute and response\n"
+      "Run a twin as 'hiltwin run' does, inside an LTTng recording, and report its jitter.\n"
+      "The jitter report goes into --output DIR: wake-up latency, period jitter, compute and response\n"
       "time (histograms, percentiles), misses and how they cluster, the 10 worst cycles, pictures\n"
       "(PNG, one HTML page) and a Perfetto trace (ui.perfetto.dev opens DIR/perfetto_trace.json).\n"
       "--kernel also records the kernel's scheduler and interrupt events and names the cause of\n"
@@ -41,7 +44,7 @@ Command AddTraceCommand(CLI::App& parent) {
       "Needs an lttng-sessiond (started when none runs and you are root or in group 'tracing').\n"
       "Exit: as 'hiltwin run' (0 PASS, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault), 2 bad\n"
       "input, 5 when tracing is not possible here or the trace could not be read.");
-  AddTwinRunOptions(*app, o->run);
+  AddTwinRunFlags(*app, *run_flags);
   app->add_option("--output", o->output_dir,
                   "folder for the trace and the report (new or empty; with --analyze: where the "
                   "report goes, default the trace folder or FILE.jitter/)");
@@ -54,13 +57,14 @@ Command AddTraceCommand(CLI::App& parent) {
                   "with --analyze: report on this process of a trace holding several (default: "
                   "the first to start its loop)")
       ->check(CLI::PositiveNumber);
-  return {app, [o, app] {
+  return {app, [o, run_flags, app] {
             if (o->analyze_path.empty()) {
               if (o->analyze_pid != 0) {
                 throw CommandError(ExitCode::kUsage,
                                    "--pid goes with --analyze: a recording made by trace keeps "
                                    "only its own process");
               }
+              o->run = TwinRunOptionsFrom(*run_flags, "trace");
               return TraceTwin(*o);
             }
             RefuseRunFlagsWithAnalyze(*app);

@@ -1,6 +1,6 @@
 // `hiltwin tune`: measure this machine, recommend the twin's update rate (thesis §3.8.2,
 // method 2) and validate it with runs like thesis Table 5.1 (docs/tuning.md). Thin: flags ->
-// TuneOptions -> RunTune -> one TuneReport -> text, JSON, plot.
+// TuneOptions (typed, read once) -> RunTune -> one TuneReport -> text, JSON, plot.
 #include <unistd.h>
 
 #include <cerrno>
@@ -14,14 +14,16 @@
 
 #include "hiltwin/tuning/tuning_report.h"
 #include "commands.h"
-#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/tune.h"
+#include "session_flags.h"
 
 namespace hiltwin::app {
 namespace {
 
 struct TuneCommandOptions {
-  TuneOptions tune;
+  TuneOptions tune;  ///< every flag but --clock, whose text is read in RunTuneCommand
+  std::string clock = "realtime";
   bool json = false;
   std::string report_path;
   std::string plot_path;
@@ -75,7 +77,9 @@ void WriteReportFile(const std::string& path, const analysis::TuneReport& report
   }
 }
 
-int RunTuneCommand(const TuneCommandOptions& o) {
+int RunTuneCommand(const TuneCommandOptions& flags) {
+  TuneCommandOptions o = flags;
+  o.tune.clock = ClockKindOf(flags.clock);
   CheckTuneOptions(o.tune);
   CheckOutputPath(o.report_path, "--report");
   CheckOutputPath(o.plot_path, "--plot");
@@ -143,7 +147,7 @@ void AddTuneFlags(CLI::App& app, TuneCommandOptions& o) {
   app.add_option("--latency-seconds", t.latency_seconds,
                  "real clock: length of the wake-up latency run at each candidate")
       ->capture_default_str();
-  app.add_option("--clock", t.clock,
+  app.add_option("--clock", o.clock,
                  "realtime, or virtual: validation in virtual time with the measured (or "
                  "injected) costs charged to every cycle")
       ->check(CLI::IsMember({"realtime", "virtual"}))

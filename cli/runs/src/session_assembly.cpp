@@ -1,4 +1,5 @@
-#include "hiltwin/runs/session_options.h"
+// The session assembly (session_assembly.h): typed settings -> board -> SessionConfig -> run.
+#include "hiltwin/runs/session_assembly.h"
 
 #include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"
@@ -12,7 +13,6 @@
 #include <cstring>
 #include <utility>
 
-#include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/scheduler/executive.h"
 #include "hiltwin/tracing/csv_logger.h"
@@ -20,41 +20,28 @@
 namespace hiltwin::app {
 namespace {
 
-qos::QosConfig MakeQosConfig(const SessionOptions& o, const SessionRole& role,
+/// The monitor's configuration: the parsed rules, checked against this run's length.
+qos::QosConfig MakeQosConfig(const SessionSettings& s, const SessionRole& role,
                              std::uint64_t planned_cycles) {
   qos::QosConfig config;
   config.planned_cycles = planned_cycles;
-  config.grace_cycles = o.grace_cycles;
+  config.grace_cycles = s.grace_cycles;
+  config.policy = s.on_violation;
+  config.rules = s.qos_rules;
   try {
-    config.policy = qos::ParseViolationPolicy(o.on_violation);
-    // Exactly 0 switches the ratio rule off; anything else (negative, NaN) is validated.
-    if (o.max_miss_pct != 0.0) config.rules.push_back(qos::MakeMissRatioRule(o.max_miss_pct));
-    if (o.mk_rules.empty()) {
-      // The documented default (m,k) rule for this rate pair (docs/qos.md).
-      for (const qos::RuleSpec& rule : qos::DefaultRulesFor(o.rate_hz, role.other_rate_hz)) {
-        if (rule.kind == qos::RuleKind::kMkFirm) config.rules.push_back(rule);
-      }
-    }
-    for (const std::string& text : o.mk_rules) config.rules.push_back(qos::ParseMkRule(text));
-    for (const std::string& text : o.window_rules) {
-      config.rules.push_back(qos::ParseMissesInWindowRule(text));
-    }
-    if (o.max_consecutive_misses) {
-      config.rules.push_back(qos::MakeConsecutiveMissesRule(*o.max_consecutive_misses));
-    }
     qos::Validate(config);
   } catch (const std::invalid_argument& e) {
     ThrowUsage(std::string("QoS rules: ") + e.what() + " (see 'hiltwin " + role.command +
-          " --help' and docs/qos.md)");
+               " --help' and docs/qos.md)");
   }
   return config;
 }
 
-runtime::OverrunInjector MakeInjector(const SessionOptions& o, std::uint64_t planned) {
+/// The parsed injections, checked against this run's length: one that never fires is refused.
+runtime::OverrunInjector MakeInjector(const SessionSettings& s, std::uint64_t planned) {
   runtime::OverrunInjector injector;
   try {
-    for (const std::string& spec : o.inject_overrun)
-      injector.Add(runtime::ParseOverrunInjection(spec));
+    for (const runtime::OverrunInjection& injection : s.overrun_injections) injector.Add(injection);
     injector.CheckFiresWithin(planned);
   } catch (const std::exception& e) {  // invalid_argument, length_error: both the user's input
     ThrowUsage(std::string("--inject-overrun ") + e.what());
@@ -92,170 +79,63 @@ std::string Num(double value) {
   return text;
 }
 
-void AddSessionOptions(CLI::App& app, SessionOptions& o) {
-  app.add_option("--rate", o.rate_hz, "update rate in Hz (1 .. 50000)")->capture_default_str();
-  app.add_option("--duration", o.duration_s, "run length in seconds")->capture_default_str();
-  app.add_option("--io", o.io, "FPGA link: mock | wire:NAME | spidev:/dev/spidevB.C | verilated")
-      ->capture_default_str();
-  app.add_option("--qos", o.mk_rules,
-                 "(m,k)-firm rule M:K: at least M deadlines met in any K cycles (repeatable; "
-                 "replaces the default (m,k) rule)");
-  app.add_option("--max-misses", o.window_rules,
-                 "rule N:K: at most N misses in any K cycles (repeatable)");
-  app.add_option("--max-consecutive-misses", o.max_consecutive_misses,
-                 "rule: at most N consecutive misses");
-  app.add_option("--max-miss-pct", o.max_miss_pct,
-                 "rule: overall miss ratio below P percent (0: off)")
-      ->capture_default_str();
-  app.add_option("--grace-cycles", o.grace_cycles,
-                 "ignore the first N cycles (start-up); fewer than the run's cycles")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--on-violation", o.on_violation,
-                 "flag: finish and mark unreliable (exit 3); abort: stop at once (exit 4)")
-      ->check(CLI::IsMember({"flag", "abort"}))
-      ->capture_default_str();
-  app.add_option("--clock", o.clock, "realtime, or virtual: the identical loop as fast as possible")
-      ->check(CLI::IsMember({"realtime", "virtual"}))
-      ->capture_default_str();
-  app.add_option("--overrun-policy", o.overrun_policy,
-                 "after an overrun: catch-up (run skipped steps back to back) or skip (count them "
-                 "as misses)")
-      ->check(CLI::IsMember({"catch-up", "skip"}))
-      ->capture_default_str();
-  app.add_option("--deadline-us", o.deadline_us, "deadline in microseconds (0: the period)")
-      ->capture_default_str();
-  app.add_option("--log", o.log_path, "write a CSV log (20-sim DataFromFile / MATLAB readable)");
-  app.add_option("--log-decimation", o.log_decimation, "log every Nth cycle")
-      ->capture_default_str();
-  app.add_option("--timing-log", o.timing_log_path,
-                 "write every cycle's time stamps to this file (no LTTng needed); analyse it "
-                 "with 'hiltwin trace --analyze FILE'");
-  app.add_option("--report", o.report_path, "write the JSON run report to this file");
-  app.add_option("--inject-overrun", o.inject_overrun,
-                 "add compute time to chosen cycles, e.g. at=20000,count=5,extra-us=600 or "
-                 "every=1000,extra-us=300 (repeatable)");
-  app.add_option("--priority", o.priority, "SCHED_FIFO priority of the loop (0: none)")
-      ->capture_default_str();
-  app.add_option("--cpu", o.cpus, "pin the loop to these CPUs");
-  app.add_flag("--no-progress", o.no_progress, "no progress line on the terminal");
-  app.add_option("--wait-peer", o.wait_peer_s,
-                 "wire only: wait in ready up to SECONDS for the other process (countdown on "
-                 "stderr; exit 5 if it never comes); 0: start at once")
-      ->capture_default_str();
-  app.add_option("--board-image", o.board_image,
-                 "fault injection (mock and wire): the FPGA image the emulated board carries, "
-                 "icoboard or icoboard_inverse; the wrong one stops at INIT with exit 5")
-      ->check(CLI::IsMember({"icoboard", "icoboard_inverse"}));
-  AddTelemetryOptions(app, o.telemetry);
-}
-
-void AddTelemetryOptions(CLI::App& app, telemetry::TelemetryOptions& t) {
-  app.add_option("--telemetry", t.specs,
-                 "live telemetry out of the loop (repeatable): dds[:DOMAIN] publishes ROS 2 "
-                 "topics rt/NS/{pose,joint_states,timing} and takes commands on rt/NS/command; "
-                 "udp[:HOST:PORT] streams JSON to PlotJuggler (default 127.0.0.1:9870)");
-  app.add_option("--namespace", t.ns,
-                 "telemetry namespace NS, one per task on a network (default: twin for run, "
-                 "controller for ecs; hil publishes its sides under NS/twin and NS/controller, "
-                 "default hil)");
-  app.add_option("--web", t.web,
-                 "serve a live page (pose, trail, wheels, timing) at ADDR:PORT (bare --web: "
-                 "127.0.0.1:8080)")
-      ->expected(0, 1)
-      ->default_str("127.0.0.1:8080");
-  app.add_option("--telemetry-rate", t.rate_hz, "telemetry records per second (0 < HZ <= 1000)")
-      ->capture_default_str();
-}
-
-void ValidateSessionOptions(const SessionOptions& o) {
-  try {
-    scheduler::ValidateRateHz(o.rate_hz);
-  } catch (const std::invalid_argument& e) {
-    ThrowUsage(std::string("--rate: ") + e.what());
-  }
-  if (!std::isfinite(o.duration_s) || o.duration_s <= 0.0 || o.duration_s > 7 * 86400.0) {
-    ThrowUsage("--duration " + Num(o.duration_s) +
-          ": must be a positive number of seconds, at most 604800 (7 days)");
-  }
-  if (!std::isfinite(o.deadline_us) || o.deadline_us < 0.0 ||
-      o.deadline_us * 1e3 > 1e9 / o.rate_hz) {
-    ThrowUsage("--deadline-us: must be between 0 (= the period) and the period (" +
-          Num(1e6 / o.rate_hz) + " us)");
-  }
-  if (o.log_decimation == 0) ThrowUsage("--log-decimation: must be at least 1");
-  if (o.priority < 0 || o.priority > 99) ThrowUsage("--priority: 0 (no SCHED_FIFO) .. 99");
-  if (!std::isfinite(o.wait_peer_s) || o.wait_peer_s < 0.0 || o.wait_peer_s > 86400.0) {
-    ThrowUsage("--wait-peer " + Num(o.wait_peer_s) + ": must be 0 .. 86400 seconds");
-  }
-}
-
-std::uint64_t PlannedCycles(const SessionOptions& o) {
-  const auto planned = static_cast<std::uint64_t>(std::llround(o.duration_s * o.rate_hz));
+std::uint64_t PlannedCycles(const SessionSettings& s) {
+  const auto planned = static_cast<std::uint64_t>(std::llround(s.duration_s * s.rate_hz));
   if (planned == 0) ThrowUsage("--duration is shorter than one period at --rate");
-  if (o.grace_cycles >= planned) {
+  if (s.grace_cycles >= planned) {
     // A grace period that covers the whole run would judge nothing and always PASS.
-    ThrowUsage("--grace-cycles " + std::to_string(o.grace_cycles) + ": must be below the " +
-          std::to_string(planned) + " cycles of the run; lower it or lengthen --duration");
+    ThrowUsage("--grace-cycles " + std::to_string(s.grace_cycles) + ": must be below the " +
+               std::to_string(planned) + " cycles of the run; lower it or lengthen --duration");
   }
   return planned;
 }
 
-io::BackendOptions BackendOptionsFor(const SessionOptions& o, io::Image side) {
+io::BackendOptions BackendOptionsFor(const SessionSettings& s, io::Image side) {
   io::BackendOptions options;
   options.side = side;
-  if (!o.board_image.empty()) {
-    options.mock_board_image =
-        o.board_image == "icoboard" ? io::Image::kIcoboard : io::Image::kIcoboardInverse;
-  }
+  options.mock_board_image = s.board_image;
   return options;
 }
 
-std::unique_ptr<io::IoBackend> OpenBoard(const SessionOptions& o, io::Image side) {
+std::unique_ptr<io::IoBackend> OpenBoard(const SessionSettings& s, io::Image side) {
   try {
-    return io::OpenBackend(o.io, BackendOptionsFor(o, side));
+    return io::OpenBackend(s.io, BackendOptionsFor(s, side));
   } catch (const io::ConfigError& e) {
     ThrowUsage(std::string("--io: ") + e.what());
   } catch (const std::exception& e) {
-    throw CommandError(ExitCode::kIo, std::string("--io ") + o.io + ": " + e.what());
+    throw CommandError(ExitCode::kIo, std::string("--io ") + s.io_text + ": " + e.what());
   }
 }
 
-runtime::SessionConfig MakeSessionConfig(const SessionOptions& o, const SessionRole& role,
+runtime::SessionConfig MakeSessionConfig(const SessionSettings& s, const SessionRole& role,
                                          io::IoBackend& backend) {
-  const std::uint64_t planned = PlannedCycles(o);
+  const std::uint64_t planned = PlannedCycles(s);
   runtime::SessionConfig config;
-  config.io = o.io;
+  config.io = s.io_text;
   config.peer_name = role.peer_name;
-  config.clock =
-      o.clock == "virtual" ? runtime::ClockKind::kVirtual : runtime::ClockKind::kRealtime;
-  config.rate_hz = o.rate_hz;
-  config.executive.period_ns = kernel_glue::PeriodNsFromRateHz(o.rate_hz);
-  config.executive.deadline_ns =
-      static_cast<kernel_glue::TimeNs>(std::llround(o.deadline_us * 1e3));
+  config.clock = s.clock;
+  config.rate_hz = s.rate_hz;
+  config.executive.period_ns = kernel_glue::PeriodNsFromRateHz(s.rate_hz);
+  config.executive.deadline_ns = s.deadline_ns;
   config.executive.max_cycles = planned;
-  if (const auto policy = scheduler::ParseOverrunPolicy(o.overrun_policy)) {
-    config.executive.overrun_policy = *policy;
-  } else {
-    ThrowUsage("--overrun-policy '" + o.overrun_policy + "': use 'catch-up' or 'skip'");
-  }
-  config.qos = MakeQosConfig(o, role, planned);
-  config.rt.fifo_priority = o.priority;
-  config.rt.cpus = o.cpus;
-  config.injector = MakeInjector(o, planned);
-  if (!o.log_path.empty()) config.log = runtime::LogConfig{o.log_path, o.log_decimation};
-  config.timing_log_path = o.timing_log_path;
-  config.progress = !o.no_progress && isatty(STDERR_FILENO) == 1;
+  config.executive.overrun_policy = s.overrun_policy;
+  config.qos = MakeQosConfig(s, role, planned);
+  config.rt.fifo_priority = s.priority;
+  config.rt.cpus = s.cpus;
+  config.injector = MakeInjector(s, planned);
+  if (!s.log_path.empty()) config.log = runtime::LogConfig{s.log_path, s.log_decimation};
+  config.timing_log_path = s.timing_log_path;
+  config.progress = s.progress && isatty(STDERR_FILENO) == 1;
   config.pause_signals = true;  // kill -USR1 pauses, -USR2 resumes (documented in --help)
   if (io::PeerLink* link = backend.peer_link(); link != nullptr) {
-    config.peer =
-        runtime::PeerWait{link, o.wait_peer_s, std::string(role.peer_command) + " --io " + o.io};
-  } else if (o.wait_peer_s != SessionOptions{}.wait_peer_s && o.wait_peer_s != 0.0) {
+    const std::string start_hint = std::string(role.peer_command) + " --io " + s.io_text;
+    config.peer = runtime::PeerWait{link, s.wait_peer_s, start_hint};
+  } else if (s.wait_peer_s != kDefaultWaitPeerS && s.wait_peer_s != 0.0) {
     ThrowUsage(
         "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a real "
         "board's peer cannot be seen from here (drop --wait-peer)");
   }
-  config.telemetry = MakeTelemetry(o.telemetry, role, o.cpus);
+  config.telemetry = MakeTelemetry(s.telemetry, role, s.cpus);
   return config;
 }
 

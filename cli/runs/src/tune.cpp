@@ -1,4 +1,4 @@
-// `hiltwin tune` (tune.h): measure, recommend, validate. The maths is analysis/tuning.h's;
+// `hiltwin tune` (tune.h): measure, recommend, validate. The maths is tuning/tuning.h's;
 // this file measures and runs, always through the shared run assembly and the twin of
 // `hiltwin run` (twin_build.h).
 #include "hiltwin/runs/tune.h"
@@ -13,18 +13,19 @@
 
 #include "hiltwin/runs/command.h"
 #include "hiltwin/relbot/relbot_reference.h"
-#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/trajectory_recorder.h"
 #include "hiltwin/runs/twin_build.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/qos/rules.h"
 #include "hiltwin/scheduler/executive.h"
 #include "tune_measure.h"
 
 namespace hiltwin::app {
 namespace {
 
-bool IsVirtual(const TuneOptions& o) { return o.clock == "virtual"; }
+bool IsVirtual(const TuneOptions& o) { return o.clock == runtime::ClockKind::kVirtual; }
 
 bool AllInjected(const TuneOptions& o) {
   return o.inject_compute_us && o.inject_overhead_us && o.inject_latency_us;
@@ -136,7 +137,7 @@ class TuneProcedure {
 
   analysis::TuneReport Run() {
     analysis::TuneReport report;
-    report.clock = o_.clock;
+    report.clock = runtime::ToString(o_.clock);
     report.validate_seconds = o_.validate_seconds;
     report.policy = policy_;
     Measure(report);
@@ -249,7 +250,7 @@ analysis::CandidateResult TuneProcedure::RunRecorded(double rate_hz, bool virtua
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(t, period_ns);
   runtime::SessionConfig config =
-      MakeSessionConfig(t.session, TuneRole(o_.controller_rate_hz), *twin->backend);
+      MakeSessionConfig(t.session, TwinRole("tune", o_.controller_rate_hz), *twin->backend);
   config.task_name = "RELbot twin";
   config.virtual_costs = std::move(costs);
   TrajectoryRecorder recorder(*twin->task, period_ns, PlannedCycles(t.session));
@@ -279,9 +280,11 @@ TwinRunOptions TwinOptionsFor(const TuneOptions& o, double rate_hz, double secon
   TwinRunOptions t;
   t.session.rate_hz = rate_hz;
   t.session.duration_s = seconds;
-  t.session.clock = virtual_clock ? "virtual" : "realtime";
-  t.session.io = "mock";         // the profile plays into the emulated board, as `run` does
-  t.session.no_progress = true;  // tune draws its own progress bar
+  t.session.clock = virtual_clock ? runtime::ClockKind::kVirtual : runtime::ClockKind::kRealtime;
+  // The profile plays into the emulated board (SessionSettings' default mock), as `run` does;
+  // the rules are `run`'s defaults for this rate pair.
+  t.session.qos_rules = qos::DefaultRulesFor(rate_hz, o.controller_rate_hz);
+  t.session.progress = false;  // tune draws its own progress bar
   t.session.priority = o.priority;
   t.session.cpus = o.cpus;
   t.input = o.input;

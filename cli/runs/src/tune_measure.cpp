@@ -32,10 +32,6 @@ class IdleTask final : public runtime::RunTask {
 
 }  // namespace
 
-SessionRole TuneRole(double controller_rate_hz) {
-  return {"tune", "controller", "hiltwin ecs", controller_rate_hz, "twin"};
-}
-
 StepCost MeasureStepCost(const Twin& twin, double rate_hz) {
   const double step_s = 1.0 / rate_hz;
   RelbotModel model(twin.params, twin.integrator, step_s);
@@ -70,12 +66,12 @@ StepCost InjectedStepCost(kernel_glue::TimeNs ns) { return {ConstantSummary(ns),
 
 double MeasureLoopOverheadNs(const TwinRunOptions& t, double step_mean_ns) {
   TwinRunOptions flat_out = t;
-  flat_out.session.clock = "virtual";
+  flat_out.session.clock = runtime::ClockKind::kVirtual;
   flat_out.session.duration_s = kOverheadCycles / t.session.rate_hz;
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(t.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(flat_out, period_ns);
   runtime::SessionConfig config =
-      MakeSessionConfig(flat_out.session, TuneRole(t.controller_rate_hz), *twin->backend);
+      MakeSessionConfig(flat_out.session, TwinRole("tune", t.controller_rate_hz), *twin->backend);
   const auto start = std::chrono::steady_clock::now();
   const runtime::RunReport report = RunSessionOf(std::move(config), *twin->task);
   const double wall_ns =
@@ -88,7 +84,7 @@ double MeasureLoopOverheadNs(const TwinRunOptions& t, double step_mean_ns) {
 scheduler::TimingSummary MeasureWakeLatency(const TwinRunOptions& t) {
   const std::unique_ptr<io::IoBackend> board = OpenBoard(t.session, io::Image::kIcoboardInverse);
   runtime::SessionConfig config =
-      MakeSessionConfig(t.session, TuneRole(t.controller_rate_hz), *board);
+      MakeSessionConfig(t.session, TwinRole("tune", t.controller_rate_hz), *board);
   config.task_name = "idle loop";
   IdleTask idle;
   return RunSessionOf(std::move(config), idle).latency;

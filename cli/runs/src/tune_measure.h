@@ -1,11 +1,11 @@
 #pragma once
-// Private to app_relbot: the measuring half of `hiltwin tune` (tune.h) and the options every
+// Private to runs: the measuring half of `hiltwin tune` (tune.h) and the typed options every
 // one of its runs is built from.
 
 #include <vector>
 
 #include "hiltwin/tuning/tuning_report.h"
-#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/tune.h"
 #include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runs/twin_run.h"
@@ -18,9 +18,6 @@ namespace hiltwin::app {
 /// controller rate, no progress line (tune draws its own), tune's priority and CPUs.
 [[nodiscard]] TwinRunOptions TwinOptionsFor(const TuneOptions& o, double rate_hz, double seconds,
                                             bool virtual_clock);
-
-/// How tune's runs name themselves in messages.
-[[nodiscard]] SessionRole TuneRole(double controller_rate_hz);
 
 /// The model step's cost: the summary (the run report's percentiles) and every sample in the
 /// order taken, for the virtual clock to replay.

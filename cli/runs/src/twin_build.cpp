@@ -6,7 +6,7 @@
 
 #include "hiltwin/runs/command.h"
 #include "hiltwin/relbot/relbot_plant.h"
-#include "hiltwin/runs/session_options.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/fmi/fmu_plant.h"
 #include "hiltwin/plant/plant_registry.h"
 
@@ -102,7 +102,8 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   const bool profile_drives =
       (kind == io::BackendSpec::Kind::kMock || kind == io::BackendSpec::Kind::kVerilated) &&
       twin->backend->AttachPwmSource(twin->pwm_source.get());
-  twin->input_name = profile_drives ? twin->profile->name() : "the controller on " + o.session.io;
+  twin->input_name =
+      profile_drives ? twin->profile->name() : "the controller on " + o.session.io_text;
   twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
   InitBoard(*twin->driver, period_ns);
   twin->task.emplace(*twin->driver, *twin->plant, std::move(made.bound), step_s, y0);

@@ -1,5 +1,5 @@
-// `hiltwin run` as a function (twin_run.h): flags -> twin -> the shared session assembly ->
-// the run's outcome. cli/cmd_run.cpp and cli/cmd_trace.cpp both call it.
+// `hiltwin run` as a function (twin_run.h): typed options -> twin -> the shared session
+// assembly -> the run's outcome. cli/commands/cmd_run.cpp and trace_run.cpp both call it.
 #include "hiltwin/runs/twin_run.h"
 
 #include <algorithm>
@@ -26,23 +26,14 @@
 namespace hiltwin::app {
 namespace {
 
-void Validate(const TwinRunOptions& o) {
-  ValidateSessionOptions(o.session);
-  if (!std::isfinite(o.controller_rate_hz) || o.controller_rate_hz <= 0.0 ||
-      o.controller_rate_hz > o.session.rate_hz) {
-    ThrowUsage("--input-rate: the controller rate must be positive and not above --rate (" +
-          Num(o.session.rate_hz) + " Hz)");
-  }
-}
-
-void PrintStartLines(const char* command, const SessionOptions& o, std::uint64_t planned,
+void PrintStartLines(const char* command, const SessionSettings& s, std::uint64_t planned,
                      const std::string& plant, const std::string& input,
                      const kernel_glue::RtSetupRecord* rt) {
   std::fprintf(
       stdout,
       "hiltwin %s: %s twin at %.0f Hz for %.3f s (%llu cycles), io %s, input %s, %s clock\n",
-      command, plant.c_str(), o.rate_hz, o.duration_s, static_cast<unsigned long long>(planned),
-      o.io.c_str(), input.c_str(), o.clock.c_str());
+      command, plant.c_str(), s.rate_hz, s.duration_s, static_cast<unsigned long long>(planned),
+      s.io_text.c_str(), input.c_str(), runtime::ToString(s.clock));
   if (rt != nullptr)
     std::fprintf(stdout, "real-time set-up: %s\n", kernel_glue::Summary(*rt).c_str());
   std::fflush(stdout);
@@ -66,17 +57,17 @@ std::vector<std::pair<std::string, std::string>> PlantDetails(const Twin& twin) 
   return details;
 }
 
-/// --inject-link-fault's SPECs, checked against the backend and the run's length (exit 2).
+/// --inject-link-fault's faults, checked against the board and the run's length (exit 2).
 io::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
   io::LinkFaultSchedule schedule;
-  if (o.inject_link_faults.empty()) return schedule;
-  if (o.session.io != "mock" && o.session.io.rfind("wire:", 0) != 0) {
+  if (o.link_faults.empty()) return schedule;
+  const io::BackendSpec::Kind kind = o.session.io.kind;
+  if (kind != io::BackendSpec::Kind::kMock && kind != io::BackendSpec::Kind::kWire) {
     ThrowUsage("--inject-link-fault needs an emulated board (--io mock or wire:NAME), not --io " +
-          o.session.io);
+               o.session.io_text);
   }
   try {
-    for (const std::string& spec : o.inject_link_faults)
-      schedule.Add(io::ParseLinkFaultInjection(spec));
+    for (const io::LinkFaultInjection& fault : o.link_faults) schedule.Add(fault);
     schedule.CheckFiresWithin(PlannedCycles(o.session));
   } catch (const std::exception& e) {
     ThrowUsage(std::string("--inject-link-fault ") + e.what());
@@ -93,23 +84,28 @@ std::string DescribeAll(const io::LinkFaultSchedule& schedule) {
   return text;
 }
 
-/// --input-rate, or its documented default.
-double ControllerRateOf(const TwinRunOptions& o) {
-  return o.controller_rate_hz == 0.0 ? std::min(1000.0, o.session.rate_hz) : o.controller_rate_hz;
-}
-
 }  // namespace
 
-void CheckTwinRunOptions(const TwinRunOptions& o) {
-  TwinRunOptions checked = o;
-  checked.controller_rate_hz = ControllerRateOf(o);
-  Validate(checked);
-  static_cast<void>(LinkFaultsOf(checked));
+SessionRole TwinRole(const char* command, double controller_rate_hz) {
+  return {command, "controller", "hiltwin ecs", controller_rate_hz, "twin"};
 }
 
-TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
-  o.controller_rate_hz = ControllerRateOf(o);
-  Validate(o);
+void ValidateTwinRunNumbers(const TwinRunOptions& o) {
+  ValidateSessionSettings(o.session);
+  if (!std::isfinite(o.controller_rate_hz) || o.controller_rate_hz <= 0.0 ||
+      o.controller_rate_hz > o.session.rate_hz) {
+    ThrowUsage("--input-rate: the controller rate must be positive and not above --rate (" +
+               Num(o.session.rate_hz) + " Hz)");
+  }
+}
+
+void CheckTwinRunOptions(const TwinRunOptions& o) {
+  ValidateTwinRunNumbers(o);
+  static_cast<void>(LinkFaultsOf(o));
+}
+
+TwinRunOutcome RunTwin(const TwinRunOptions& o, const char* command) {
+  ValidateTwinRunNumbers(o);
   const io::LinkFaultSchedule link_faults = LinkFaultsOf(o);
   const std::uint64_t planned = PlannedCycles(o.session);
   // Before the first output exists: a stop signal during start-up (building the plant, INIT)
@@ -119,7 +115,7 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   ReportFile report_file(o.session.report_path);
   const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
   const std::unique_ptr<Twin> twin = BuildTwin(o, period_ns);
-  const SessionRole role{command, "controller", "hiltwin ecs", o.controller_rate_hz, "twin"};
+  const SessionRole role = TwinRole(command, o.controller_rate_hz);
   runtime::SessionConfig config = MakeSessionConfig(o.session, role, *twin->backend);
   const std::string task_name = TaskNameOf(twin->plant->Info());
   config.task_name = task_name + " twin";
@@ -131,7 +127,9 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   };
   // The emulated board exists: LinkFaultsOf accepted only mock and wire.
   std::optional<runtime::LinkFaultingTask> faulting;
-  if (!link_faults.empty()) faulting.emplace(*twin->task, *twin->backend->emulated_board(), link_faults);
+  if (!link_faults.empty()) {
+    faulting.emplace(*twin->task, *twin->backend->emulated_board(), link_faults);
+  }
   runtime::RunTask& task = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
   const runtime::RunReport report = RunSessionOf(std::move(config), task);
   PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
@@ -145,30 +143,6 @@ TwinRunOutcome RunTwin(TwinRunOptions o, const char* command) {
   twin->plant->Finish();
   const int exit_code = static_cast<int>(runtime::ExitCodeFor(report));
   return {report, exit_code};
-}
-
-void AddTwinRunOptions(CLI::App& app, TwinRunOptions& o) {
-  AddSessionOptions(app, o.session);
-  app.add_option("--input", o.input,
-                 "input profile: a built-in name (openloop) or a CSV file time,left,right")
-      ->capture_default_str();
-  app.add_option("--input-rate", o.controller_rate_hz,
-                 "rate in Hz at which the input is played into the PWM reader (the ECS's rate; "
-                 "default 1000, or --rate if lower)");
-  app.add_option("--plant", o.plant,
-                 "the plant: a built-in or 20-sim plant's name, or fmu:PATH.fmu for an FMI 2.0 "
-                 "co-simulation FMU (docs/plants.md)")
-      ->capture_default_str();
-  app.add_option("--plant-map", o.plant_map_path,
-                 "plant map (TOML): which PWM channel drives which plant input and which output "
-                 "each encoder follows, with scales (default: the plant's own; docs/plants.md)");
-  app.add_option("--config", o.config_path,
-                 "RELbot parameter file (TOML, see app_relbot/relbot.toml)");
-  app.add_option("--integrator", o.integrator, "RELbot integrator: euler | rk2 | rk4 (default rk4)");
-  app.add_option("--inject-link-fault", o.inject_link_faults,
-                 "fault injection (mock and wire): break the link at exchange K, e.g. "
-                 "drop-answer,at=4000,count=3; KIND corrupt-request, corrupt-answer, drop-answer, "
-                 "delay-answer or stuck-encoder (to the end without count) (repeatable)");
 }
 
 }  // namespace hiltwin::app

@@ -58,6 +58,21 @@ class SpidevBackend final : public IoBackend {
 
 std::atomic<VerilatedBackendFactory> verilated_factory{nullptr};
 
+/// The SPEC form of a parsed backend, for messages: the text ParseBackendSpec read.
+std::string SpecText(const BackendSpec& spec) {
+  switch (spec.kind) {
+    case BackendSpec::Kind::kMock:
+      return "mock";
+    case BackendSpec::Kind::kWire:
+      return "wire:" + spec.argument;
+    case BackendSpec::Kind::kSpidev:
+      return "spidev:" + spec.argument;
+    case BackendSpec::Kind::kVerilated:
+      return spec.argument.empty() ? "verilated" : "verilated:" + spec.argument;
+  }
+  return "?";
+}
+
 }  // namespace
 
 void RegisterVerilatedBackendFactory(VerilatedBackendFactory factory) noexcept {
@@ -103,16 +118,20 @@ BackendSpec ParseBackendSpec(std::string_view text) {
 }
 
 std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptions& options) {
-  const BackendSpec parsed = ParseBackendSpec(spec);
+  return OpenBackend(ParseBackendSpec(spec), options);
+}
+
+std::unique_ptr<IoBackend> OpenBackend(const BackendSpec& parsed, const BackendOptions& options) {
+  const std::string spec = SpecText(parsed);
   if (options.mock_board_image && parsed.kind == BackendSpec::Kind::kSpidev) {
     throw ConfigError("a board image can only be chosen for an emulated board (mock, wire, "
                       "verilated), "
-                      "not for '" + std::string(spec) + "': the real board carries its own image");
+                      "not for '" + spec + "': the real board carries its own image");
   }
   if (parsed.kind == BackendSpec::Kind::kVerilated && !parsed.argument.empty() &&
       options.mock_board_image && ParseImage(parsed.argument) != options.mock_board_image) {
     // Two flags naming two images for one board: neither may win silently.
-    throw ConfigError("'" + std::string(spec) + "' names the RTL board's image and the board "
+    throw ConfigError("'" + spec + "' names the RTL board's image and the board "
                       "image chosen besides it is " + ToString(*options.mock_board_image) +
                       ": name the image once (--io verilated:IMAGE)");
   }
@@ -127,7 +146,7 @@ std::unique_ptr<IoBackend> OpenBackend(std::string_view spec, const BackendOptio
     case BackendSpec::Kind::kVerilated: {
       const VerilatedBackendFactory factory = verilated_factory.load();
       if (factory == nullptr) {
-        throw ConfigError("I/O backend '" + std::string(spec) +
+        throw ConfigError("I/O backend '" + spec +
                           "': this program has no verilated boards (build with "
                           "-DHILTWIN_FPGA_SIM=ON and apt-get install verilator)");
       }

@@ -7,9 +7,10 @@
 #include <memory>
 
 #include "fakes/loop_allocations.h"
-#include "hiltwin/runs/session_options.h"
 #include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/twin_build.h"
+#include "hiltwin/runs/twin_run.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
@@ -22,8 +23,8 @@ TwinRunOptions VirtualTwin(double seconds) {
   TwinRunOptions o;
   o.session.rate_hz = kRateHz;
   o.session.duration_s = seconds;
-  o.session.clock = "virtual";
-  o.session.no_progress = true;
+  o.session.clock = runtime::ClockKind::kVirtual;
+  o.session.progress = false;
   o.controller_rate_hz = 1000.0;
   return o;
 }
@@ -40,7 +41,7 @@ RecordedRun RunRecorded(double seconds, runtime::VirtualCycleCosts costs, std::s
   const TwinRunOptions o = VirtualTwin(seconds);
   const std::unique_ptr<Twin> twin = BuildTwin(o, kPeriodNs);
   runtime::SessionConfig config =
-      MakeSessionConfig(o.session, {"test", "controller", "hiltwin ecs", 1000.0, "twin"}, *twin->backend);
+      MakeSessionConfig(o.session, TwinRole("test", o.controller_rate_hz), *twin->backend);
   config.virtual_costs = std::move(costs);
   TrajectoryRecorder recorder(*twin->task, kPeriodNs, capacity);
   runtime::RunSession session(std::move(config), recorder);

@@ -14,7 +14,7 @@ namespace {
 
 TuneOptions ThesisCosts() {
   TuneOptions o;
-  o.clock = "virtual";
+  o.clock = runtime::ClockKind::kVirtual;
   o.validate_seconds = 3.0;  // openloop rests for 1 s, then steps and ramps
   o.inject_compute_us = 85.0;
   o.inject_overhead_us = 35.0;
@@ -148,7 +148,7 @@ TEST(TuneProcedure, RefusesBadInputWithExitTwo) {
   o.candidates_hz = {4000.0, 60000.0};
   EXPECT_EQ(code_of(o), 2);
   o = ThesisCosts();
-  o.clock = "realtime";  // injected costs on the real clock
+  o.clock = runtime::ClockKind::kRealtime;  // injected costs on the real clock
   EXPECT_EQ(code_of(o), 2);
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-/// The `hiltwin` command line: exit codes (DESIGN.md "Contracts") and the shape every
-/// subcommand takes. Each subcommand lives in its own app_relbot/src/cmd_<name>.cpp.
+/// The `hiltwin` command line: exit codes (docs/architecture.md, "Exit codes") and the shape
+/// every subcommand takes. Each subcommand lives in its own cli/commands/cmd_<name>.cpp.
 
 #include <CLI/CLI.hpp>
 #include <functional>
@@ -11,7 +11,7 @@
 
 namespace hiltwin::app {
 
-/// Process exit codes (DESIGN.md "Contracts"), shared with the run assembly.
+/// Process exit codes (docs/architecture.md, "Exit codes"), shared with the run assembly.
 using ExitCode = runtime::ExitCode;
 
 /// Ends a command with `code` and a message that says what, where and what to do.

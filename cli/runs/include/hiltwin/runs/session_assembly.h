@@ -1,56 +1,23 @@
 #pragma once
-/// The flags every command that runs a session shares (`run` for the twin, `ecs` for the
-/// controller): rate, duration, QoS rules, clock, overrun policy, deadline, log, report, fault
-/// injection, real-time set-up, progress and the wait for a wire peer. One definition, so the
-/// two sides of a HiL pair take the same flags with the same meaning and the same checks, and
-/// each command stays thin: flags -> SessionOptions -> runtime::SessionConfig -> report.
+/// The session assembly every command that runs a session shares (`run` for the twin, `ecs` for
+/// the controller, `tune`'s runs): typed SessionSettings -> the board -> runtime::SessionConfig
+/// -> the run -> report. One definition, so the two sides of a HiL pair run with the same meaning
+/// and the same checks; the flags themselves are read once, in cli/session_flags.h.
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
-#include <fstream>
 #include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
-#include "hiltwin/runs/command.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
-#include "hiltwin/qos/monitor.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/session_settings.h"
 #include "hiltwin/runtime/run_report.h"
 #include "hiltwin/runtime/run_session.h"
-#include "hiltwin/telemetry/sinks.h"
 
 namespace hiltwin::app {
 
-struct SessionOptions {
-  double rate_hz = 4000.0;
-  double duration_s = 10.0;
-  std::string io = "mock";
-  std::vector<std::string> mk_rules;
-  std::vector<std::string> window_rules;
-  std::optional<std::uint32_t> max_consecutive_misses;
-  double max_miss_pct = 1.0;
-  std::uint64_t grace_cycles = 0;
-  std::string on_violation = "flag";
-  std::string clock = "realtime";
-  std::string overrun_policy = "catch-up";
-  double deadline_us = 0.0;
-  std::string log_path;
-  std::uint32_t log_decimation = 1;
-  std::string timing_log_path;  ///< every cycle's time stamps, for `hiltwin trace --analyze`
-  std::string report_path;
-  std::vector<std::string> inject_overrun;
-  int priority = 80;
-  std::vector<int> cpus;
-  bool no_progress = false;
-  double wait_peer_s = 30.0;
-  std::string board_image;  ///< fault injection: the image the emulated board carries
-  /// --telemetry, --namespace (empty: the role's default), --web, --telemetry-rate.
-  telemetry::TelemetryOptions telemetry;
-};
-
-/// What the command that uses the options is, for messages and help texts.
+/// What the command that runs the session is, for messages and help texts.
 struct SessionRole {
   const char* command;            ///< "run" or "ecs"
   const char* peer_name;          ///< who is on the other side: "controller" or "twin"
@@ -59,33 +26,21 @@ struct SessionRole {
   const char* default_namespace;  ///< telemetry namespace without --namespace: "twin", ...
 };
 
-/// Adds the shared flags (with their help texts) to `app`. `--rate` and `--duration` take
-/// their defaults from `o` as it is when called.
-void AddSessionOptions(CLI::App& app, SessionOptions& o);
-
-/// Adds --telemetry, --namespace, --web and --telemetry-rate (part of AddSessionOptions; `hil`
-/// adds them alone and passes them on to its two processes).
-void AddTelemetryOptions(CLI::App& app, telemetry::TelemetryOptions& t);
-
-/// Checks the shared flags; throws CommandError(kUsage) naming the flag and the fix.
-void ValidateSessionOptions(const SessionOptions& o);
-
 /// The planned cycles of --duration at --rate (at least 1; checked against --grace-cycles).
-[[nodiscard]] std::uint64_t PlannedCycles(const SessionOptions& o);
+[[nodiscard]] std::uint64_t PlannedCycles(const SessionSettings& s);
 
 /// How to open the board for this side: the side's image and, for fault injection, the image
 /// its emulated board carries instead (--board-image).
-[[nodiscard]] io::BackendOptions BackendOptionsFor(const SessionOptions& o, io::Image side);
+[[nodiscard]] io::BackendOptions BackendOptionsFor(const SessionSettings& s, io::Image side);
 
-/// Opens --io as `side` (exit 2 for a bad spec, 5 when the OS refuses it).
-[[nodiscard]] std::unique_ptr<io::IoBackend> OpenBoard(const SessionOptions& o, io::Image side);
+/// Opens --io as `side` (exit 2 for an option the backend refuses, 5 when the OS refuses it).
+[[nodiscard]] std::unique_ptr<io::IoBackend> OpenBoard(const SessionSettings& s, io::Image side);
 
-/// The session configuration of the shared flags: clock, executive, QoS (the documented
-/// default (m,k) rule for this rate pair unless --qos is given), RT set-up, injection, log,
-/// progress, pause signals, telemetry (its sinks opened now: a port in use is exit 2 before the
-/// board is touched) and, on a wire, the wait for the peer. The command adds its task's name,
-/// details and on_ready.
-[[nodiscard]] runtime::SessionConfig MakeSessionConfig(const SessionOptions& o,
+/// The session configuration of the shared settings: clock, executive, QoS (its rules checked
+/// against the run's length), RT set-up, injection, log, progress, pause signals, telemetry (its
+/// sinks opened now: a port in use is exit 2 before the run starts) and, on a wire, the wait for
+/// the peer. The command adds its task's name, details and on_ready.
+[[nodiscard]] runtime::SessionConfig MakeSessionConfig(const SessionSettings& s,
                                                        const SessionRole& role,
                                                        io::IoBackend& backend);
 

@@ -4,7 +4,7 @@
 ///   measure   the model step's cost, the loop's own overhead per cycle, the wake-up latency
 ///             at each candidate rate, and the machine findings that matter;
 ///   recommend 75 % of 1/(overhead + compute), clamped to 4-10x the controller rate, raised to
-///             the accuracy bound where the timing allows (analysis/tuning.h);
+///             the accuracy bound where the timing allows (hiltwin/tuning/tuning.h);
 ///   validate  a run at every candidate and the recommended rate: misses, QoS verdict and the
 ///             RMS wheel-position error the controller sees against the reference.
 /// Every run goes through the shared run assembly with the same twin `hiltwin run` builds.
@@ -14,18 +14,19 @@
 #include <string>
 #include <vector>
 
+#include "hiltwin/runtime/run_report.h"
 #include "hiltwin/tuning/tuning_report.h"
 
 namespace hiltwin::app {
 
-/// `tune`'s flags.
+/// `tune`'s typed configuration (its flags parsed by cli/commands/cmd_tune.cpp).
 struct TuneOptions {
   double controller_rate_hz = 1000.0;
   double tolerance_m = 1.0e-4;
   std::vector<double> candidates_hz = {1000.0, 2000.0, 4000.0, 8000.0, 16000.0};
   double validate_seconds = 5.0;
   double latency_seconds = 1.0;  ///< per candidate, real clock only
-  std::string clock = "realtime";
+  runtime::ClockKind clock = runtime::ClockKind::kRealtime;
   /// Virtual clock only: costs given instead of measured, which makes the procedure exact.
   std::optional<double> inject_compute_us;
   std::optional<double> inject_overhead_us;

@@ -1,33 +1,41 @@
 #pragma once
-/// `hiltwin run` as a function: the RELbot twin's flags, built into a task and run through the
+/// `hiltwin run` as a function: the twin's typed options, built into a task and run through the
 /// shared session assembly, with the run's summary, report and exit code. `hiltwin trace` runs
 /// exactly this inside its recording, so a traced run and a plain one cannot differ.
 
-#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
-#include "hiltwin/runs/session_options.h"
+#include "hiltwin/io/link_fault_injection.h"
+#include "hiltwin/runs/session_assembly.h"
+#include "hiltwin/runs/session_settings.h"
 #include "hiltwin/runtime/run_report.h"
 
 namespace hiltwin::app {
 
-/// `run`'s own flags beside the shared ones.
+/// `run`'s typed configuration (its flags parsed by cli/session_flags.h, or set by `tune`).
 struct TwinRunOptions {
-  SessionOptions session;
-  std::string input = "openloop";
-  double controller_rate_hz = 0.0;  ///< 0: min(1000 Hz, --rate), the thesis ECS rate
-  std::string plant = "relbot";   ///< --plant: a registered name or fmu:PATH.fmu
-  std::string plant_map_path;     ///< --plant-map ("" = the plant's own map)
+  SessionSettings session;
+  std::string input = "openloop";  ///< --input: a built-in profile's name or a CSV file
+  double controller_rate_hz = 1000.0;  ///< the rate --input is played at (the ECS's)
+  std::string plant = "relbot";        ///< --plant: a registered name or fmu:PATH.fmu
+  std::string plant_map_path;          ///< --plant-map ("" = the plant's own map)
   std::string config_path;
-  std::string integrator;  ///< "" = the plant's default (the RELbot's is rk4)
-  std::vector<std::string> inject_link_faults;  ///< --inject-link-fault SPECs (mock and wire)
+  /// --integrator ("" = the plant's default, the RELbot's rk4), as given: the plant reads it
+  /// (plant::PlantOptions), and a plant without integrators refuses it in its own words.
+  std::string integrator;
+  std::vector<io::LinkFaultInjection> link_faults;  ///< --inject-link-fault (mock and wire)
 };
 
-/// Adds every `run` flag (shared and own) to `app`.
-void AddTwinRunOptions(CLI::App& app, TwinRunOptions& o);
+/// How the twin's runs name themselves in messages: `command` ("run", "trace", "tune") against
+/// a controller at `controller_rate_hz`.
+[[nodiscard]] SessionRole TwinRole(const char* command, double controller_rate_hz);
 
-/// The flag checks RunTwin starts with, for a caller that must know before it starts anything.
+/// The numbers' checks RunTwin starts with: the session's, then the controller rate's.
+void ValidateTwinRunNumbers(const TwinRunOptions& o);
+
+/// Every check RunTwin starts with (the numbers; the link faults against the board and the
+/// run's length), for a caller that must know before it starts anything.
 void CheckTwinRunOptions(const TwinRunOptions& o);
 
 /// What a twin run ended with.
@@ -36,9 +44,9 @@ struct TwinRunOutcome {
   int exit_code = 0;
 };
 
-/// Checks the flags, builds the twin, runs it and prints its outcome exactly as `hiltwin run`
-/// does (stdout summary, stderr problems, --report file). Throws CommandError for bad flags
+/// Checks the options, builds the twin, runs it and prints its outcome exactly as `hiltwin run`
+/// does (stdout summary, stderr problems, --report file). Throws CommandError for bad options
 /// (exit 2) and an unusable board (exit 5) before the run. `command` names it in messages.
-TwinRunOutcome RunTwin(TwinRunOptions o, const char* command = "run");
+TwinRunOutcome RunTwin(const TwinRunOptions& o, const char* command = "run");
 
 }  // namespace hiltwin::app

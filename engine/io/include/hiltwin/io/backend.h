@@ -79,5 +79,9 @@ void RegisterVerilatedBackendFactory(VerilatedBackendFactory factory) noexcept;
 /// std::runtime_error when the OS refuses (no such SPI device, /dev/shm unusable).
 [[nodiscard]] std::unique_ptr<IoBackend> OpenBackend(std::string_view spec,
                                                      const BackendOptions& options);
+/// Opens an already parsed backend (a command parses its flag once, at the command line).
+/// Throws as the string form does, for the options; the messages quote the SPEC form.
+[[nodiscard]] std::unique_ptr<IoBackend> OpenBackend(const BackendSpec& spec,
+                                                     const BackendOptions& options);
 
 }  // namespace hiltwin::io
