@@ -1,21 +1,21 @@
 // `hiltwin assess`: credibility of a simulation against an experiment (thesis §2.4,
 // appendix C), read from CSV files. It reports a score and a verdict; it exits 0 whenever the
 // assessment completed, PASS or FAIL, so the exit code tells "ran" from "could not run".
+// Flags -> AssessRunOptions (typed, read once) -> RunAssess (hiltwin/runs/assess_run.h).
 #include <array>
 #include <charconv>
-#include <cstdio>
 #include <filesystem>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 
-#include "hiltwin/assess/assessment.h"
-#include "hiltwin/tracing/csv.h"
-#include "hiltwin/assess/plot.h"
 #include "commands.h"
+#include "hiltwin/assess/assessment.h"
+#include "hiltwin/runs/assess_run.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::app {
 namespace {
@@ -39,14 +39,9 @@ struct AssessCliOptions {
   std::string plot;
 };
 
-struct Spec {
-  std::string file;
-  std::string column;
-};
-
 // "[FILE:]COL". With a positional FILE, a prefix counts as a file only if it names one, so
 // column names may contain ':'; without it, FILE:COL is required.
-Spec ParseSpec(const std::string& value, const std::string& positional, const char* flag) {
+CurveSpec ParseSpec(const std::string& value, const std::string& positional, const char* flag) {
   const auto colon = value.rfind(':');
   if (colon != std::string::npos && colon > 0 && colon + 1 < value.size()) {
     const std::string prefix = value.substr(0, colon);
@@ -144,17 +139,19 @@ std::string FlagPrefix(const AssessCliOptions& o, analysis::AssessOption option)
   return std::string(FlagOf(option)) + (value.empty() ? "" : " " + value) + ": ";
 }
 
-int RunAssess(const AssessCliOptions& o) {
+// The flags' text, read once: the curves' specs, the weights and ranges as numbers, and the
+// library's options, which name their choices by flag (FlagOf) and the flags' values as typed.
+AssessRunOptions AssessRunOptionsOf(const AssessCliOptions& o) {
   if (o.file.empty() && (o.sim.empty() || o.exp.empty())) {
     ThrowUsage("nothing to compare: give FILE (columns 2 and 3 are the simulation and the "
                 "experiment, as thesis appendix C), or --sim A.csv:COL --exp B.csv:COL");
   }
-  const Spec sim_spec = ParseSpec(o.sim.empty() ? "2" : o.sim, o.file, "--sim");
-  const Spec exp_spec = ParseSpec(o.exp.empty() ? "3" : o.exp, o.file, "--exp");
-  std::optional<Spec> input_spec;
-  if (!o.input.empty()) input_spec = ParseSpec(o.input, o.file, "--input");
+  AssessRunOptions run;
+  run.sim = ParseSpec(o.sim.empty() ? "2" : o.sim, o.file, "--sim");
+  run.exp = ParseSpec(o.exp.empty() ? "3" : o.exp, o.file, "--exp");
+  if (!o.input.empty()) run.input = ParseSpec(o.input, o.file, "--input");
 
-  analysis::AssessOptions options;
+  analysis::AssessOptions& options = run.assess;
   options.params.kp = o.kp;
   options.params.eta_pass = o.eta_pass;
   options.weights = ParseWeights(o.weights);
@@ -166,51 +163,10 @@ int RunAssess(const AssessCliOptions& o) {
   options.welch_segment = o.welch_segment;
   options.coherence_min = o.coherence;
   options.name_option = FlagOf;
-  if (!o.plot.empty()) {
-    const std::filesystem::path parent = std::filesystem::path(o.plot).parent_path();
-    std::error_code ec;
-    if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
-      ThrowUsage("--plot " + o.plot + ": directory " + parent.string() +
-                  " does not exist; create it or choose another path");
-    }
-  }
-
-  try {
-    std::map<std::string, analysis::CsvTable> tables;  // each file read once
-    auto curve = [&](const Spec& spec, const char* flag) {
-      auto it = tables.find(spec.file);
-      if (it == tables.end()) it = tables.emplace(spec.file, analysis::ReadCsv(spec.file)).first;
-      return analysis::ExtractCurve(it->second, analysis::ResolveColumn(it->second, spec.column, flag));
-    };
-    const analysis::Curve sim = curve(sim_spec, "--sim");
-    const analysis::Curve exp = curve(exp_spec, "--exp");
-    std::optional<analysis::Curve> input;
-    if (input_spec) input = curve(*input_spec, "--input");
-    const analysis::Assessment result =
-        analysis::Assess(sim, exp, input ? &*input : nullptr, options);
-    if (!o.plot.empty()) {
-      try {
-        analysis::WritePlot(result, o.plot);
-      } catch (const analysis::InputError& e) {  // gnuplot is not installed
-        ThrowUsage(std::string("--plot: ") + e.what() + ", or leave out --plot");
-      } catch (const analysis::PlotError& e) {
-        throw CommandError(ExitCode::kIo, std::string("--plot: ") + e.what());
-      }
-    }
-    if (o.json) {
-      std::printf("%s\n", analysis::ToJson(result).dump(2).c_str());
-    } else {
-      std::printf("%s", analysis::FormatText(result).c_str());
-      if (!o.plot.empty()) std::printf("Plot written to %s\n", o.plot.c_str());
-    }
-  } catch (const analysis::OptionError& e) {
-    ThrowUsage(FlagPrefix(o, e.option()) + e.what());
-  } catch (const analysis::InputError& e) {
-    ThrowUsage(e.what());
-  } catch (const analysis::PlotError& e) {
-    throw CommandError(ExitCode::kIo, e.what());
-  }
-  return static_cast<int>(ExitCode::kPass);
+  run.plot = o.plot;
+  run.json = o.json;
+  run.flag_prefix = [o](analysis::AssessOption option) { return FlagPrefix(o, option); };
+  return run;
 }
 
 Command AddAssessCommand(CLI::App& parent) {
@@ -274,7 +230,7 @@ Command AddAssessCommand(CLI::App& parent) {
       "Exit code: 0 whenever the assessment completed, PASS or FAIL (read the verdict from\n"
       "the output or --json); 2 for bad usage or input (the message names file:line:column or\n"
       "the flag); 5 when gnuplot fails to write the plot; 1 for an internal error.");
-  return Command{app, [o] { return RunAssess(*o); }};
+  return Command{app, [o] { return RunAssess(AssessRunOptionsOf(*o)); }};
 }
 
 }  // namespace
