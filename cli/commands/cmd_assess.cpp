@@ -172,7 +172,8 @@ AssessRunOptions AssessRunOptionsOf(const AssessCliOptions& o) {
 Command AddAssessCommand(CLI::App& parent) {
   auto o = std::make_shared<AssessCliOptions>();
   CLI::App* app = parent.add_subcommand(
-      "assess", "credibility score of two time series (CSV), time/performance/frequency domains");
+      "assess",
+      "Score the credibility of two time series (CSV): time, performance, frequency domains.");
   app->add_option("FILE", o->file, "CSV file holding both curves (omit with --sim/--exp FILE:COL)");
   app->add_option("--sim", o->sim, "simulation curve y_s: [FILE:]COL (default: column 2 of FILE)");
   app->add_option("--exp", o->exp, "experiment curve y_e: [FILE:]COL (default: column 3 of FILE)");

@@ -62,8 +62,7 @@ Command AddCompletionCommand(CLI::App& parent) {
   auto options = std::make_shared<CompletionOptions>();
   CLI::App* app = parent.add_subcommand(
       "completion",
-      "Print the shell completion script of hiltwin (bash), generated from its "
-      "commands and options");
+      "Print the shell completion script of hiltwin (bash), made from its commands and flags.");
   app->add_option("SHELL", options->shell, "the shell to complete in: bash")
       ->required()
       ->check(KnownShell());

@@ -41,8 +41,8 @@ Command AddDoctorCommand(CLI::App& parent) {
   auto options = std::make_shared<DoctorOptions>();
   CLI::App* app = parent.add_subcommand(
       "doctor",
-      "RT readiness of this machine: kernel preemption model, privileges, governor, "
-      "isolation, throttling");
+      "Check this machine's real-time readiness: preemption model, privileges, governor, "
+      "isolation, throttling.");
   app->add_flag("--json", options->json,
                 "print {checks: [{id, name, value, status, advice}], summary: {ok, warn, bad}} "
                 "instead of the table");

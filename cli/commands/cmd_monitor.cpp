@@ -48,7 +48,7 @@ Command AddMonitorCommand(CLI::App& parent) {
   auto flags = std::make_shared<MonitorFlags>();
   MonitorRunOptions* o = &flags->run;
   CLI::App* app = parent.add_subcommand(
-      "monitor", "every twin and controller on a DDS domain, live; send them commands");
+      "monitor", "Watch every twin and controller on a DDS domain, live; send them commands.");
   app->add_option("--domain", o->domain,
                   "DDS domain to watch: the DOMAIN of the tasks' --telemetry dds:DOMAIN (0..232)")
       ->capture_default_str();
