@@ -41,7 +41,7 @@ Command AddDoctorCommand(CLI::App& parent) {
   auto options = std::make_shared<DoctorOptions>();
   CLI::App* app = parent.add_subcommand(
       "doctor",
-      "Check this machine's real-time readiness: preemption model, privileges, governor, "
+      "Check this machine's real-time readiness: preemption, privileges, governor, "
       "isolation, throttling.");
   app->add_flag("--json", options->json,
                 "print {checks: [{id, name, value, status, advice}], summary: {ok, warn, bad}} "
