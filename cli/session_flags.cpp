@@ -249,7 +249,7 @@ void AddTwinRunFlags(CLI::App& app, TwinRunFlags& o) {
                  "plant map (TOML): which PWM channel drives which plant input and which output "
                  "each encoder follows, with scales (default: the plant's own; docs/plants.md)");
   app.add_option("--config", o.config_path,
-                 "RELbot parameter file (TOML, see app_relbot/relbot.toml)");
+                 "RELbot parameter file (TOML, see relbot/relbot.toml)");
   app.add_option("--integrator", o.integrator,
                  "RELbot integrator: euler | rk2 | rk4 (default rk4)");
   app.add_option("--inject-link-fault", o.inject_link_faults,
