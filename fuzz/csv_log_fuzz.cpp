@@ -9,8 +9,8 @@
 #include <string>
 
 #include "fuzz_util.h"
-#include "hiltwin/tracing/csv.h"
 #include "hiltwin/traces/trace_readers.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace {
 

@@ -15,10 +15,10 @@
 #include <span>
 
 #include "fuzz_util.h"
-#include "hiltwin/relbot/ecs_gains.h"
-#include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/plant/plant.h"
 #include "hiltwin/plant/plant_map.h"
+#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/relbot_params.h"
 
 namespace {
 

@@ -16,11 +16,11 @@
 #include <ctime>
 #include <vector>
 
+#include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/relbot/ecs_task.h"
 #include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/io/emulated_fpga.h"
-#include "hiltwin/kernel_glue/clock.h"
 
 namespace {
 

@@ -14,9 +14,9 @@
 #include <cstdlib>
 #include <vector>
 
+#include "hiltwin/plant/plant_registry.h"
 #include "hiltwin/relbot/relbot_model.h"
 #include "hiltwin/relbot/relbot_plant.h"
-#include "hiltwin/plant/plant_registry.h"
 #include "bench_stats.h"
 #include "relbot_duty_samples.h"
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "commands.h"
-#include "hiltwin/runs/doctor_format.h"
 #include "hiltwin/kernel_glue/rt_probe.h"
+#include "hiltwin/runs/doctor_format.h"
 
 namespace hiltwin::app {
 namespace {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "commands.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/relbot/ecs_report.h"
 #include "hiltwin/relbot/ecs_task.h"
@@ -17,7 +18,6 @@
 #include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/session_assembly.h"
-#include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/runtime/run_session.h"
 #include "session_flags.h"
 

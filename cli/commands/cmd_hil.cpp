@@ -18,13 +18,13 @@
 #include <vector>
 
 #include "commands.h"
-#include "hiltwin/runs/hil_report.h"
-#include "hiltwin/relbot/input_profile.h"
-#include "hiltwin/runs/session_assembly.h"
-#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/process.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/setpoint_profile.h"
+#include "hiltwin/runs/hil_report.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/scheduler/executive.h"
 #include "session_flags.h"
 

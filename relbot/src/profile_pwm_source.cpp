@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/kernel_glue/clock.h"
+#include "hiltwin/relbot/relbot_channels.h"
 
 namespace hiltwin::app {
 

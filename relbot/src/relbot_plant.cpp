@@ -3,9 +3,9 @@
 
 #include <mutex>
 
+#include "hiltwin/plant/plant_registry.h"
 #include "hiltwin/relbot/config_error.h"
 #include "hiltwin/relbot/relbot_channels.h"
-#include "hiltwin/plant/plant_registry.h"
 
 namespace hiltwin::app {
 namespace {

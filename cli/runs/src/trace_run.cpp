@@ -14,17 +14,17 @@
 #include <string>
 #include <system_error>
 
-#include "hiltwin/tracing/csv.h"
 #include "hiltwin/jitter/jitter_outputs.h"
-#include "hiltwin/traces/kernel_events.h"
+#include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/report_kit/gnuplot.h"  // PlotError
-#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/runs/command.h"
 #include "hiltwin/runs/hil_report.h"
-#include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/trace_capture/capture_error.h"
 #include "hiltwin/trace_capture/kernel_recorder.h"
 #include "hiltwin/trace_capture/lttng_session.h"
+#include "hiltwin/traces/kernel_events.h"
+#include "hiltwin/traces/trace_readers.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::app {
 namespace {

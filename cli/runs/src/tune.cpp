@@ -11,14 +11,14 @@
 #include <memory>
 #include <utility>
 
-#include "hiltwin/runs/command.h"
-#include "hiltwin/relbot/relbot_reference.h"
-#include "hiltwin/runs/session_assembly.h"
-#include "hiltwin/runs/trajectory_recorder.h"
-#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/qos/rules.h"
+#include "hiltwin/relbot/relbot_reference.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/session_assembly.h"
+#include "hiltwin/runs/trajectory_recorder.h"
+#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/scheduler/executive.h"
 #include "tune_measure.h"
 

@@ -7,9 +7,9 @@
 #include <memory>
 #include <string_view>
 
+#include "hiltwin/kernel_glue/rt_probe.h"
 #include "hiltwin/relbot/relbot_model.h"
 #include "hiltwin/runs/twin_build.h"
-#include "hiltwin/kernel_glue/rt_probe.h"
 #include "hiltwin/runtime/run_session.h"
 #include "hiltwin/scheduler/timing_stats.h"
 

@@ -4,13 +4,13 @@
 
 #include <vector>
 
-#include "hiltwin/tuning/tuning_report.h"
+#include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/tune.h"
 #include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runs/twin_run.h"
-#include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/scheduler/timing_stats.h"
+#include "hiltwin/tuning/tuning_report.h"
 
 namespace hiltwin::app {
 

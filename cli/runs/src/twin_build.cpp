@@ -4,11 +4,11 @@
 #include <stdexcept>
 #include <vector>
 
-#include "hiltwin/runs/command.h"
-#include "hiltwin/relbot/relbot_plant.h"
-#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/fmi/fmu_plant.h"
 #include "hiltwin/plant/plant_registry.h"
+#include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/session_assembly.h"
 
 namespace hiltwin::app {
 namespace {

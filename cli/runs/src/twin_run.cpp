@@ -10,16 +10,16 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/runs/command.h"
-#include "hiltwin/relbot/input_profile.h"
-#include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/runs/twin_build.h"
-#include "hiltwin/relbot/relbot_plant.h"
 #include "hiltwin/io/backend.h"
+#include "hiltwin/io/link_fault_injection.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
-#include "hiltwin/io/link_fault_injection.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runtime/link_faulting_task.h"
 #include "hiltwin/runtime/run_session.h"
 

@@ -20,8 +20,8 @@
 #include <thread>
 
 #include "hiltwin/io/conversions.h"
-#include "hiltwin/lockfree/seqlock.h"
 #include "hiltwin/io/wire_segment.h"
+#include "hiltwin/lockfree/seqlock.h"
 
 namespace hiltwin::io {
 

@@ -13,16 +13,16 @@
 #include <vector>
 
 #include "hiltwin/kernel_glue/clock.h"
-#include "hiltwin/qos/monitor.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/lockfree/command_queue.h"
 #include "hiltwin/lockfree/latest_value.h"
+#include "hiltwin/lockfree/spsc_ring.h"
+#include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_task.h"
 #include "hiltwin/runtime/session_command.h"
 #include "hiltwin/scheduler/cycle.h"
-#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
-#include "hiltwin/lockfree/spsc_ring.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "hiltwin/tracing/trace_codes.h"
 

@@ -16,13 +16,13 @@
 
 #include "cycle_runner.h"
 #include "hiltwin/kernel_glue/thread.h"
-#include "hiltwin/qos/monitor.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/lockfree/latest_value.h"
+#include "hiltwin/lockfree/spsc_ring.h"
+#include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/session_command.h"
 #include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/scheduler/executive.h"
-#include "hiltwin/lifecycle/lifecycle.h"
-#include "hiltwin/lockfree/spsc_ring.h"
 
 namespace hiltwin::runtime {
 

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <string>
 
-#include "hiltwin/report_kit/gnuplot.h"
 #include "hiltwin/jitter/jitter_outputs.h"
+#include "hiltwin/report_kit/gnuplot.h"
 #include "jitter_format.h"
 
 namespace hiltwin::analysis {

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "hiltwin/jitter/jitter_report.h"
-#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/scheduler/timing_stats.h"
+#include "hiltwin/traces/timing_trace.h"
 
 namespace hiltwin::analysis::detail {
 

@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "hiltwin/tracing/csv.h"
 #include "hiltwin/kernel_glue/process.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::analysis::detail {
 namespace {

@@ -10,8 +10,8 @@
 #include <mutex>
 #include <vector>
 
-#include "hiltwin/traces/kernel_events.h"
 #include "hiltwin/kernel_glue/thread.h"
+#include "hiltwin/traces/kernel_events.h"
 #include "kernel_event_decoder.h"
 #include "tracefs_api.h"
 

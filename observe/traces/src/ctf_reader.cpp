@@ -24,8 +24,8 @@
 #include <utility>
 #include <vector>
 
-#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/lifecycle/lifecycle.h"
+#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/tracing/trace_codes.h"
 #include "trace_reading.h"
 

@@ -14,8 +14,8 @@
 #include <string_view>
 #include <system_error>
 
-#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/kernel_glue/os_calls.h"
+#include "hiltwin/traces/timing_trace.h"
 
 namespace hiltwin::analysis {
 namespace {

@@ -20,9 +20,9 @@
 #include <utility>
 #include <vector>
 
-#include "hiltwin/tracing/csv.h"
-#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/kernel_glue/os_calls.h"
+#include "hiltwin/traces/trace_readers.h"
+#include "hiltwin/tracing/csv.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "trace_reading.h"
 

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/qos/rules.h"
+#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/tracing/trace_codes.h"
 
 namespace hiltwin::analysis::detail {

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/tuning/tuning_report.h"
 #include "hiltwin/report_kit/svg_chart.h"
+#include "hiltwin/tuning/tuning_report.h"
 #include "tuning_format.h"
 
 namespace hiltwin::analysis {

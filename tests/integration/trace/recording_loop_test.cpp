@@ -12,11 +12,11 @@
 
 #include "fakes/alloc_counter.h"
 #include "fakes/loop_allocations.h"
-#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
 #include "hiltwin/trace_capture/capture_error.h"
 #include "hiltwin/trace_capture/lttng_session.h"
+#include "hiltwin/traces/trace_readers.h"
 
 namespace hiltwin {
 namespace {

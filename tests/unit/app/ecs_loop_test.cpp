@@ -11,8 +11,8 @@
 
 #include "fakes/alloc_counter.h"
 #include "fakes/loop_allocations.h"
-#include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/qos/rules.h"
+#include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/runtime/run_session.h"
 #include "in_process_hil.h"
 

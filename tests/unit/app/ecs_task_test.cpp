@@ -7,9 +7,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app {
 namespace {

@@ -22,12 +22,12 @@
 #include <memory>
 #include <optional>
 
+#include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/relbot/ecs_task.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
 #include "hiltwin/relbot/relbot_model.h"
 #include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/relbot/profile_pwm_source.h"
 #include "hiltwin/relbot/relbot_twin.h"
-#include "hiltwin/io/emulated_fpga.h"
 
 namespace hiltwin::app::test {
 

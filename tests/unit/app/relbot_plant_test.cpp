@@ -4,10 +4,10 @@
 #include <gtest/gtest.h>
 
 #include "fakes/test_paths.h"
-#include "hiltwin/runs/command.h"
-#include "hiltwin/relbot/relbot_plant.h"
-#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/plant/plant_registry.h"
+#include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/twin_build.h"
 
 namespace hiltwin::app {
 namespace {

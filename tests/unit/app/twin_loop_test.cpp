@@ -11,14 +11,14 @@
 
 #include "fakes/alloc_counter.h"
 #include "fakes/loop_allocations.h"
-#include "hiltwin/relbot/input_profile.h"
-#include "hiltwin/relbot/relbot_model.h"
-#include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/relbot/profile_pwm_source.h"
-#include "hiltwin/relbot/relbot_channels.h"
-#include "hiltwin/relbot/relbot_twin.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/qos/rules.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
+#include "hiltwin/relbot/relbot_channels.h"
+#include "hiltwin/relbot/relbot_model.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/relbot/relbot_twin.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {

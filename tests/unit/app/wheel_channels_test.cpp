@@ -12,13 +12,13 @@
 #include <cmath>
 #include <cstdint>
 
+#include "hiltwin/io/conversions.h"
+#include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/io/icoboard.h"
 #include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/relbot/relbot_model.h"
 #include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/relbot_twin.h"
-#include "hiltwin/io/conversions.h"
-#include "hiltwin/io/emulated_fpga.h"
-#include "hiltwin/io/icoboard.h"
 
 namespace hiltwin::app {
 namespace {

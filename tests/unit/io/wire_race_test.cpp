@@ -17,9 +17,9 @@
 
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
-#include "hiltwin/lockfree/seqlock.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/clock.h"
+#include "hiltwin/lockfree/seqlock.h"
 
 namespace hiltwin::io {
 namespace {

@@ -17,8 +17,8 @@
 #include <filesystem>
 #include <thread>
 
-#include "hiltwin/traces/kernel_events.h"
 #include "hiltwin/kernel_glue/thread.h"
+#include "hiltwin/traces/kernel_events.h"
 
 namespace {
 

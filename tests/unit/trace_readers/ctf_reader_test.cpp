@@ -16,8 +16,8 @@
 
 #include "fakes/lttng_fixture.h"
 #include "fakes/test_paths.h"
-#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/qos/rules.h"
+#include "hiltwin/traces/trace_readers.h"
 
 namespace hiltwin::analysis {
 namespace {

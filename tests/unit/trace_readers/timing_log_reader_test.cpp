@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/runtime/run_session.h"
+#include "hiltwin/traces/trace_readers.h"
 
 namespace hiltwin::analysis {
 namespace {

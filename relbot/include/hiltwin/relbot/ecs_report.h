@@ -8,10 +8,10 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/relbot/ecs_task.h"
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_lines.h"
 #include "hiltwin/io/icoboard.h"
+#include "hiltwin/relbot/ecs_task.h"
 #include "hiltwin/runtime/run_report.h"
 
 namespace hiltwin::app {

@@ -26,12 +26,12 @@
 #include <string>
 #include <vector>
 
+#include "hiltwin/io/conversions.h"
+#include "hiltwin/io/icoboard.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/position_pid.h"
 #include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/relbot/setpoint_profile.h"
-#include "hiltwin/io/conversions.h"
-#include "hiltwin/io/icoboard.h"
 #include "hiltwin/runtime/run_task.h"
 
 namespace hiltwin::app {

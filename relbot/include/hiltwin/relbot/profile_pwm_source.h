@@ -5,8 +5,8 @@
 #include <array>
 #include <cstdint>
 
-#include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/io/emulated_fpga.h"
+#include "hiltwin/relbot/input_profile.h"
 
 namespace hiltwin::app {
 

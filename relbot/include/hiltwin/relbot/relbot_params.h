@@ -9,9 +9,9 @@
 #include <span>
 #include <string_view>
 
+#include "hiltwin/io/conversions.h"
 #include "hiltwin/relbot/config_error.h"
 #include "hiltwin/relbot/toml_numbers.h"
-#include "hiltwin/io/conversions.h"
 
 namespace hiltwin::app {
 

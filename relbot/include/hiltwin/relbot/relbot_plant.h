@@ -7,11 +7,11 @@
 #include <optional>
 #include <span>
 
+#include "hiltwin/plant/plant.h"
+#include "hiltwin/plant/plant_map.h"
 #include "hiltwin/relbot/integrator.h"
 #include "hiltwin/relbot/relbot_model.h"
 #include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/plant/plant.h"
-#include "hiltwin/plant/plant_map.h"
 
 namespace hiltwin::app {
 

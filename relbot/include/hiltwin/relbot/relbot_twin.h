@@ -7,9 +7,9 @@
 #include <array>
 #include <cstdint>
 
+#include "hiltwin/plant/plant_twin_task.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/relbot_plant.h"
-#include "hiltwin/plant/plant_twin_task.h"
 
 namespace hiltwin::app {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/tuning/tuning.h"
 #include "hiltwin/plant/plant_twin_task.h"
 #include "hiltwin/runtime/run_task.h"
+#include "hiltwin/tuning/tuning.h"
 
 namespace hiltwin::app {
 

@@ -9,17 +9,17 @@
 #include <optional>
 #include <string>
 
-#include "hiltwin/relbot/input_profile.h"
-#include "hiltwin/relbot/integrator.h"
-#include "hiltwin/relbot/profile_pwm_source.h"
-#include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/runs/twin_run.h"
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/plant/plant.h"
 #include "hiltwin/plant/plant_map.h"
 #include "hiltwin/plant/plant_twin_task.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/integrator.h"
+#include "hiltwin/relbot/profile_pwm_source.h"
+#include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/runs/twin_run.h"
 
 namespace hiltwin::app {
 

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "hiltwin/kernel_glue/rt_setup.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/exit_code.h"
 #include "hiltwin/scheduler/overrun_policy.h"
 #include "hiltwin/scheduler/timing_stats.h"
-#include "hiltwin/lifecycle/lifecycle.h"
 
 namespace hiltwin::runtime {
 

@@ -22,6 +22,7 @@
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
 #include "hiltwin/kernel_glue/thread.h"
+#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/runtime/run_report.h"
@@ -30,7 +31,6 @@
 #include "hiltwin/runtime/telemetry.h"
 #include "hiltwin/runtime/virtual_costs.h"
 #include "hiltwin/scheduler/executive.h"
-#include "hiltwin/lifecycle/lifecycle.h"
 #include "hiltwin/tracing/csv_logger.h"
 
 namespace hiltwin::runtime {

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "hiltwin/qos/monitor.h"
 #include "hiltwin/lifecycle/lifecycle.h"
+#include "hiltwin/qos/monitor.h"
 
 namespace hiltwin::runtime {
 

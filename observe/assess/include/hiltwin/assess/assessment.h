@@ -15,9 +15,9 @@
 #include "hiltwin/assess/assess_option.h"
 #include "hiltwin/assess/credibility.h"
 #include "hiltwin/assess/cross_checks.h"
-#include "hiltwin/tracing/csv.h"
 #include "hiltwin/assess/delay.h"
 #include "hiltwin/assess/spectral.h"
+#include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::analysis {
 

@@ -10,10 +10,10 @@
 #include <utility>
 #include <vector>
 
-#include "hiltwin/traces/kernel_events.h"
-#include "hiltwin/traces/timing_trace.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/scheduler/timing_stats.h"
+#include "hiltwin/traces/kernel_events.h"
+#include "hiltwin/traces/timing_trace.h"
 
 namespace hiltwin::analysis {
 
