@@ -1,0 +1,252 @@
+// `hiltwin hil`'s run (hiltwin/runs/hil_run.h): the closed HiL loop on one machine. Starts the
+// twin (`hiltwin run`) and the controller (`hiltwin ecs`) as two real processes on a fresh wire,
+// lets them find each other (either may be first), waits for both, reads both run reports back
+// and prints one combined summary; exits with the worse of the two exit codes. No shared memory
+// is left behind.
+#include "hiltwin/runs/hil_run.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hiltwin/io/wire_bus.h"
+#include "hiltwin/kernel_glue/process.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/runs/command.h"
+#include "hiltwin/runs/hil_report.h"
+#include "hiltwin/runs/session_assembly.h"
+
+namespace hiltwin::app {
+namespace {
+
+namespace fs = std::filesystem;
+using kernel_glue::Process;
+
+/// The twin runs this much longer than the ECS, so the ECS's finish ends the pair (the twin
+/// then stops with peer_stopped) and the tracking error covers the whole profile.
+constexpr double kTwinExtraS = 2.0;
+/// After one side ended, how long the other may take to notice before it is told to stop.
+constexpr auto kPeerGrace = std::chrono::seconds(3);
+
+/// The folder for reports, logs and the two processes' output: --log-dir, or a temporary
+/// one removed at the end.
+struct WorkDir {
+  fs::path path;
+  bool temporary = false;
+  ~WorkDir() {
+    std::error_code ignored;
+    if (temporary) fs::remove_all(path, ignored);
+  }
+};
+
+std::unique_ptr<WorkDir> MakeWorkDir(const HilRunOptions& o) {
+  auto dir = std::make_unique<WorkDir>();
+  std::error_code error;
+  if (!o.log_dir.empty()) {
+    dir->path = o.log_dir;
+    fs::create_directories(dir->path, error);
+    if (error) ThrowUsage("--log-dir " + o.log_dir + ": " + error.message());
+    return dir;
+  }
+  std::string pattern = (fs::temp_directory_path() / "hiltwin-hil-XXXXXX").string();
+  if (::mkdtemp(pattern.data()) == nullptr) {
+    throw CommandError(ExitCode::kIo,
+                       "cannot create a temporary folder in " + fs::temp_directory_path().string());
+  }
+  dir->path = pattern;
+  dir->temporary = true;
+  return dir;
+}
+
+/// One side's telemetry flags: its own namespace under --namespace; the page on the twin only.
+void AddTelemetry(std::vector<std::string>& argv, const telemetry::TelemetryOptions& t,
+                  const char* side, bool serves_web) {
+  if (t.specs.empty() && (t.web.empty() || !serves_web)) return;
+  for (const std::string& spec : t.specs) argv.insert(argv.end(), {"--telemetry", spec});
+  argv.insert(argv.end(), {"--namespace", t.ns + "/" + side, "--telemetry-rate", Num(t.rate_hz)});
+  if (serves_web && !t.web.empty()) argv.insert(argv.end(), {"--web", t.web});
+}
+
+void AddRules(std::vector<std::string>& argv, const std::vector<std::string>& qos,
+              const std::optional<double>& max_miss_pct,
+              const std::optional<std::string>& on_violation) {
+  for (const std::string& rule : qos) argv.insert(argv.end(), {"--qos", rule});
+  if (max_miss_pct) argv.insert(argv.end(), {"--max-miss-pct", Num(*max_miss_pct)});
+  if (on_violation) argv.insert(argv.end(), {"--on-violation", *on_violation});
+}
+
+std::vector<std::string> TwinArgv(const HilRunOptions& o, const std::string& wire,
+                                  const fs::path& dir) {
+  std::vector<std::string> argv = {"/proc/self/exe",
+                                   "run",
+                                   "--io",
+                                   wire,
+                                   "--rate",
+                                   Num(o.twin_rate_hz),
+                                   "--duration",
+                                   Num(o.duration_s + kTwinExtraS),
+                                   "--wait-peer",
+                                   Num(o.wait_peer_s),
+                                   "--no-progress",
+                                   "--report",
+                                   (dir / "twin.json").string()};
+  if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", (dir / "twin.csv").string()});
+  if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
+  AddRules(argv, o.twin_qos, o.twin_max_miss_pct, o.on_violation);
+  AddTelemetry(argv, o.telemetry, "twin", true);
+  argv.insert(argv.end(), o.twin_args.begin(), o.twin_args.end());
+  return argv;
+}
+
+std::vector<std::string> EcsArgv(const HilRunOptions& o, const std::string& wire,
+                                 const fs::path& dir) {
+  std::vector<std::string> argv = {"/proc/self/exe",
+                                   "ecs",
+                                   "--io",
+                                   wire,
+                                   "--rate",
+                                   Num(o.ecs_rate_hz),
+                                   "--duration",
+                                   Num(o.duration_s),
+                                   "--mode",
+                                   o.mode,
+                                   "--wait-peer",
+                                   Num(o.wait_peer_s),
+                                   "--no-progress",
+                                   "--report",
+                                   (dir / "ecs.json").string()};
+  if (o.mode == "closedloop") {
+    argv.insert(argv.end(), {"--setpoint", o.setpoint});
+  } else {
+    argv.insert(argv.end(), {"--input", o.input});
+  }
+  if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", (dir / "ecs.csv").string()});
+  if (!o.gains_path.empty()) argv.insert(argv.end(), {"--gains", o.gains_path});
+  if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
+  AddRules(argv, o.ecs_qos, o.ecs_max_miss_pct, o.on_violation);
+  AddTelemetry(argv, o.telemetry, "controller", false);
+  argv.insert(argv.end(), o.ecs_args.begin(), o.ecs_args.end());
+  return argv;
+}
+
+/// A started side and how it ended.
+struct Child {
+  const char* name;
+  Process process;
+  std::optional<kernel_glue::ExitStatus> status;
+  std::optional<std::chrono::steady_clock::time_point> told_to_stop;
+};
+
+Child Start(const char* name, const std::vector<std::string>& argv, const fs::path& dir) {
+  kernel_glue::ProcessOptions options;
+  options.out = kernel_glue::OutputTarget::File(dir / (std::string(name) + ".out"));
+  options.err = kernel_glue::OutputTarget::SameAsStdout();
+  return Child{name, Process::Start(argv, options), std::nullopt, std::nullopt};
+}
+
+void Poll(Child& child) {
+  if (!child.status) child.status = child.process.WaitFor(std::chrono::milliseconds(0));
+}
+
+/// Asks a side to stop (SIGTERM: report and log written); kills it when it has not stopped
+/// kPeerGrace later.
+void Stop(Child& child, const char* why) {
+  const auto now = std::chrono::steady_clock::now();
+  if (!child.told_to_stop) {
+    std::fprintf(stderr, "\nhiltwin hil: stopping the %s (%s)\n", child.name, why);
+    ::kill(child.process.pid(), SIGTERM);
+    child.told_to_stop = now;
+  } else if (now - *child.told_to_stop > kPeerGrace) {
+    std::fprintf(stderr, "\nhiltwin hil: the %s did not stop; killing it\n", child.name);
+    child.status = child.process.Kill(SIGKILL);
+  }
+}
+
+/// Waits for both sides. A stop signal is passed on; a side that outlives its peer by more
+/// than kPeerGrace is told to stop.
+void WaitForBoth(Child& twin, Child& ecs, double duration_s, bool progress) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  std::optional<Clock::time_point> first_end;
+  while (!twin.status || !ecs.status) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    Poll(twin);
+    Poll(ecs);
+    if (!first_end && (twin.status || ecs.status)) first_end = Clock::now();
+    const bool overdue = first_end && Clock::now() - *first_end > kPeerGrace;
+    for (Child* child : {&twin, &ecs}) {
+      if (child->status) continue;
+      if (kernel_glue::StopRequested()) Stop(*child, "stop requested");
+      if (overdue) Stop(*child, "its peer ended and it did not follow");
+    }
+    if (progress) {
+      const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+      std::fprintf(stderr, "\r  hil: %.1f s of about %.1f s; twin %s, ECS %s   ", elapsed_s,
+                   duration_s, twin.status ? "ended" : "running", ecs.status ? "ended" : "running");
+      std::fflush(stderr);
+    }
+  }
+  if (progress) std::fputc('\n', stderr);
+}
+
+std::optional<nlohmann::ordered_json> ReadReport(const fs::path& path) {
+  std::ifstream file(path);
+  if (!file) return std::nullopt;
+  try {
+    return nlohmann::ordered_json::parse(file);
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;  // a side that died mid-write: said in the summary as "no report"
+  }
+}
+
+/// A side that did not pass shows its own output, so the cause is on the screen.
+void ShowOutputOf(const Child& child, const fs::path& dir) {
+  const int code = ExitCodeOf(*child.status);
+  if (code == 0 || code == 3) return;
+  std::ifstream file(dir / (std::string(child.name) + ".out"));
+  std::string line;
+  std::fprintf(stderr, "hiltwin hil: the %s ended with %s; its output:\n", child.name,
+               child.status->Describe().c_str());
+  while (std::getline(file, line)) std::fprintf(stderr, "  %s| %s\n", child.name, line.c_str());
+}
+
+}  // namespace
+
+int RunHil(const HilRunOptions& o) {
+  const std::string& name = o.wire;
+  const std::string wire = "wire:" + name;
+  // Before anything is created: a stop signal from here on ends the pair cleanly, never
+  // leaving a half-made report or work folder (docs/reliability.md, row M13).
+  kernel_glue::InstallStopSignalHandlers();
+  const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
+  ReportFile report_file(o.report_path);
+  std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s\n",
+              Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(), wire.c_str(),
+              Num(o.duration_s).c_str());
+  std::fflush(stdout);
+  Child twin = Start("twin", TwinArgv(o, wire, dir->path), dir->path);
+  Child ecs = Start("ecs", EcsArgv(o, wire, dir->path), dir->path);
+  WaitForBoth(twin, ecs, o.duration_s, !o.no_progress && isatty(STDERR_FILENO) == 1);
+  io::WireBus::Unlink(name);  // both are gone: nothing may be left in /dev/shm
+  ShowOutputOf(twin, dir->path);
+  ShowOutputOf(ecs, dir->path);
+  const HilResult result =
+      CombineHil(wire, o.mode, HilSide{"twin", *twin.status, ReadReport(dir->path / "twin.json")},
+                 HilSide{"ecs", *ecs.status, ReadReport(dir->path / "ecs.json")});
+  std::fputs(FormatHilSummary(result).c_str(), stdout);
+  std::fflush(stdout);
+  report_file.Write(ToJson(result).dump(2) + '\n');
+  return result.exit_code;
+}
+
+}  // namespace hiltwin::app
