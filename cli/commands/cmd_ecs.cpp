@@ -2,35 +2,16 @@
 // lifecycle, QoS verdict, run report, logger), through the ECS image of the IcoBoard. The
 // controller code is identical for the twin and the robot (thesis requirement "Must 1"): only
 // --io differs, wire:NAME against `hiltwin run --io wire:NAME`, spidev:/dev/spidev0.0 on the robot.
-#include <cmath>
-#include <cstdio>
-#include <fstream>
+// Flags -> EcsRunOptions (typed, read once) -> RunEcs (hiltwin/runs/ecs_run.h).
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "commands.h"
-#include "hiltwin/kernel_glue/stop_signal.h"
-#include "hiltwin/relbot/ecs_gains.h"
-#include "hiltwin/relbot/ecs_report.h"
-#include "hiltwin/relbot/ecs_task.h"
-#include "hiltwin/relbot/input_profile.h"
-#include "hiltwin/relbot/relbot_params.h"
-#include "hiltwin/relbot/setpoint_profile.h"
-#include "hiltwin/runs/session_assembly.h"
-#include "hiltwin/runtime/run_session.h"
+#include "hiltwin/runs/ecs_run.h"
 #include "session_flags.h"
 
 namespace hiltwin::app {
 namespace {
-
-/// What the controller does: follow setpoints with its PIDs, or play a duty profile.
-enum class EcsMode { kClosedLoop, kOpenLoop };
-
-/// --mode's word for it, as the start line and the report say it.
-const char* ToString(EcsMode mode) {
-  return mode == EcsMode::kClosedLoop ? "closedloop" : "openloop";
-}
 
 /// `ecs`'s own flags beside the shared ones, as the command line gave them.
 struct EcsFlags {
@@ -43,25 +24,9 @@ struct EcsFlags {
   std::string config_path;
 };
 
-/// `ecs`'s typed configuration.
-struct EcsOptions {
-  SessionSettings session;
-  bool duration_given = false;
-  EcsMode mode = EcsMode::kClosedLoop;
-  std::string setpoint;  ///< closed loop: a built-in profile's name or a CSV file
-  std::string input;     ///< open loop: a built-in profile's name or a CSV file
-  std::string gains_path;
-  std::string config_path;
-};
-
-/// How the controller's runs name themselves; its default (m,k) rule is judged at its own rate.
-SessionRole EcsRole(double rate_hz) {
-  return {"ecs", "twin", "hiltwin run", rate_hz, "controller"};
-}
-
 /// The flags, read once (exit 2 naming the flag).
-EcsOptions EcsOptionsFrom(const EcsFlags& f) {
-  EcsOptions o;
+EcsRunOptions EcsRunOptionsOf(const EcsFlags& f) {
+  EcsRunOptions o;
   o.session = SessionSettingsFrom(f.session, EcsRole(f.session.rate_hz));
   o.duration_given = f.duration_given;
   o.mode = f.mode == "openloop" ? EcsMode::kOpenLoop : EcsMode::kClosedLoop;  // CLI11-checked
@@ -72,101 +37,6 @@ EcsOptions EcsOptionsFrom(const EcsFlags& f) {
   return o;
 }
 
-/// The controller behind its board, built from the flags; owns everything the task uses.
-struct Ecs {
-  RelbotParams params = DefaultRelbotParams();
-  PidGains gains = DefaultEcsGains();
-  std::optional<SetpointProfile> setpoints;
-  std::optional<InputProfile> duty_profile;
-  std::unique_ptr<io::IoBackend> backend;
-  std::unique_ptr<io::IcoBoard> driver;
-  std::optional<EcsTask> task;
-  std::string profile_name;
-};
-
-void LoadEcsConfiguration(const EcsOptions& o, Ecs& ecs) {
-  try {
-    if (!o.config_path.empty()) ecs.params = LoadRelbotParams(o.config_path);
-    if (!o.gains_path.empty()) ecs.gains = LoadEcsGains(o.gains_path);
-    if (o.mode == EcsMode::kClosedLoop) {
-      ecs.setpoints.emplace(LoadSetpointProfile(o.setpoint));
-      ecs.profile_name = ecs.setpoints->name();
-    } else {
-      ecs.duty_profile.emplace(LoadInputProfile(o.input));
-      ecs.profile_name = ecs.duty_profile->name();
-    }
-  } catch (const ConfigError& e) {
-    ThrowUsage(e.what());
-  } catch (const ProfileError& e) {
-    ThrowUsage(e.what());
-  }
-}
-
-/// Loads gains and profiles (exit 2 with file:line), opens the link and checks the board's
-/// identity (exit 5 with the thesis's message), then builds the task.
-std::unique_ptr<Ecs> BuildEcs(const EcsOptions& o, kernel_glue::TimeNs period_ns) {
-  auto ecs = std::make_unique<Ecs>();
-  LoadEcsConfiguration(o, *ecs);
-  ecs->backend = OpenBoard(o.session, io::Image::kIcoboard);
-  ecs->driver = std::make_unique<io::IcoBoard>(ecs->backend->bus());
-  InitBoard(*ecs->driver, period_ns);
-  const io::WheelGeometry geometry = WheelGeometryOf(ecs->params);
-  try {
-    if (ecs->setpoints) {
-      ecs->task.emplace(*ecs->driver, *ecs->setpoints, ecs->gains, geometry, period_ns);
-    } else {
-      ecs->task.emplace(*ecs->driver, *ecs->duty_profile, geometry, period_ns);
-    }
-  } catch (const ConfigError& e) {
-    ThrowUsage(std::string("--gains: ") + e.what());
-  }
-  return ecs;
-}
-
-void PrintStartLines(const EcsOptions& o, std::uint64_t planned, const std::string& profile,
-                     const kernel_glue::RtSetupRecord* rt) {
-  std::fprintf(stdout,
-               "hiltwin ecs: RELbot controller (%s, %s) at %.0f Hz for %.3f s (%llu cycles), "
-               "io %s, %s clock\n",
-               ToString(o.mode), profile.c_str(), o.session.rate_hz, o.session.duration_s,
-               static_cast<unsigned long long>(planned), o.session.io_text.c_str(),
-               runtime::ToString(o.session.clock));
-  if (o.session.io.kind == io::BackendSpec::Kind::kMock) {
-    std::fprintf(stdout,
-                 "note: the mock board has no plant behind it, so the encoders stay at 0; drive "
-                 "the twin with --io wire:NAME and `hiltwin run --io wire:NAME`, or use `hiltwin "
-                 "hil`\n");
-  }
-  if (rt != nullptr)
-    std::fprintf(stdout, "real-time set-up: %s\n", kernel_glue::Summary(*rt).c_str());
-  std::fflush(stdout);
-}
-
-int RunEcs(EcsOptions o) {
-  const kernel_glue::TimeNs period_ns = kernel_glue::PeriodNsFromRateHz(o.session.rate_hz);
-  kernel_glue::InstallStopSignalHandlers();  // before any output exists: as `run` does
-  ReportFile report_file(o.session.report_path);
-  const std::unique_ptr<Ecs> ecs = BuildEcs(o, period_ns);
-  // By default the run lasts as long as its profile: the setpoints end settled.
-  if (!o.duration_given) o.session.duration_s = ecs->task->length_s();
-  ValidateSessionSettings(o.session);
-  const std::uint64_t planned = PlannedCycles(o.session);
-  const SessionRole role = EcsRole(o.session.rate_hz);
-  runtime::SessionConfig config = MakeSessionConfig(o.session, role, *ecs->backend);
-  config.task_name = "RELbot ECS";
-  config.details = {{"mode", ToString(o.mode)}, {"profile", ecs->profile_name}};
-  config.on_ready = [o, planned, profile = ecs->profile_name](
-                        const kernel_glue::RtSetupRecord* rt) {
-    PrintStartLines(o, planned, profile, rt);
-  };
-  const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
-  const EcsFigures figures =
-      EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
-  PrintOutcome(role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
-               report_file);
-  return static_cast<int>(runtime::ExitCodeFor(report));
-}
-
 Command AddEcsCommand(CLI::App& parent) {
   auto o = std::make_shared<EcsFlags>();
   o->session.rate_hz = 1000.0;
@@ -174,7 +44,8 @@ Command AddEcsCommand(CLI::App& parent) {
       "ecs",
       "Run the RELbot's embedded controller (ECS) with a QoS verdict.\n"
       "Closed loop (default): one position PID per wheel follows --setpoint (built-in\n"
-      "closedloop: 2.5 m forward, thesis 7.2) and reports the tracking error. Open loop: plays the\n"
+      "closedloop: 2.5 m forward, thesis 7.2) and reports the tracking error. "
+      "Open loop: plays the\n"
       "duty profile --input and logs duty and measured wheel positions (thesis 5.2).\n"
       "The same controller drives the twin (--io wire:NAME, with `hiltwin run --io wire:NAME`)\n"
       "or the robot (--io spidev:/dev/spidev0.0). Default (m,k) rule: (1,2), never two misses\n"
@@ -197,7 +68,7 @@ Command AddEcsCommand(CLI::App& parent) {
                   "PID gains and limits (TOML, see relbot/ecs_gains.toml; default: built in)");
   app->add_option("--config", o->config_path,
                   "RELbot parameter file for the wheel geometry (TOML, relbot/relbot.toml)");
-  return {app, [o] { return RunEcs(EcsOptionsFrom(*o)); }};
+  return {app, [o] { return RunEcs(EcsRunOptionsOf(*o)); }};
 }
 
 }  // namespace
