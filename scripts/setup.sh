@@ -41,7 +41,7 @@ packages=(
   libcpp-httplib-dev                            # the live web page (--web)
   chromium                                      # the web page test (headless)
   libzip-dev libxml2-dev                        # FMI 2.0 FMUs: unpacking, modelDescription.xml
-  yosys nextpnr-ice40 fpga-icestorm verilator   # the IcoBoard gateware (fpga/, docs/fpga.md)
+  yosys nextpnr-ice40 fpga-icestorm verilator   # the IcoBoard gateware (board/fpga/, docs/fpga.md)
   clang libclang-rt-14-dev                      # libFuzzer targets (fuzz/; the runtime is only recommended)
   stress-ng                                     # the fault matrix's CPU hog (docs/reliability.md)
   dpkg-dev fakeroot file                        # CPack's .deb: dpkg-shlibdeps, file ownership

@@ -1,7 +1,7 @@
 #pragma once
 /// Choosing a backend at run time from a string: `mock`, `wire:NAME`, `spidev:/dev/spidevB.C`,
-/// `verilated[:IMAGE]`. The verilated backend (the RTL of fpga/ compiled by Verilator) lives in
-/// the fpga_sim module, which io does not depend on: fpga_sim registers its factory here
+/// `verilated[:IMAGE]`. The verilated backend (the RTL of board/fpga/ compiled by Verilator) lives
+/// in the fpga_sim module, which io does not depend on: fpga_sim registers its factory here
 /// (fpga_sim::RegisterVerilatedBackend), and OpenBackend refuses `verilated` until it has.
 
 #include <memory>
