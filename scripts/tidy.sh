@@ -77,7 +77,7 @@ sed -E 's# -Winvalid-pch##g; s# -include [^ "]*/cmake_pch\.hxx# '"${pch_flags[*]
 # example, a test of a configuration switched off) borrows a neighbour's flags, which may lack
 # its module's folder.
 extra=(--extra-arg=-w)
-for include in "$root"/*/include; do extra+=(--extra-arg="-I$include"); done
+for include in "$root"/*/include "$root"/*/*/include; do extra+=(--extra-arg="-I$include"); done
 status=0
 printf '%s\n' "${inputs[@]}" |
   xargs -P "$(nproc)" -n 2 clang-tidy -p "$work" --quiet --config-file="$root/.clang-tidy" \
