@@ -139,7 +139,10 @@ void AddSessionFlags(CLI::App& app, SessionFlags& o) {
                  "flag: finish and mark unreliable (exit 3); abort: stop at once (exit 4)")
       ->check(CLI::IsMember({"flag", "abort"}))
       ->capture_default_str();
-  app.add_option("--clock", o.clock, "realtime, or virtual: the identical loop as fast as possible")
+  app.add_option("--clock", o.clock,
+                 "realtime, or virtual: the identical loop as fast as possible; on --io wire:NAME "
+                 "both sides must say virtual and then run in lockstep on one virtual time base "
+                 "(exact and repeatable; docs/lockstep.md)")
       ->check(CLI::IsMember({"realtime", "virtual"}))
       ->capture_default_str();
   app.add_option("--overrun-policy", o.overrun_policy,

@@ -122,6 +122,12 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--wire", o->wire, "wire name (default: hil-<pid>, fresh)");
   app->add_option("--wait-peer", o->wait_peer_s, "how long each side waits for the other, s")
       ->capture_default_str();
+  app->add_option("--clock", o->clock,
+                  "realtime: both sides on CLOCK_MONOTONIC (timing, QoS); virtual: both sides in "
+                  "lockstep on one virtual time base, as fast as they compute, with results that "
+                  "are exact and repeatable on any machine (docs/lockstep.md)")
+      ->check(CLI::IsMember({"realtime", "virtual"}))
+      ->capture_default_str();
   app->add_flag("--no-progress", o->no_progress, "no progress line on the terminal");
   AddTelemetryFlags(*app, o->telemetry);
   return {app, [o] { return RunHil(HilRunOptionsOf(*o)); }};

@@ -97,6 +97,8 @@ std::vector<std::string> TwinArgv(const HilRunOptions& o, const std::string& wir
                                    Num(o.duration_s + kTwinExtraS),
                                    "--wait-peer",
                                    Num(o.wait_peer_s),
+                                   "--clock",
+                                   o.clock,
                                    "--no-progress",
                                    "--report",
                                    (dir / "twin.json").string()};
@@ -122,6 +124,8 @@ std::vector<std::string> EcsArgv(const HilRunOptions& o, const std::string& wire
                                    o.mode,
                                    "--wait-peer",
                                    Num(o.wait_peer_s),
+                                   "--clock",
+                                   o.clock,
                                    "--no-progress",
                                    "--report",
                                    (dir / "ecs.json").string()};
@@ -230,9 +234,10 @@ int RunHil(const HilRunOptions& o) {
   kernel_glue::InstallStopSignalHandlers();
   const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
   ReportFile report_file(o.report_path);
-  std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s\n",
+  std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s, %s\n",
               Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(), wire.c_str(),
-              Num(o.duration_s).c_str());
+              Num(o.duration_s).c_str(),
+              o.clock == "virtual" ? "in lockstep on one virtual clock" : "in real time");
   std::fflush(stdout);
   Child twin = Start("twin", TwinArgv(o, wire, dir->path), dir->path);
   Child ecs = Start("ecs", EcsArgv(o, wire, dir->path), dir->path);

@@ -94,6 +94,8 @@ io::BackendOptions BackendOptionsFor(const SessionSettings& s, io::Image side) {
   io::BackendOptions options;
   options.side = side;
   options.mock_board_image = s.board_image;
+  // On a wire the virtual clock is the one both sides share (lockstep, docs/lockstep.md).
+  options.lockstep = s.clock == runtime::ClockKind::kVirtual && s.io.kind == io::BackendSpec::Kind::kWire;
   return options;
 }
 
@@ -128,8 +130,15 @@ runtime::SessionConfig MakeSessionConfig(const SessionSettings& s, const Session
   config.progress = s.progress && isatty(STDERR_FILENO) == 1;
   config.pause_signals = true;  // kill -USR1 pauses, -USR2 resumes (documented in --help)
   if (io::PeerLink* link = backend.peer_link(); link != nullptr) {
-    const std::string start_hint = std::string(role.peer_command) + " --io " + s.io_text;
+    const std::string start_hint = std::string(role.peer_command) + " --io " + s.io_text +
+                                   (s.clock == runtime::ClockKind::kVirtual ? " --clock virtual" : "");
     config.peer = runtime::PeerWait{link, s.wait_peer_s, start_hint};
+    config.lockstep_clock = backend.lockstep_clock();
+    if (config.lockstep_clock != nullptr && s.wait_peer_s == 0.0) {
+      ThrowUsage("--wait-peer 0 with --clock virtual on " + s.io_text +
+                 ": a lockstep run starts both sides on one time base, so it waits for its peer; "
+                 "drop --wait-peer 0 or run --clock realtime");
+    }
   } else if (s.wait_peer_s != kDefaultWaitPeerS && s.wait_peer_s != 0.0) {
     ThrowUsage(
         "--wait-peer only applies to --io wire:NAME; a mock board has no peer and a real "

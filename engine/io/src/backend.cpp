@@ -34,12 +34,14 @@ class MockBackend final : public IoBackend {
 
 class WireBackend final : public IoBackend {
  public:
-  WireBackend(const std::string& name, Image side, std::optional<Image> board_image)
-      : bus_(name, side, board_image) {}
+  WireBackend(const std::string& name, Image side, std::optional<Image> board_image,
+              WireClock clock)
+      : bus_(name, side, board_image, clock) {}
   SpiBus& bus() noexcept override { return bus_; }
   EmulatedFpga* emulated_board() noexcept override { return &bus_.board(); }
   BackendSpec::Kind kind() const noexcept override { return BackendSpec::Kind::kWire; }
   PeerLink* peer_link() noexcept override { return &bus_; }
+  kernel_glue::Clock* lockstep_clock() noexcept override { return bus_.lockstep_clock(); }
 
  private:
   WireBus bus_;
@@ -139,8 +141,13 @@ std::unique_ptr<IoBackend> OpenBackend(const BackendSpec& parsed, const BackendO
     case BackendSpec::Kind::kMock:
       return std::make_unique<MockBackend>(options.mock_board_image.value_or(options.side));
     case BackendSpec::Kind::kWire:
-      return std::make_unique<WireBackend>(parsed.argument, options.side,
-                                           options.mock_board_image);
+      try {
+        return std::make_unique<WireBackend>(
+            parsed.argument, options.side, options.mock_board_image,
+            options.lockstep ? WireClock::kLockstep : WireClock::kRealtime);
+      } catch (const std::invalid_argument& e) {  // a peer on the other clock: the user's mix
+        throw ConfigError("'" + spec + "': " + e.what());
+      }
     case BackendSpec::Kind::kSpidev:
       return std::make_unique<SpidevBackend>(parsed.argument, options.spidev);
     case BackendSpec::Kind::kVerilated: {

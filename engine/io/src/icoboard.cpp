@@ -89,7 +89,8 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   // answer is checked all the same, so a caller can tell that its safe outputs arrived.
   // A corrupted wire is the same kind of fault, at INIT too: nothing read from it is trusted.
   const bool peer_lost = (transfer.result == BusResult::kPeerLost && !peer_lost_at_init) ||
-                         transfer.result == BusResult::kWireCorrupted;
+                         transfer.result == BusResult::kWireCorrupted ||
+                         transfer.result == BusResult::kPeerMismatch;
   if (transfer.result == BusResult::kIoError) {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;

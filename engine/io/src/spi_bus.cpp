@@ -12,6 +12,7 @@ const char* ToString(BusResult result) noexcept {
     case BusResult::kPeerAbsent: return "peer absent";
     case BusResult::kPeerStopped: return "peer stopped";
     case BusResult::kWireCorrupted: return "wire corrupted";
+    case BusResult::kPeerMismatch: return "peer on another clock";
   }
   return "?";
 }

@@ -21,6 +21,8 @@
 
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/wire_segment.h"
+#include "wire_guard.h"
+#include "wire_lockstep.h"
 #include "hiltwin/lockfree/seqlock.h"
 
 namespace hiltwin::io {
@@ -58,9 +60,6 @@ void FenceAgainstClockReads() noexcept {
 #endif
 }
 
-/// kill(pid, 0) succeeds, or fails only for lack of permission: the process exists.
-bool ProcessAlive(std::int32_t pid) noexcept { return ::kill(pid, 0) == 0 || errno == EPERM; }
-
 std::uint64_t Pack16(std::size_t c, std::uint16_t value) noexcept {
   return std::uint64_t{value} << (16U * c);
 }
@@ -88,50 +87,6 @@ const char* PeerStopMessage(bool ecs_side, std::uint32_t cause) noexcept {
 }
 
 }  // namespace
-
-/// The first impossible value this side read from the segment, latched: once set, the side
-/// reads nothing more from the wire and every transfer reports it. The message lives in this
-/// object (the bus outlives the run that reports it), formatted without allocating.
-class WireGuard {
- public:
-  explicit WireGuard(std::string path) : path_(std::move(path)) {}
-  [[nodiscard]] bool ok() const noexcept { return reason_ == nullptr; }
-  [[nodiscard]] const char* reason() const noexcept { return reason_; }
-  [[nodiscard]] const std::string& path() const noexcept { return path_; }
-
-  /// Latches "wire: <what>: the segment is corrupted (...)" unless a reason is latched already.
-  __attribute__((format(printf, 2, 3))) void Fail(const char* format, ...) noexcept {
-    if (reason_ != nullptr) return;
-    va_list args;
-    va_start(args, format);
-    const int used = std::vsnprintf(text_.data(), text_.size(), format, args);
-    va_end(args);
-    if (used >= 0 && static_cast<std::size_t>(used) < text_.size()) {
-      std::snprintf(text_.data() + used, text_.size() - static_cast<std::size_t>(used),
-                    ": the segment is corrupted (another process writes into %s); outputs go "
-                    "safe: stop that process, then restart both sides",
-                    path_.c_str());
-    }
-    reason_ = text_.data();
-  }
-
-  // The ECS's view of the ring's newest index: the last value read and when.
-  std::uint64_t newest_seen = 0;
-  std::int64_t newest_seen_ns = 0;
-  // The twin's own count of the periods it published.
-  std::uint64_t published = 0;
-  // The peer's identity as last seen, and since when a changed pid awaits its new session.
-  std::uint32_t peer_sessions = 0;
-  std::int32_t peer_pid = 0;
-  std::int64_t pid_changed_ns = -1;
-  // What this side last stored in its own stop_cause.
-  std::uint32_t own_stop_cause = 0;
-
- private:
-  std::string path_;
-  const char* reason_ = nullptr;
-  std::array<char, 512> text_{};
-};
 
 namespace {
 
@@ -167,7 +122,7 @@ class WireBus::PwmWire final : public PwmSignalSource {
 /// Twin side: publishes the board's emulator periods into the ring. ECS side: reads them.
 class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSource {
  public:
-  EncoderWire(WireSegment& seg, WireGuard& guard, const kernel_glue::MonotonicClock& clock) noexcept
+  EncoderWire(WireSegment& seg, WireGuard& guard, const kernel_glue::Clock& clock) noexcept
       : seg_(seg), guard_(guard), clock_(clock) {}
 
   void OnPeriod(const std::array<PulseSegment, kChannels>& channels) noexcept override {
@@ -270,7 +225,7 @@ class WireBus::EncoderWire final : public EncoderLineSink, public EncoderLineSou
 
   WireSegment& seg_;
   WireGuard& guard_;
-  const kernel_glue::MonotonicClock& clock_;
+  const kernel_glue::Clock& clock_;  ///< the board's clock (wall or lockstep)
   std::int64_t now_ns_ = 0;  ///< the ECS board's time at its current read of the lines
 };
 
@@ -496,11 +451,41 @@ bool LayOutOrCheck(WireSegment& segment) {
 
 }  // namespace
 
-WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board_image)
+const char* ClockFlagWord(WireClock clock) noexcept {
+  return clock == WireClock::kLockstep ? "virtual" : "realtime";
+}
+
+namespace {
+
+std::uint32_t ClockCode(WireClock clock) noexcept {
+  return clock == WireClock::kLockstep ? kClockLockstep : kClockRealtime;
+}
+
+/// The refusal of a peer on the other clock, seen from the twin or the ECS running `own`.
+const char* MismatchMessage(bool ecs_side, WireClock own) noexcept {
+  static constexpr const char* kText[2][2] = {
+      {"wire: the ECS on this wire runs --clock virtual and this twin --clock realtime; start "
+       "both sides with the same --clock",
+       "wire: the ECS on this wire runs --clock realtime and this twin --clock virtual "
+       "(lockstep); start both sides with the same --clock"},
+      {"wire: the twin on this wire runs --clock virtual and this ECS --clock realtime; start "
+       "both sides with the same --clock",
+       "wire: the twin on this wire runs --clock realtime and this ECS --clock virtual "
+       "(lockstep); start both sides with the same --clock"}};
+  return kText[ecs_side ? 1 : 0][own == WireClock::kLockstep ? 1 : 0];
+}
+
+}  // namespace
+
+WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board_image,
+                 WireClock clock)
     : label_("wire:" + name),
       segment_name_(SegmentName(name)),
       side_(side),
-      board_(board_image.value_or(side), &clock_),
+      clock_kind_(clock),
+      lockstep_(clock == WireClock::kLockstep ? std::make_unique<LockstepClock>(*this) : nullptr),
+      board_clock_(lockstep_ ? static_cast<const kernel_glue::Clock*>(lockstep_.get()) : &wall_),
+      board_(board_image.value_or(side), board_clock_),
       pid_(static_cast<std::int32_t>(::getpid())),
       guard_(std::make_unique<WireGuard>(SegmentPath(name))) {
   segment_ = MapSegment(segment_name_, label_);
@@ -510,14 +495,20 @@ WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board
     throw std::runtime_error("shared memory /dev/shm" + segment_name_ + " is not a hiltwin wire " +
                              "of this version; remove /dev/shm" + segment_name_ + " and retry");
   }
+  if (ClockMismatch().result != BusResult::kOk) {
+    const std::string why = ClockMismatch().reason;
+    ::munmap(segment_, sizeof(WireSegment));
+    segment_ = nullptr;
+    throw std::invalid_argument(why.substr(6));  // without "wire: ": the caller names the wire
+  }
   Attach();
   pwm_wire_ = std::make_unique<PwmWire>(*segment_, *guard_);
-  encoder_wire_ = std::make_unique<EncoderWire>(*segment_, *guard_, clock_);
+  encoder_wire_ = std::make_unique<EncoderWire>(*segment_, *guard_, *board_clock_);
   const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
   guard_->peer_sessions = peer.sessions.load();
   guard_->peer_pid = peer.pid.load();
   guard_->newest_seen = segment_->encoder_newest.load();
-  guard_->newest_seen_ns = clock_.NowNs();
+  guard_->newest_seen_ns = board_clock_->NowNs();
   guard_->published = guard_->newest_seen;
   if (side_ == Image::kIcoboardInverse) {
     segment_->twin_sampling_ns.store(kNotSampling);  // a crashed twin may have left it set
@@ -526,6 +517,23 @@ WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board
   } else {
     board_.SetEncoderSource(encoder_wire_.get());
   }
+}
+
+kernel_glue::Clock* WireBus::lockstep_clock() noexcept { return lockstep_.get(); }
+
+LockstepCounts WireBus::lockstep_counts() const noexcept {
+  return lockstep_ ? lockstep_->counts() : LockstepCounts{};
+}
+
+BusStatus WireBus::ClockMismatch() const noexcept {
+  const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
+  const std::uint32_t peer_clock = peer.clock.load(std::memory_order_acquire);
+  const std::int32_t peer_pid = peer.pid.load(std::memory_order_relaxed);
+  // Only a peer that is there now counts: a stale entry of one that left says nothing.
+  const bool present = peer.attached.load(std::memory_order_acquire) == 1 && peer_pid > 0 &&
+                       ProcessAlive(peer_pid);
+  if (!present || peer_clock == kClockUnset || peer_clock == ClockCode(clock_kind_)) return {};
+  return {BusResult::kPeerMismatch, MismatchMessage(side_ == Image::kIcoboard, clock_kind_)};
 }
 
 void WireBus::Attach() {
@@ -547,6 +555,8 @@ void WireBus::Attach() {
     peer.attached.store(0);
     peer.sessions.store(0);
     peer.stop_cause.store(0);
+    peer.clock.store(kClockUnset);
+    peer.lockstep_ns.store(0);
     // A new peer stores its pid before its flags: if one arrived while these were cleared,
     // give its presence back.
     if (peer.pid.load() != 0) {
@@ -557,6 +567,8 @@ void WireBus::Attach() {
   self.pid.store(pid_);
   self.stop_cause.store(static_cast<std::uint32_t>(StopCause::kNone));
   self.step_ns.store(0);
+  self.clock.store(ClockCode(clock_kind_));
+  self.lockstep_ns.store(0);  // lockstep: its set-up happens at time 0, before its first wait
   self.last_beat_ns.store(kNoBeatYet);  // up at its first beat (Poll or a transfer)
   self.attached.store(1);
   self.sessions.fetch_add(1);
@@ -567,6 +579,7 @@ WireBus::~WireBus() {
   if (segment_ == nullptr) return;
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
   const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
+  if (lockstep_) lockstep_->Leave();  // a peer waiting for this side's turn goes on
   self.attached.store(0);
   segment_->attach_count.fetch_sub(1);
   // The last one out removes the segment. A peer that crashed never detached, so its pid is
@@ -603,7 +616,7 @@ void WireBus::Beat(std::int64_t now_ns) noexcept {
 }
 
 BusStatus WireBus::Poll() noexcept {
-  const std::int64_t now_ns = clock_.NowNs();
+  const std::int64_t now_ns = wall_.NowNs();
   CheckSegment(now_ns);
   Beat(now_ns);
   return Status();
@@ -613,6 +626,8 @@ void WireBus::AnnounceStop(StopCause cause) noexcept {
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
   guard_->own_stop_cause = static_cast<std::uint32_t>(cause);
   self.stop_cause.store(static_cast<std::uint32_t>(cause), std::memory_order_release);
+  // After the cause: a peer released by this leave reads why at its next exchange.
+  if (lockstep_) lockstep_->Leave();
 }
 
 bool WireBus::CheckSegment(std::int64_t now_ns) noexcept {
@@ -632,24 +647,35 @@ bool WireBus::CheckSegment(std::int64_t now_ns) noexcept {
   }
   const std::int32_t own_pid = self.pid.load(std::memory_order_relaxed);
   const std::uint32_t own_cause = self.stop_cause.load(std::memory_order_relaxed);
+  const std::uint32_t own_clock = self.clock.load(std::memory_order_relaxed);
+  // Only this side writes its lockstep time (in real time it stays 0 from the attach).
+  const std::int64_t own_lockstep_ns = self.lockstep_ns.load(std::memory_order_relaxed);
   if (own_pid != pid_ || self.attached.load(std::memory_order_relaxed) != 1 ||
-      own_cause != guard.own_stop_cause) {
+      own_cause != guard.own_stop_cause || own_clock != ClockCode(clock_kind_) ||
+      own_lockstep_ns != guard.own_lockstep_ns) {
     guard.Fail("wire: this side's own entry was overwritten (pid %d, expected %d; stop cause %u, "
-               "expected %u)",
-               own_pid, pid_, own_cause, guard.own_stop_cause);
+               "expected %u; clock %u, expected %u; lockstep time %lld, expected %lld)",
+               own_pid, pid_, own_cause, guard.own_stop_cause, own_clock,
+               ClockCode(clock_kind_), static_cast<long long>(own_lockstep_ns),
+               static_cast<long long>(guard.own_lockstep_ns));
     return false;
   }
   const std::uint32_t cause = peer.stop_cause.load(std::memory_order_relaxed);
   const std::uint32_t attached = peer.attached.load(std::memory_order_relaxed);
   const std::int64_t step_ns = peer.step_ns.load(std::memory_order_relaxed);
   const std::int64_t beat_ns = peer.last_beat_ns.load(std::memory_order_relaxed);
-  if (beat_ns > now_ns + kFutureSlackNs) now_ns = clock_.NowNs();  // preempted since now_ns?
+  if (beat_ns > now_ns + kFutureSlackNs) now_ns = wall_.NowNs();  // preempted since now_ns?
+  const std::uint32_t peer_clock = peer.clock.load(std::memory_order_relaxed);
+  const std::int64_t peer_lockstep_ns = peer.lockstep_ns.load(std::memory_order_relaxed);
   if (cause > kLastStopCause || attached > 1 || step_ns < 0 || step_ns > kMaxStepNs ||
-      beat_ns < 0 || beat_ns > now_ns + kFutureSlackNs) {
+      beat_ns < 0 || beat_ns > now_ns + kFutureSlackNs || peer_clock > kClockLockstep ||
+      peer_lockstep_ns < kLockstepRunning) {
     guard.Fail("wire: the %s's entry holds impossible values (stop cause %u, attached %u, step "
-               "%lld ns, heartbeat at %lld ns with this clock at %lld ns)",
+               "%lld ns, heartbeat at %lld ns with this clock at %lld ns, clock %u, lockstep "
+               "time %lld ns)",
                peer_name, cause, attached, static_cast<long long>(step_ns),
-               static_cast<long long>(beat_ns), static_cast<long long>(now_ns));
+               static_cast<long long>(beat_ns), static_cast<long long>(now_ns), peer_clock,
+               static_cast<long long>(peer_lockstep_ns));
     return false;
   }
   return CheckPeerIdentity(now_ns);
@@ -692,6 +718,12 @@ bool WireBus::CheckPeerIdentity(std::int64_t now_ns) noexcept {
 
 BusStatus WireBus::Status() const noexcept {
   if (!guard_->ok()) return {BusResult::kWireCorrupted, guard_->reason()};
+  if (lockstep_ && lockstep_->broken() != nullptr) {
+    return {BusResult::kPeerLost, lockstep_->broken()};
+  }
+  if (const BusStatus mismatch = ClockMismatch(); mismatch.result != BusResult::kOk) {
+    return mismatch;
+  }
   return PeerStatus();
 }
 
@@ -722,7 +754,7 @@ BusStatus WireBus::PeerStatus() const noexcept {
   std::int64_t timeout_ns = 20 * step_ns;
   if (timeout_ns < kWireMinHeartbeatTimeoutNs) timeout_ns = kWireMinHeartbeatTimeoutNs;
   // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
-  if (beat_ns < 0 || clock_.NowNs() - beat_ns > timeout_ns) {
+  if (beat_ns < 0 || wall_.NowNs() - beat_ns > timeout_ns) {
     return {BusResult::kPeerLost,
             ecs_side ? "wire: the twin process stopped updating its heartbeat (crashed, hung or "
                        "killed); restart it, either side may start first"
@@ -738,7 +770,7 @@ BusStatus WireBus::RunOnBoard(Transfers&& transfers) noexcept {
   const bool twin = side_ == Image::kIcoboardInverse;
   // Nothing read from a segment that failed a check is used: no pins, idle PWM, held lines.
   std::array<bool, kChannels> pins{};
-  const bool clean = CheckSegment(clock_.NowNs());
+  const bool clean = CheckSegment(wall_.NowNs());
   if (clean && twin) {
     const std::uint64_t words = seg.pwm_words.load(std::memory_order_acquire);
     if (CheckPwmWords(words, guard_.get())) {
@@ -757,14 +789,14 @@ BusStatus WireBus::RunOnBoard(Transfers&& transfers) noexcept {
   // The board samples (and publishes its period) while acting on the request; the fetch's NOOP
   // changes nothing on the wire, so one window around both keeps the ECS's replay bound valid.
   if (twin) {
-    seg.twin_sampling_ns.store(clock_.NowNs(), std::memory_order_seq_cst);
+    seg.twin_sampling_ns.store(board_clock_->NowNs(), std::memory_order_seq_cst);
     // The board's clock reads in transfers() come after the store is visible (arm64 may
     // otherwise read the clock while the store still waits in its buffer).
     FenceAgainstClockReads();
   }
   transfers();
   if (twin) seg.twin_sampling_ns.store(kNotSampling, std::memory_order_seq_cst);
-  Publish(clock_.NowNs());
+  Publish(wall_.NowNs());
   return Status();
 }
 
@@ -781,7 +813,7 @@ BusStatus WireBus::TransferPair(const FrameBytes& request, FrameBytes& request_m
 }
 
 bool WireBus::ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept {
-  return encoder_wire_->Peek(index, clock_.NowNs(), out);
+  return encoder_wire_->Peek(index, board_clock_->NowNs(), out);
 }
 
 }  // namespace hiltwin::io

@@ -24,7 +24,9 @@
 namespace hiltwin::runtime {
 namespace {
 
+/// The loop's own clock; null when it runs on the link's lockstep clock.
 std::unique_ptr<kernel_glue::Clock> MakeClock(const SessionConfig& config) {
+  if (config.lockstep_clock != nullptr) return nullptr;
   if (config.clock == ClockKind::kRealtime) return std::make_unique<kernel_glue::MonotonicClock>();
   if (config.virtual_costs.wake_latency_ns.empty()) {
     return std::make_unique<kernel_glue::VirtualClock>();
@@ -147,6 +149,20 @@ void CheckConfig(const SessionConfig& config) {
   }
   config.injector.CheckFiresWithin(planned);
   CheckVirtualCosts(config);
+  if (config.lockstep_clock != nullptr) {
+    if (config.clock != ClockKind::kVirtual || !config.lockstep_clock->IsVirtual()) {
+      throw std::invalid_argument("a lockstep clock is a virtual clock: it needs ClockKind::kVirtual");
+    }
+    if (!config.peer || config.peer->timeout_s == 0.0) {
+      // The time base starts when both sides are there: a side that ran ahead alone would
+      // begin the shared time where the other cannot follow.
+      throw std::invalid_argument("a lockstep run waits for its peer before its first cycle: "
+                                  "give the wait a timeout above 0 s");
+    }
+    if (!config.virtual_costs.empty()) {
+      throw std::invalid_argument("virtual cycle costs do not apply to a lockstep clock");
+    }
+  }
   if (config.peer && (config.peer->link == nullptr || !(config.peer->timeout_s >= 0.0))) {
     throw std::invalid_argument("waiting for the peer needs a link and a timeout of 0 s or more");
   }
@@ -174,7 +190,8 @@ struct RunSession::LoopResult {
 RunSession::RunSession(SessionConfig config, RunTask& task)
     : config_((CheckConfig(config), std::move(config))),  // checked before anything is built
       task_(task),
-      clock_(MakeClock(config_)),
+      own_clock_(MakeClock(config_)),
+      clock_(own_clock_ ? own_clock_.get() : config_.lockstep_clock),
       monitor_(config_.qos),
       executive_(*clock_, config_.executive),
       allowed_cpus_(kernel_glue::AllowedCpus()) {
@@ -359,6 +376,13 @@ bool RunSession::WaitForPeer() {
       if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
       wait_peer_stopped_ = status.reason;
       HandleTraced(lifecycle_, lifecycle::Event::kPeerStopped, 0);
+      return false;
+    }
+    if (status.result == io::BusResult::kPeerMismatch) {
+      // A peer on the other clock came: refused at once, it will not change its mind.
+      if (shown_s >= 0 && config_.progress) std::fputc('\n', stderr);
+      wait_fault_ = RunFault{lifecycle::StopReason::kIoFault, 0, status.reason};
+      HandleTraced(lifecycle_, lifecycle::Event::kIoFault, 0);
       return false;
     }
     const kernel_glue::TimeNs waited_ns = clock.NowNs() - start_ns;

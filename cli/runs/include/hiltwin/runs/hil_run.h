@@ -30,6 +30,7 @@ struct HilRunOptions {
   std::string log_dir;
   std::string wire;  ///< the wire's name (wire:NAME), checked; hil-<pid> without --wire
   double wait_peer_s = 10.0;
+  std::string clock = "realtime";  ///< realtime, or virtual: both sides in lockstep (checked)
   bool no_progress = false;
   /// Passed on: each side publishes under NS/twin and NS/controller; the twin serves --web.
   /// Checked.

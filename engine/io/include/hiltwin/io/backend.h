@@ -46,6 +46,9 @@ struct BackendOptions {
   /// mock, wire: the image the emulated board carries (default: side); fault injection
   std::optional<Image> mock_board_image;
   SpidevConfig spidev{};
+  /// wire: run in lockstep with the peer on one virtual time base (--clock virtual); the
+  /// backend's lockstep_clock() is then the clock the session must run on. Others: ignored.
+  bool lockstep = false;
 };
 
 /// An opened backend: owns its bus and, for mock and wire, the local emulated board.
@@ -58,6 +61,8 @@ class IoBackend {
   [[nodiscard]] virtual BackendSpec::Kind kind() const noexcept = 0;
   /// The process on the other end (wire); null when there is none to wait for (mock, spidev).
   [[nodiscard]] virtual PeerLink* peer_link() noexcept { return nullptr; }
+  /// The virtual clock this backend shares with its peer (wire in lockstep); null otherwise.
+  [[nodiscard]] virtual kernel_glue::Clock* lockstep_clock() noexcept { return nullptr; }
   /// Feeds the local twin board's PWM reader from `source` (mock: the emulated board,
   /// verilated: the RTL's PWM inputs). False when this backend has no such input.
   virtual bool AttachPwmSource(PwmSignalSource* source) noexcept {

@@ -22,6 +22,9 @@ enum class BusResult : std::uint8_t {
   /// wire: the shared segment held a value no hiltwin process writes (another process writes
   /// into it); nothing more is read from it. An I/O fault, but the local board still answered.
   kWireCorrupted,
+  /// wire: the peer runs on the other clock (one side --clock realtime, the other virtual);
+  /// refused, as an I/O fault, before anything is read from it.
+  kPeerMismatch,
 };
 [[nodiscard]] const char* ToString(BusResult result) noexcept;
 

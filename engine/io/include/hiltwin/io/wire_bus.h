@@ -25,6 +25,15 @@
 /// BusResult::kWireCorrupted with a message naming the field, after which this side reads
 /// nothing more from the wire (idle PWM, held encoder lines) and the run stops on an I/O fault
 /// with safe outputs (this side's own board still answers). docs/spi-protocol.md, wire:NAME.
+///
+/// Time: in real time (WireClock::kRealtime) both boards read CLOCK_MONOTONIC. In lockstep
+/// (WireClock::kLockstep, `--clock virtual` on both sides) the two processes share one virtual
+/// time base instead (docs/lockstep.md): the bus owns a clock (lockstep_clock()) that the
+/// session runs its loop on and both boards read, and a side that sleeps until its next release
+/// waits until the other side has run everything that comes earlier, so each side's cycle k
+/// happens at its release in that base, in a fixed order (at equal times the ECS first). The
+/// heartbeat stays in wall time, so a peer that hangs or dies still ends this side within a
+/// second. A side refuses a peer on the other clock: at attach, and while it waits to start.
 
 #include <cstdint>
 #include <memory>
@@ -49,6 +58,21 @@ constexpr std::int64_t kWireMinHeartbeatTimeoutNs = 250'000'000;
 /// Owner-only: the mode the segment is created with and must have when it exists.
 constexpr unsigned kWireSegmentMode = 0600;
 
+/// Which time base a wire side runs on; both sides of one wire must agree.
+enum class WireClock : std::uint8_t {
+  kRealtime,  ///< CLOCK_MONOTONIC (--clock realtime)
+  kLockstep,  ///< one virtual time base shared with the peer (--clock virtual)
+};
+/// "realtime" / "virtual": the --clock word that selects it, for messages.
+[[nodiscard]] const char* ClockFlagWord(WireClock clock) noexcept;
+
+/// What one side's lockstep clock counted (benchmarks, tests).
+struct LockstepCounts {
+  std::uint64_t waits = 0;          ///< SleepUntilNs/SpendNs calls that moved this side's time
+  std::uint64_t handovers = 0;      ///< of them: the peer held the turn first
+  std::uint64_t sleeps = 0;         ///< futex sleeps (a hand-over that outlasted the spin)
+};
+
 class WireBus final : public SpiBus, public PeerLink {
  public:
   /// Attaches to (or creates) the segment of `name` as the side that owns a board of `side`
@@ -57,7 +81,9 @@ class WireBus final : public SpiBus, public PeerLink {
   /// user with mode 0600, another layout, impossible contents) or that side is already attached
   /// by a live process. `board_image` (fault injection) is the image this side's emulated
   /// board carries, the side's own image when empty: the wrong one fails INIT's identity check.
-  WireBus(const std::string& name, Image side, std::optional<Image> board_image = {});
+  /// `clock`: the time base; a peer attached on the other one is refused (ClockMismatch).
+  WireBus(const std::string& name, Image side, std::optional<Image> board_image = {},
+          WireClock clock = WireClock::kRealtime);
   ~WireBus() override;
   WireBus(const WireBus&) = delete;
   WireBus& operator=(const WireBus&) = delete;
@@ -71,6 +97,9 @@ class WireBus final : public SpiBus, public PeerLink {
 
   /// This side's board model (fault injection, inspection).
   [[nodiscard]] EmulatedFpga& board() noexcept { return board_; }
+  /// Lockstep: the shared virtual clock the session must run its loop on; null in real time.
+  [[nodiscard]] kernel_glue::Clock* lockstep_clock() noexcept;
+  [[nodiscard]] LockstepCounts lockstep_counts() const noexcept;
   /// Heartbeat status of the other side right now (no transfer).
   [[nodiscard]] BusStatus PeerStatus() const noexcept;
   BusStatus Poll() noexcept override;
@@ -89,6 +118,7 @@ class WireBus final : public SpiBus, public PeerLink {
  private:
   class PwmWire;
   class EncoderWire;
+  class LockstepClock;
   /// Registers this side in the segment (refusing a second live process on it) and clears
   /// the flags of a peer that crashed without detaching.
   void Attach();
@@ -98,8 +128,10 @@ class WireBus final : public SpiBus, public PeerLink {
   bool CheckSegment(std::int64_t now_ns) noexcept;
   /// The peer's pid may change only with a new session (after a short settling time).
   bool CheckPeerIdentity(std::int64_t now_ns) noexcept;
-  /// This side's result: the latched corruption, else the peer's status.
+  /// This side's result: the latched corruption, a broken lockstep, else the peer's status.
   [[nodiscard]] BusStatus Status() const noexcept;
+  /// The peer's clock when it differs from this side's (kPeerMismatch), else kOk.
+  [[nodiscard]] BusStatus ClockMismatch() const noexcept;
   void Beat(std::int64_t now_ns) noexcept;
   /// Reads the digital inputs off the wire into the board, runs `transfers` (callable) inside
   /// the twin's sampling window, publishes and returns the peer's status.
@@ -109,7 +141,12 @@ class WireBus final : public SpiBus, public PeerLink {
   std::string label_;
   std::string segment_name_;
   Image side_;
-  kernel_glue::MonotonicClock clock_;
+  WireClock clock_kind_;
+  /// Wall time: heartbeats, liveness and the checks of the peer's wall-clock fields.
+  kernel_glue::MonotonicClock wall_;
+  std::unique_ptr<LockstepClock> lockstep_;  ///< lockstep only
+  /// What the board and the wire's time model read: wall_, or the lockstep clock.
+  const kernel_glue::Clock* board_clock_;
   EmulatedFpga board_;
   WireSegment* segment_ = nullptr;
   std::int32_t pid_ = 0;

@@ -16,8 +16,9 @@ namespace hiltwin::io {
 
 namespace wire {
 constexpr std::uint64_t kMagic = 0x6869'6C74'7769'7265ULL;  // "hiltwire"
-// 2: encoder periods in a ring; 3: stop causes; 4: seqlock slots of 64-bit words (no fences)
-constexpr std::uint32_t kLayoutVersion = 4;
+// 2: encoder periods in a ring; 3: stop causes; 4: seqlock slots of 64-bit words (no fences);
+// 5: each side's clock and the lockstep's turn words
+constexpr std::uint32_t kLayoutVersion = 5;
 constexpr std::uint32_t kFresh = 0;
 constexpr std::uint32_t kInitialising = 1;
 constexpr std::uint32_t kReady = 2;
@@ -31,6 +32,13 @@ constexpr std::int64_t kNotSampling = std::numeric_limits<std::int64_t>::max();
 /// Words of one encoder period: start_ns, subticks << 32 | divider, start_counts (4 × 16),
 /// pulses (4 × 16), directions (4 × 8).
 constexpr std::size_t kPeriodWords = 5;
+/// WireSide::clock: which time base a side runs on. 0 until it attaches.
+constexpr std::uint32_t kClockUnset = 0;
+constexpr std::uint32_t kClockRealtime = 1;  ///< CLOCK_MONOTONIC, each side on its own
+constexpr std::uint32_t kClockLockstep = 2;  ///< the shared virtual time base (--clock virtual)
+/// WireSide::lockstep_ns besides a virtual time (>= 0) the side waits for its turn at:
+constexpr std::int64_t kLockstepRunning = -1;  ///< it holds the turn: the time base stands still
+constexpr std::int64_t kLockstepLeft = std::numeric_limits<std::int64_t>::max();  ///< it stopped
 }  // namespace wire
 
 /// One process's presence on the wire.
@@ -42,6 +50,11 @@ struct WireSide {
   std::atomic<std::uint32_t> attached;
   std::atomic<std::uint32_t> sessions;
   std::atomic<std::uint32_t> stop_cause;  ///< a StopCause; kNone while running
+  std::atomic<std::uint32_t> clock;       ///< wire::kClockRealtime or kClockLockstep
+  /// Lockstep only: the virtual time of this side's next event while it waits for its turn,
+  /// wire::kLockstepRunning while it runs, wire::kLockstepLeft once it stopped. 0 from its
+  /// attach until its loop waits for the first release: its set-up happens at time 0.
+  std::atomic<std::int64_t> lockstep_ns;
 };
 
 /// One encoder period in the ring: a single-writer seqlock whose tag is the period's index.
@@ -65,6 +78,10 @@ struct WireSegment {
   /// period it is about to publish starts no earlier, so the ECS replays edges only up to here.
   std::atomic<std::int64_t> twin_sampling_ns;
   WirePeriod encoder_periods[kEncoderLineHistory];
+  /// Lockstep: bumped whenever a side publishes a new lockstep_ns; the futex word a side
+  /// sleeps on while the other holds the turn (kernel_glue/shared_wait.h).
+  std::atomic<std::uint32_t> lockstep_turns;
+  std::atomic<std::uint32_t> lockstep_sleepers;  ///< sides asleep on lockstep_turns
 };
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&
                   std::atomic<std::int64_t>::is_always_lock_free &&

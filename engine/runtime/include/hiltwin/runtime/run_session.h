@@ -81,6 +81,10 @@ struct SessionConfig {
   TelemetryConfig telemetry;
   /// Set when the link has a process on its other end (wire); empty otherwise.
   std::optional<PeerWait> peer;
+  /// The virtual clock the link shares with its peer (a wire in lockstep, not owned): the
+  /// loop runs on it instead of a VirtualClock of its own. Needs ClockKind::kVirtual, a peer
+  /// to wait for, and no virtual costs (the peer's time would not be charged them).
+  kernel_glue::Clock* lockstep_clock = nullptr;
   /// Called on the control thread once the loop thread is set up, before the first cycle:
   /// the RT set-up record (null on the virtual clock). For the command's start-up lines.
   std::function<void(const kernel_glue::RtSetupRecord*)> on_ready;
@@ -140,7 +144,8 @@ class RunSession {
 
   SessionConfig config_;
   RunTask& task_;
-  std::unique_ptr<kernel_glue::Clock> clock_;
+  std::unique_ptr<kernel_glue::Clock> own_clock_;  ///< null on a lockstep clock
+  kernel_glue::Clock* clock_;                       ///< the loop's clock
   lifecycle::Lifecycle lifecycle_;
   qos::QosMonitor monitor_;
   scheduler::Executive executive_;

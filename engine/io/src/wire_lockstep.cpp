@@ -1,0 +1,141 @@
+#include "wire_lockstep.h"
+
+#include <atomic>
+
+#include "hiltwin/kernel_glue/shared_wait.h"
+#include "wire_guard.h"
+
+namespace hiltwin::io {
+
+namespace {
+
+/// Why the lockstep broke, seen from the twin (column 0) or the ECS (column 1).
+constexpr const char* kPeerGone[2] = {
+    "wire: lockstep: the ECS process is gone (killed or crashed) while this twin waited for "
+    "its turn; outputs went safe: restart both sides",
+    "wire: lockstep: the twin process is gone (killed or crashed) while this ECS waited for "
+    "its turn; outputs went safe: restart both sides"};
+constexpr const char* kPeerHung[2] = {
+    "wire: lockstep: the ECS stopped taking its turns (hung, stopped with SIGSTOP, or lost its "
+    "heartbeat) while this twin waited; outputs went safe: restart both sides",
+    "wire: lockstep: the twin stopped taking its turns (hung, stopped with SIGSTOP, or lost its "
+    "heartbeat) while this ECS waited; outputs went safe: restart both sides"};
+constexpr const char* kPeerNew[2] = {
+    "wire: lockstep: another ECS process took the wire during the run; a lockstep run cannot "
+    "take a new peer: restart both sides",
+    "wire: lockstep: another twin process took the wire during the run; a lockstep run cannot "
+    "take a new peer: restart both sides"};
+
+}  // namespace
+
+WireBus::LockstepClock::LockstepClock(WireBus& bus) noexcept
+    : bus_(bus), ecs_side_(bus.side_ == Image::kIcoboard) {}
+
+WireSide& WireBus::LockstepClock::self() noexcept {
+  return ecs_side_ ? bus_.segment_->ecs : bus_.segment_->twin;
+}
+
+const WireSide& WireBus::LockstepClock::peer() const noexcept {
+  return ecs_side_ ? bus_.segment_->twin : bus_.segment_->ecs;
+}
+
+void WireBus::LockstepClock::Publish(std::int64_t value) noexcept {
+  WireSegment& seg = *bus_.segment_;
+  bus_.guard_->own_lockstep_ns = value;
+  self().lockstep_ns.store(value, std::memory_order_seq_cst);
+  if (value == wire::kLockstepRunning) return;  // nobody waits for a side to take its turn
+  // The peer sleeps only after counting itself in lockstep_sleepers and reading
+  // lockstep_turns: either it sees this bump (and does not sleep) or this side sees it counted.
+  seg.lockstep_turns.fetch_add(1, std::memory_order_seq_cst);
+  if (seg.lockstep_sleepers.load(std::memory_order_seq_cst) != 0) {
+    kernel_glue::SharedWakeAll(seg.lockstep_turns);
+  }
+}
+
+void WireBus::LockstepClock::Leave() noexcept {
+  if (bus_.guard_->own_lockstep_ns != wire::kLockstepLeft) Publish(wire::kLockstepLeft);
+}
+
+bool WireBus::LockstepClock::MayRun(kernel_glue::TimeNs t_ns, std::int64_t peer_ns) noexcept {
+  if (peer_ns == wire::kLockstepLeft) return true;
+  if (peer_ns == wire::kLockstepRunning) return false;
+  if (peer_ns < 0) {
+    bus_.guard_->Fail("wire: the %s's lockstep time is %lld ns (a time >= 0, -1 or the largest)",
+                      ecs_side_ ? "twin" : "ECS", static_cast<long long>(peer_ns));
+    return true;  // nothing more is read from the wire; the exchange reports the corruption
+  }
+  return peer_ns > t_ns || (peer_ns == t_ns && ecs_side_);
+}
+
+bool WireBus::LockstepClock::PeerStillTakingTurns() noexcept {
+  const kernel_glue::TimeNs wall_ns = bus_.wall_.NowNs();
+  if (!bus_.CheckSegment(wall_ns)) return false;
+  bus_.Beat(wall_ns);  // the peer may be asleep on this side: keep this side's presence fresh
+  const int column = ecs_side_ ? 1 : 0;
+  const std::int32_t pid = peer().pid.load(std::memory_order_relaxed);
+  if (pid > 0 && !ProcessAlive(pid)) {
+    broken_ = kPeerGone[column];
+    return false;
+  }
+  switch (bus_.PeerStatus().result) {
+    case BusResult::kOk:
+      if (peer().sessions.load(std::memory_order_relaxed) != peer_sessions_) {
+        broken_ = kPeerNew[column];
+        return false;
+      }
+      return true;
+    case BusResult::kPeerStopped:
+      return false;  // it ended: its next exchange says so; its time no longer holds this side
+    case BusResult::kPeerAbsent:
+      broken_ = kPeerNew[column];
+      return false;
+    default:
+      broken_ = kPeerHung[column];
+      return false;
+  }
+}
+
+void WireBus::LockstepClock::WaitForTurn(kernel_glue::TimeNs t_ns) noexcept {
+  if (t_ns <= now_ns_) return;  // no time passes: this side keeps the turn it holds
+  ++counts_.waits;
+  if (broken_ != nullptr || !bus_.guard_->ok()) {
+    now_ns_ = t_ns;  // the lockstep is over; the next exchange reports why and the run ends
+    return;
+  }
+  // The loop's first wait: the peer is up (the session waited for it); a later session on
+  // the peer's side is another process, which a lockstep run cannot take.
+  if (counts_.waits == 1) peer_sessions_ = peer().sessions.load(std::memory_order_relaxed);
+  WireSegment& seg = *bus_.segment_;
+  Publish(t_ns);
+  bool handed_over = false;
+  kernel_glue::TimeNs waiting_since_ns = 0;
+  kernel_glue::TimeNs looked_ns = 0;  // when the peer was last looked at
+  for (;;) {
+    if (MayRun(t_ns, peer().lockstep_ns.load(std::memory_order_seq_cst))) break;
+    const kernel_glue::TimeNs wall_ns = bus_.wall_.NowNs();
+    if (!handed_over) {
+      handed_over = true;
+      ++counts_.handovers;
+      waiting_since_ns = looked_ns = wall_ns;
+    }
+    if (wall_ns - waiting_since_ns < kLockstepSpinNs) {
+      kernel_glue::SpinPause();
+      continue;
+    }
+    if (wall_ns - looked_ns >= kLockstepSliceNs) {
+      if (!PeerStillTakingTurns()) break;
+      looked_ns = wall_ns;
+    }
+    seg.lockstep_sleepers.fetch_add(1, std::memory_order_seq_cst);
+    const std::uint32_t seen = seg.lockstep_turns.load(std::memory_order_seq_cst);
+    if (!MayRun(t_ns, peer().lockstep_ns.load(std::memory_order_seq_cst))) {
+      ++counts_.sleeps;
+      kernel_glue::SharedWait(seg.lockstep_turns, seen, kLockstepSliceNs);
+    }
+    seg.lockstep_sleepers.fetch_sub(1, std::memory_order_seq_cst);
+  }
+  if (broken_ == nullptr && bus_.guard_->ok()) Publish(wire::kLockstepRunning);
+  now_ns_ = t_ns;
+}
+
+}  // namespace hiltwin::io
