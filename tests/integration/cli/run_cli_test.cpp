@@ -106,15 +106,25 @@ TEST_F(RunCli, VirtualClockWithoutInjectionPassesWithExactCycleCounts) {
 
 TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
   const std::string wire = "wire:hiltwin_run_solo_" + std::to_string(getpid());
-  // --wait-peer 0: start at once, without waiting for the controller.
-  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "0.1", "--io", wire,
-                               "--wait-peer", "0", "--report", Path("r.json")}));
+  // --wait-peer 0: start at once, without waiting for the controller (real time: a lockstep
+  // run always waits, see WaitPeerZeroInLockstepIsRefusedNamingBothFlags).
+  const auto r = Hiltwin(Args({"--duration", "0.1", "--io", wire, "--wait-peer", "0", "--report",
+                               Path("r.json")}));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["peer_absent_cycles"], 400);
   EXPECT_EQ(report["input"], "the controller on " + wire);
   EXPECT_NE(r.err.find("no controller was attached to " + wire + " in 400 of 400 cycles"),
             std::string::npos)
+      << r.err;
+}
+
+TEST_F(RunCli, WaitPeerZeroInLockstepIsRefusedNamingBothFlags) {
+  const std::string wire = "wire:hiltwin_run_solo_ls_" + std::to_string(getpid());
+  const auto r = Hiltwin(Args({"--clock", "virtual", "--duration", "0.1", "--io", wire,
+                               "--wait-peer", "0"}));
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("--wait-peer 0 with --clock virtual on " + wire), std::string::npos)
       << r.err;
 }
 

@@ -259,7 +259,7 @@ TEST_F(WireVandal, ASeqlockTornForeverIsALossNotAFaultOrAHang) {
 
 TEST_F(WireVandal, AChangedHeaderStopsBothSides) {
   vandal_->magic.store(0x1234);
-  ExpectEcsFault("the segment's header (state 2, magic 0x1234, version 4");
+  ExpectEcsFault("the segment's header (state 2, magic 0x1234, version 5");
   ExpectTwinFault("the segment's header");
 }
 
@@ -279,7 +279,7 @@ TEST_F(WireVandal, ThisSidesOwnEntryOverwrittenIsNoticed) {
                  std::to_string(::getpid()));
   vandal_->twin.stop_cause.store(3);  // a fake "aborted on its QoS policy" from the twin
   ExpectTwinFault("this side's own entry was overwritten (pid " + std::to_string(::getpid()) +
-                  ", expected " + std::to_string(::getpid()) + "; stop cause 3, expected 0)");
+                  ", expected " + std::to_string(::getpid()) + "; stop cause 3, expected 0;");
 }
 
 TEST_F(WireVandal, ImpossiblePeerEntriesAndPinBitsStopTheReader) {
