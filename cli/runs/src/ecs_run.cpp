@@ -5,6 +5,8 @@
 // wire:NAME`, spidev:/dev/spidev0.0 on the robot.
 #include "hiltwin/runs/ecs_run.h"
 
+#include <array>
+#include <charconv>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -80,6 +82,19 @@ std::unique_ptr<Ecs> BuildEcs(const EcsRunOptions& o, kernel_glue::TimeNs period
   return ecs;
 }
 
+/// "kp 100 duty/m, ki 1000 duty/(m s), kd 3 duty s/m, filter 0.005 s, limit 1": each number in
+/// its shortest form that reads back to the same double, so the report holds the exact gains.
+std::string DescribeGains(const PidGains& g) {
+  const auto exact = [](double value) {
+    std::array<char, 32> text{};
+    const auto end = std::to_chars(text.data(), text.data() + text.size(), value).ptr;
+    return std::string(text.data(), end);
+  };
+  return "kp " + exact(g.kp_duty_per_m) + " duty/m, ki " + exact(g.ki_duty_per_m_s) +
+         " duty/(m s), kd " + exact(g.kd_duty_s_per_m) + " duty s/m, filter " +
+         exact(g.derivative_filter_s) + " s, limit " + exact(g.duty_limit);
+}
+
 void PrintStartLines(const EcsRunOptions& o, std::uint64_t planned, const std::string& profile,
                      const kernel_glue::RtSetupRecord* rt) {
   std::fprintf(stdout,
@@ -120,6 +135,9 @@ int RunEcs(const EcsRunOptions& options) {
   runtime::SessionConfig config = MakeSessionConfig(o.session, role, *ecs->backend);
   config.task_name = "RELbot ECS";
   config.details = {{"mode", ToString(o.mode)}, {"profile", ecs->profile_name}};
+  // The gains the run used, to every digit: with the rates, profile and clock in the report,
+  // a lockstep result can be reproduced from the report alone (docs/lockstep.md).
+  if (o.mode == EcsMode::kClosedLoop) config.details.emplace_back("gains", DescribeGains(ecs->gains));
   config.on_ready = [o, planned, profile = ecs->profile_name](
                         const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, profile, rt);
