@@ -622,6 +622,13 @@ BusStatus WireBus::Poll() noexcept {
   return Status();
 }
 
+void WireBus::KeepAlive() noexcept {
+  if (!lockstep_) return;
+  WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
+  self.last_beat_ns.store(wall_.NowNs(), std::memory_order_relaxed);
+  self.heartbeat.fetch_add(1, std::memory_order_release);
+}
+
 void WireBus::AnnounceStop(StopCause cause) noexcept {
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
   guard_->own_stop_cause = static_cast<std::uint32_t>(cause);
@@ -753,6 +760,9 @@ BusStatus WireBus::PeerStatus() const noexcept {
   if (step_ns < 0 || step_ns > kMaxStepNs) step_ns = 0;  // garbage: CheckSegment reports it
   std::int64_t timeout_ns = 20 * step_ns;
   if (timeout_ns < kWireMinHeartbeatTimeoutNs) timeout_ns = kWireMinHeartbeatTimeoutNs;
+  if (lockstep_ && timeout_ns < kWireLockstepHeartbeatTimeoutNs) {
+    timeout_ns = kWireLockstepHeartbeatTimeoutNs;
+  }
   // A negative heartbeat is garbage (CheckSegment reports it) whose age would overflow: lost.
   if (beat_ns < 0 || wall_.NowNs() - beat_ns > timeout_ns) {
     return {BusResult::kPeerLost,

@@ -3,6 +3,7 @@
 #include <atomic>
 
 #include "hiltwin/kernel_glue/shared_wait.h"
+#include "hiltwin/kernel_glue/stop_signal.h"
 #include "wire_guard.h"
 
 namespace hiltwin::io {
@@ -124,6 +125,10 @@ void WireBus::LockstepClock::WaitForTurn(kernel_glue::TimeNs t_ns) noexcept {
     }
     if (wall_ns - looked_ns >= kLockstepSliceNs) {
       if (!PeerStillTakingTurns()) break;
+      // A stop signal ends a wait for a peer that is alive but does not take its turn (its
+      // loop stuck in a step): this side's cycle then stops the run. Out of turn, but a stop
+      // by signal lands at no fixed virtual time anyway.
+      if (kernel_glue::StopRequested()) break;
       looked_ns = wall_ns;
     }
     seg.lockstep_sleepers.fetch_add(1, std::memory_order_seq_cst);

@@ -22,7 +22,9 @@ namespace hiltwin::io {
 /// each slice it beats this side's heartbeat (wall time) and looks at the peer: a peer that
 /// stopped releases the wait (its stop is reported by the next exchange); a peer that is gone,
 /// hung or restarted breaks the lockstep (broken(): the bus then reports kPeerLost), so no
-/// wait outlasts the heartbeat timeout by more than a slice.
+/// wait outlasts the heartbeat timeout (kWireLockstepHeartbeatTimeoutNs: the peer's control
+/// thread beats for it while its loop is busy) by more than a slice. A stop signal ends a wait
+/// too, so a peer whose loop is stuck cannot hold this side forever.
 class WireBus::LockstepClock final : public kernel_glue::Clock {
  public:
   /// Spinning beyond this costs more than the futex sleep it avoids.

@@ -315,11 +315,13 @@ RunReport RunSession::Run() {
   HandleTraced(lifecycle_, lifecycle::Event::kStart, 0);
   result.go = true;
   result.changed.notify_all();
-  // The control thread's duty while the loop runs: forward signal commands every 100 ms and
-  // print the progress line every 300 ms.
+  // The control thread's duty while the loop runs: keep this process's presence on the link
+  // fresh (a lockstep loop may wait long for its log writer), forward signal commands every
+  // 100 ms and print the progress line every 300 ms.
   const auto loop_done = [&] { return result.done; };
   for (int tick = 1; !result.changed.wait_for(lock, std::chrono::milliseconds(100), loop_done);
        ++tick) {
+    if (config_.peer) config_.peer->link->KeepAlive();
     if (config_.pause_signals) ForwardPauseSignal();
     if (config_.progress && tick % 3 == 0) PrintProgress();
   }

@@ -31,6 +31,10 @@ class PeerLink {
   /// After the last transfer: tells the peer that this side has stopped, and why. The peer's
   /// next transfer returns kPeerStopped with a message naming the cause.
   virtual void AnnounceStop(StopCause cause) noexcept = 0;
+  /// While the loop runs, from the control thread (every 100 ms): tells the peer this process
+  /// is alive even while its loop is busy between two transfers without a deadline, e.g. a
+  /// lockstep loop waiting for its log writer. Only atomics; safe beside the loop's transfers.
+  virtual void KeepAlive() noexcept {}
 };
 
 }  // namespace hiltwin::io

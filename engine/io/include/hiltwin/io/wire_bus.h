@@ -54,6 +54,11 @@ class WireGuard;
 /// that a SCHED_OTHER process on a loaded machine is not declared dead by a scheduling delay,
 /// short enough that a crash ends the other side well within a second.
 constexpr std::int64_t kWireMinHeartbeatTimeoutNs = 250'000'000;
+/// In lockstep a loop may be busy for long between transfers (it waits for its log writer
+/// rather than drop a row), so the process beats from its control thread every 100 ms
+/// (PeerLink::KeepAlive) and its peer allows this much: a SIGSTOP still ends the peer's wait
+/// within well under a second.
+constexpr std::int64_t kWireLockstepHeartbeatTimeoutNs = 500'000'000;
 
 /// Owner-only: the mode the segment is created with and must have when it exists.
 constexpr unsigned kWireSegmentMode = 0600;
@@ -104,6 +109,8 @@ class WireBus final : public SpiBus, public PeerLink {
   [[nodiscard]] BusStatus PeerStatus() const noexcept;
   BusStatus Poll() noexcept override;
   void AnnounceStop(StopCause cause) noexcept override;
+  /// Lockstep: beats (heartbeat atomics only). Real time: nothing, the transfers beat.
+  void KeepAlive() noexcept override;
   /// The twin emulator's period `index` as published on the wire (tests, diagnostics); false
   /// when it is not, or no longer, in the ring.
   [[nodiscard]] bool ReadEncoderPeriod(std::uint64_t index, EncoderPeriod& out) const noexcept;
