@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "fakes/alloc_counter.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/io/wire_segment.h"
@@ -108,6 +109,40 @@ TEST(WireLockstep, TurnsFollowTheVirtualTimesWithTheEcsFirstAtEqualTimes) {
   EXPECT_EQ(twin.lockstep_counts().waits, 4000U);
   EXPECT_EQ(ecs.lockstep_counts().waits, 1000U);
   EXPECT_GE(twin.lockstep_counts().handovers + ecs.lockstep_counts().handovers, 1000U);
+}
+
+// The lockstep wait is the loop's sleep: it runs on the real-time path, so it allocates nothing,
+// whether a hand-over is spun or slept on the futex (one side sleeps 30 ms per turn for a few
+// turns, so the other goes to the futex).
+TEST(WireLockstep, WaitsAndHandOversAllocateNothing) {
+  const std::string name = FreshName("alloc");
+  WireBus twin(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
+  WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
+  BringUp(twin, ecs);
+  std::uint64_t twin_allocations = ~std::uint64_t{0};
+  std::uint64_t ecs_allocations = ~std::uint64_t{0};
+  std::thread twin_thread([&] {
+    const test::ScopedAllocationCount count;
+    kernel_glue::Clock& clock = *twin.lockstep_clock();
+    for (TimeNs t = 250'000; t <= 100'000'000; t += 250'000) clock.SleepUntilNs(t);
+    twin_allocations = count.count();
+    twin.AnnounceStop(StopCause::kFinished);
+  });
+  std::thread ecs_thread([&] {
+    const test::ScopedAllocationCount count;
+    kernel_glue::Clock& clock = *ecs.lockstep_clock();
+    for (TimeNs t = 1'000'000; t <= 100'000'000; t += 1'000'000) {
+      clock.SleepUntilNs(t);
+      if (t <= 3'000'000) std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    }
+    ecs_allocations = count.count();
+    ecs.AnnounceStop(StopCause::kFinished);
+  });
+  twin_thread.join();
+  ecs_thread.join();
+  EXPECT_EQ(twin_allocations, 0U) << "malloc counted: " << test::MallocIsCounted();
+  EXPECT_EQ(ecs_allocations, 0U);
+  EXPECT_GT(twin.lockstep_counts().sleeps, 0U) << "the futex path was not taken";
 }
 
 TEST(WireLockstep, BusyTimeLetsThePeerRunWhatFallsInsideItFirst) {
