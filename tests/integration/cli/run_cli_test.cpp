@@ -110,7 +110,9 @@ TEST_F(RunCli, WireWithoutAControllerSaysSoInReportAndWarning) {
   // run always waits, see WaitPeerZeroInLockstepIsRefusedNamingBothFlags).
   const auto r = Hiltwin(Args({"--duration", "0.1", "--io", wire, "--wait-peer", "0", "--report",
                                Path("r.json")}));
-  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  // PASS, or FLAGGED when this shared machine stalled the real-time loop: the verdict is the
+  // machine's; what this test judges is the absent peer.
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.exit_code << r.out << r.err;
   const auto report = ReadJson(Path("r.json"));
   EXPECT_EQ(report["peer_absent_cycles"], 400);
   EXPECT_EQ(report["input"], "the controller on " + wire);
