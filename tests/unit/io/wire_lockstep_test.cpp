@@ -209,6 +209,15 @@ pid_t StartPollingEcs(const std::string& name) {
   return pid;
 }
 
+/// Polls until the peer is up (at most 10 s); true when it is.
+bool UpBeside(WireBus& bus) {
+  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
+  while (bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return bus.Poll().result == BusResult::kOk;
+}
+
 /// The twin waits for a turn the child ECS holds; `signal` reaches the child 200 ms into the
 /// wait. Returns how long the wait outlasted the signal.
 Wall::duration WaitWhileTheEcsGets(int signal, WireBus& twin, pid_t child) {
@@ -232,11 +241,7 @@ TEST(WireLockstep, AKilledPeerBreaksTheLockstepWithinASecond) {
   WireBus twin_bus(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
   const pid_t child = StartPollingEcs(name);
   ASSERT_GT(child, 0);
-  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
-  while (twin_bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  ASSERT_EQ(twin_bus.Poll().result, BusResult::kOk);
+  ASSERT_TRUE(UpBeside(twin_bus));
   IcoBoardInverse twin(twin_bus);
   ASSERT_TRUE(twin.Init(250'000).ok);
   const Wall::duration late = WaitWhileTheEcsGets(SIGKILL, twin_bus, child);
@@ -256,11 +261,7 @@ TEST(WireLockstep, AStoppedPeerThatStopsTakingTurnsBreaksTheLockstepWithinASecon
   WireBus twin_bus(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
   const pid_t child = StartPollingEcs(name);
   ASSERT_GT(child, 0);
-  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
-  while (twin_bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  ASSERT_EQ(twin_bus.Poll().result, BusResult::kOk);
+  ASSERT_TRUE(UpBeside(twin_bus));
   IcoBoardInverse twin(twin_bus);
   ASSERT_TRUE(twin.Init(250'000).ok);
   const Wall::duration late = WaitWhileTheEcsGets(SIGSTOP, twin_bus, child);
