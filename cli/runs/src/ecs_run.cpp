@@ -137,7 +137,9 @@ int RunEcs(const EcsRunOptions& options) {
   config.details = {{"mode", ToString(o.mode)}, {"profile", ecs->profile_name}};
   // The gains the run used, to every digit: with the rates, profile and clock in the report,
   // a lockstep result can be reproduced from the report alone (docs/lockstep.md).
-  if (o.mode == EcsMode::kClosedLoop) config.details.emplace_back("gains", DescribeGains(ecs->gains));
+  if (o.mode == EcsMode::kClosedLoop) {
+    config.details.emplace_back("gains", DescribeGains(ecs->gains));
+  }
   config.on_ready = [o, planned, profile = ecs->profile_name](
                         const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, profile, rt);

@@ -95,7 +95,8 @@ io::BackendOptions BackendOptionsFor(const SessionSettings& s, io::Image side) {
   options.side = side;
   options.mock_board_image = s.board_image;
   // On a wire the virtual clock is the one both sides share (lockstep, docs/lockstep.md).
-  options.lockstep = s.clock == runtime::ClockKind::kVirtual && s.io.kind == io::BackendSpec::Kind::kWire;
+  options.lockstep =
+      s.clock == runtime::ClockKind::kVirtual && s.io.kind == io::BackendSpec::Kind::kWire;
   return options;
 }
 
@@ -130,8 +131,9 @@ runtime::SessionConfig MakeSessionConfig(const SessionSettings& s, const Session
   config.progress = s.progress && isatty(STDERR_FILENO) == 1;
   config.pause_signals = true;  // kill -USR1 pauses, -USR2 resumes (documented in --help)
   if (io::PeerLink* link = backend.peer_link(); link != nullptr) {
+    const bool lockstep = s.clock == runtime::ClockKind::kVirtual;  // the peer must say so too
     const std::string start_hint = std::string(role.peer_command) + " --io " + s.io_text +
-                                   (s.clock == runtime::ClockKind::kVirtual ? " --clock virtual" : "");
+                                   (lockstep ? " --clock virtual" : "");
     config.peer = runtime::PeerWait{link, s.wait_peer_s, start_hint};
     config.lockstep_clock = backend.lockstep_clock();
     if (config.lockstep_clock != nullptr && s.wait_peer_s == 0.0) {

@@ -451,10 +451,6 @@ bool LayOutOrCheck(WireSegment& segment) {
 
 }  // namespace
 
-const char* ClockFlagWord(WireClock clock) noexcept {
-  return clock == WireClock::kLockstep ? "virtual" : "realtime";
-}
-
 namespace {
 
 std::uint32_t ClockCode(WireClock clock) noexcept {

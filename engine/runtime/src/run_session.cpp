@@ -151,7 +151,8 @@ void CheckConfig(const SessionConfig& config) {
   CheckVirtualCosts(config);
   if (config.lockstep_clock != nullptr) {
     if (config.clock != ClockKind::kVirtual || !config.lockstep_clock->IsVirtual()) {
-      throw std::invalid_argument("a lockstep clock is a virtual clock: it needs ClockKind::kVirtual");
+      throw std::invalid_argument(
+          "a lockstep clock is a virtual clock: it needs ClockKind::kVirtual");
     }
     if (!config.peer || config.peer->timeout_s == 0.0) {
       // The time base starts when both sides are there: a side that ran ahead alone would

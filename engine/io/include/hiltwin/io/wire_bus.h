@@ -68,14 +68,12 @@ enum class WireClock : std::uint8_t {
   kRealtime,  ///< CLOCK_MONOTONIC (--clock realtime)
   kLockstep,  ///< one virtual time base shared with the peer (--clock virtual)
 };
-/// "realtime" / "virtual": the --clock word that selects it, for messages.
-[[nodiscard]] const char* ClockFlagWord(WireClock clock) noexcept;
 
 /// What one side's lockstep clock counted (benchmarks, tests).
 struct LockstepCounts {
-  std::uint64_t waits = 0;          ///< SleepUntilNs/SpendNs calls that moved this side's time
-  std::uint64_t handovers = 0;      ///< of them: the peer held the turn first
-  std::uint64_t sleeps = 0;         ///< futex sleeps (a hand-over that outlasted the spin)
+  std::uint64_t waits = 0;      ///< SleepUntilNs/SpendNs calls that moved this side's time
+  std::uint64_t handovers = 0;  ///< of them: the peer held the turn first
+  std::uint64_t sleeps = 0;     ///< futex sleeps (a hand-over that outlasted the spin)
 };
 
 class WireBus final : public SpiBus, public PeerLink {
