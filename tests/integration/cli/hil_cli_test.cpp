@@ -1,13 +1,14 @@
 // Closed-loop HiL on one machine with two real processes (issue 10): `hiltwin hil` end to end,
 // and `hiltwin run` + `hiltwin ecs` side by side on a wire, where a stop, an abort or a crash on
 // one side must end the other within a second with a clear message, safe outputs and a report,
-// and no shared memory may be left behind. Wall-clock runs on a shared machine: the verdicts may
-// be FLAGGED (exit 3), so the tests assert the control and orchestration figures, not PASS.
+// and no shared memory may be left behind. HilCli: wall-clock runs on a shared machine, whose
+// verdicts may be FLAGGED (exit 3), so they assert the orchestration, not PASS nor tracking.
+// HilLockstep: the tracking judged on `hil --clock virtual` (issue 33), exactly; the rest of
+// lockstep is tests/integration/cli/lockstep_cli_test.cpp.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <filesystem>
@@ -90,40 +91,40 @@ class HilCli : public ::testing::Test {
   std::optional<hiltwin::kernel_glue::Process> ecs_;
 };
 
+// The tests that judge tracking run the pair in lockstep (hil --clock virtual, issue 33): both
+// processes on one virtual time base, so the figures are exact and repeatable and the bounds
+// are the thesis's own, with no allowance for a stall of this machine. Their suite is not
+// labelled rt.
+class HilLockstep : public HilCli {};
+
+/// One encoder count in metres (WheelGeometryOf(DefaultRelbotParams()): 0.0785 mm).
+constexpr double kCountM = 7.85e-5;
+
 // Thesis §7.2 and appendix E: the 2.5 m setpoint; each wheel's error stays below 3 mm and the
 // run ends without steady-state error.
-TEST_F(HilCli, ClosedLoopTracksTheThesisSetpointWithinThreeMillimetres) {
-  const auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--report", Path("hil.json"),
-                          "--log-dir", Path("logs")});
-  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
+TEST_F(HilLockstep, ClosedLoopTracksTheThesisSetpointWithinThreeMillimetres) {
+  const auto r = Hiltwin({"hil", "--clock", "virtual", "--wire", scratch_.WireName(),
+                          "--no-progress", "--report", Path("hil.json"), "--log-dir",
+                          Path("logs")});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;  // virtual time: no deadline is ever missed
   const auto hil = ReadJson(Path("hil.json"));
-  EXPECT_EQ(hil["exit_code"], r.exit_code);
-  // Below 3 mm, plus what the setpoint travels (at most 0.625 m/s) while a stall of this
-  // machine holds either loop: a KVM guest stalls both processes for milliseconds at times,
-  // which a Raspberry Pi with Xenomai does not (docs/RESULTS.md).
-  const double stall_s =
-      std::max(hil["twin"]["latency_ns"]["max"].get<double>(),
-               hil["ecs"]["latency_ns"]["max"].get<double>()) * 1e-9;
-  const double bound_m = 3e-3 + 0.625 * stall_s;
+  EXPECT_EQ(hil["exit_code"], 0);
   EXPECT_EQ(hil["link_errors"], 0) << hil["link_error_parts"].dump();
   EXPECT_GT(hil["tracking_error_rms_m"].get<double>(), 0.0);
-#if defined(__SANITIZE_THREAD__)
-  // Under ThreadSanitizer both processes run several times slower: the ECS misses deadlines in
-  // runs ((1,2)-firm violated), and what the loop then tracks says nothing of the controller.
-  // The race check is the point of that build; the accuracy is checked in the others.
-  GTEST_SKIP() << "tracking accuracy is not judged under ThreadSanitizer (max error "
-               << hil["tracking_error_max_m"]["left"].get<double>() << " m, bound " << bound_m
-               << " m)";
-#endif
-  EXPECT_LT(hil["tracking_error_max_m"]["left"].get<double>(), bound_m) << hil.dump(1);
-  EXPECT_LT(hil["tracking_error_max_m"]["right"].get<double>(), bound_m);
+  EXPECT_LT(hil["tracking_error_max_m"]["left"].get<double>(), 3e-3) << hil.dump(1);
+  EXPECT_LT(hil["tracking_error_max_m"]["right"].get<double>(), 3e-3);
   EXPECT_LT(hil["tracking_error_rms_m"].get<double>(), 1e-3);
-  EXPECT_LT(hil["final_error_m"].get<double>(), 1e-4);  // about one encoder count (0.0785 mm)
+  EXPECT_LT(hil["final_error_m"].get<double>(), kCountM);  // rests on the count nearest 2.5 m
+  EXPECT_EQ(hil["ecs"]["clock"], "virtual");
+  EXPECT_EQ(hil["twin"]["clock"], "virtual");
   EXPECT_EQ(hil["ecs"]["stop_reason"], "finished");
+  EXPECT_EQ(hil["ecs"]["cycles_run"], 12'000);
   EXPECT_EQ(hil["twin"]["stop_reason"], "peer_stopped");
   EXPECT_EQ(hil["twin"]["peer_stopped"], "wire: the ECS finished its run");
+  EXPECT_EQ(hil["twin"]["cycles_run"], 48'000);  // stopped at the ECS's 12 s exactly
   EXPECT_EQ(hil["twin"]["peer_absent_cycles"], 0);
-  // The twin really drove forward 2.5 m: its last logged wheel positions.
+  // The twin really drove forward 2.5 m: its last logged wheel positions (the model's, not
+  // the encoder's) within one count of it.
   std::ifstream twin_log(Path("logs/twin.csv"));
   std::string header;
   std::string line;
@@ -134,18 +135,20 @@ TEST_F(HilCli, ClosedLoopTracksTheThesisSetpointWithinThreeMillimetres) {
   std::vector<double> row;
   for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
   ASSERT_GE(row.size(), 5U) << header;
-  EXPECT_NEAR(row[3], 2.5, 0.005) << header;  // wheel_left_m
-  EXPECT_NEAR(row[4], 2.5, 0.005) << header;  // wheel_right_m
+  EXPECT_NEAR(row[3], 2.5, kCountM) << header;  // wheel_left_m
+  EXPECT_NEAR(row[4], 2.5, kCountM) << header;  // wheel_right_m
   EXPECT_NE(r.out.find("tracking  max |error| left"), std::string::npos) << r.out;
 }
 
 // Thesis §5.2–5.3: the ECS plays `openloop` to the twin and logs duty and measured positions;
 // the logged duty replayed into the reference (virtual time, same model) must match the
-// twin's positions, with the twin's delay (below 2 ms) estimated and compensated.
-TEST_F(HilCli, OpenLoopTwinMatchesTheReferenceReplayOfTheLoggedDuty) {
-  auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--mode", "openloop", "--duration",
-                    "12", "--log-dir", Path("logs")});
-  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
+// twin's positions, with the twin's delay estimated and compensated. In lockstep the delay is
+// the loop's own (below one ECS period), the same in every run, and what is left once it is
+// compensated is the encoder's quantisation: less than one count.
+TEST_F(HilLockstep, OpenLoopTwinMatchesTheReferenceReplayOfTheLoggedDuty) {
+  auto r = Hiltwin({"hil", "--clock", "virtual", "--wire", scratch_.WireName(), "--no-progress",
+                    "--mode", "openloop", "--duration", "12", "--log-dir", Path("logs")});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   r = Hiltwin({"run", "--clock", "virtual", "--io", "mock", "--input", Path("logs/ecs.csv"),
                "--input-rate", "1000", "--rate", "4000", "--duration", "12", "--no-progress",
                "--log", Path("ref.csv")});
@@ -156,13 +159,42 @@ TEST_F(HilCli, OpenLoopTwinMatchesTheReferenceReplayOfTheLoggedDuty) {
   const auto a = nlohmann::json::parse(r.out);
   const double delay_s = a["delay_s"].get<double>();
   EXPECT_GT(delay_s, 0.0) << a.dump(1);  // the twin lags the reference ...
-  EXPECT_LT(delay_s, 2e-3);              // ... by less than two ECS periods (thesis: 2 ms)
+  EXPECT_LT(delay_s, 1e-3);              // ... by less than one ECS period (measured 0.25 ms)
   const double raw_m = a["time_domain"]["e_t"].get<double>();
   const double compensated_m = a["time_domain_compensated"]["e_t"].get<double>();
   EXPECT_LT(compensated_m, raw_m);
-  EXPECT_LT(compensated_m, 1e-3);  // encoder counts are 0.0785 mm; stalls of this VM add spikes
-  EXPECT_GE(a["time_domain_compensated"]["eta"].get<double>(), 0.9999);
-  EXPECT_GE(a["time_domain"]["eta"].get<double>(), 0.9999);
+  EXPECT_LT(compensated_m, kCountM);  // measured 0.043 mm: the encoder's quantisation
+  EXPECT_GE(a["time_domain_compensated"]["eta"].get<double>(), 0.99999);
+  EXPECT_GE(a["time_domain"]["eta"].get<double>(), 0.99999);
+}
+
+// In real time the pair is not judged on tracking (a stall of a shared machine holds either
+// loop): both sides run their cycles at their rates, the twin stops when the controller
+// finishes, within a second of it, and the wire's segment is gone.
+TEST_F(HilCli, InRealTimeBothSidesRunTheirCyclesAndStopTogether) {
+  const auto r = Hiltwin({"hil", "--wire", scratch_.WireName(), "--no-progress", "--duration",
+                          "2", "--report", Path("hil.json"), "--log-dir", Path("logs")});
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;
+  const auto hil = ReadJson(Path("hil.json"));
+  const auto& twin = hil["twin"];
+  const auto& ecs = hil["ecs"];
+  EXPECT_EQ(twin["clock"], "realtime");
+  EXPECT_EQ(ecs["clock"], "realtime");
+  EXPECT_EQ(ecs["stop_reason"], "finished");
+  EXPECT_EQ(ecs["cycles_run"], 2'000);
+  EXPECT_EQ(ecs["log_rows_written"], 2'000);
+  EXPECT_EQ(ecs["peer_absent_cycles"], 0);
+  EXPECT_EQ(twin["stop_reason"], "peer_stopped");
+  EXPECT_EQ(twin["peer_stopped"], "wire: the ECS finished its run");
+  // 4 kHz while the controller's 2 s ran (about 8000), well short of its own 4 s.
+  EXPECT_GE(twin["cycles_run"].get<int>(), 6'000);
+  EXPECT_LT(twin["cycles_run"].get<int>(), 12'000);
+  EXPECT_EQ(twin["log_rows_written"], twin["cycles_run"]);
+  // The twin followed the controller's finish within a second.
+  EXPECT_LT(twin["wall_time_s"].get<double>(), ecs["wall_time_s"].get<double>() + 1.0);
+  EXPECT_EQ(twin["outputs_safe"], true);
+  EXPECT_EQ(ecs["outputs_safe"], true);
+  EXPECT_EQ(hil["link_errors"], 0) << hil["link_error_parts"].dump();
 }
 
 TEST_F(HilCli, AKilledControllerEndsTheTwinWithinASecondAsAnIoFault) {
