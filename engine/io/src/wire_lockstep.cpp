@@ -73,27 +73,23 @@ bool WireBus::LockstepClock::PeerStillTakingTurns() noexcept {
   if (!bus_.CheckSegment(wall_ns)) return false;
   bus_.Beat(wall_ns);  // the peer may be asleep on this side: keep this side's presence fresh
   const int column = ecs_side_ ? 1 : 0;
+  // Its announced stop first: a peer that stopped cleanly and exited is gone too, but it ended
+  // its run, it did not crash.
+  const BusResult status = bus_.PeerStatus().result;
+  if (status == BusResult::kPeerStopped) return false;  // its next exchange says why
   const std::int32_t pid = peer().pid.load(std::memory_order_relaxed);
   if (pid > 0 && !ProcessAlive(pid)) {
-    broken_ = kPeerGone[column];
+    // It may have announced its stop and exited since the status above: then it ended.
+    if (bus_.PeerStatus().result != BusResult::kPeerStopped) broken_ = kPeerGone[column];
     return false;
   }
-  switch (bus_.PeerStatus().result) {
-    case BusResult::kOk:
-      if (peer().sessions.load(std::memory_order_relaxed) != peer_sessions_) {
-        broken_ = kPeerNew[column];
-        return false;
-      }
-      return true;
-    case BusResult::kPeerStopped:
-      return false;  // it ended: its next exchange says so; its time no longer holds this side
-    case BusResult::kPeerAbsent:
-      broken_ = kPeerNew[column];
-      return false;
-    default:
-      broken_ = kPeerHung[column];
-      return false;
-  }
+  const bool same_peer = peer().sessions.load(std::memory_order_relaxed) == peer_sessions_;
+  if (status == BusResult::kOk && same_peer) return true;
+  // A new session, or a side attached but not beating yet: another process; else its
+  // heartbeat is stale (hung, SIGSTOP).
+  broken_ = status == BusResult::kOk || status == BusResult::kPeerAbsent ? kPeerNew[column]
+                                                                          : kPeerHung[column];
+  return false;
 }
 
 void WireBus::LockstepClock::WaitForTurn(kernel_glue::TimeNs t_ns) noexcept {
