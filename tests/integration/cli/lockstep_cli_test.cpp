@@ -605,31 +605,20 @@ TEST_P(LockstepFault, AHungPeerEndsTheOtherWithinASecondAsAnIoFault) {
                 FaultTheTwin() ? "lockstep: the twin stopped taking its turns"
                                : "lockstep: the ECS stopped taking its turns");
   // Continued, the hung side finds its peer ended and ends as well, outputs safe, the last one
-  // out removing the segment (killed instead, it could not, and the segment would stay). Its
-  // reason is peer_stopped, the peer having stopped on a fault; but when SIGSTOP caught it
-  // between reading the peer's lockstep time and reading the wall clock (a few instructions of
-  // the wait's spin, about 1 run in 10), it looks at the peer's pid before the peer's announced
-  // stop on resuming and ends as an I/O fault calling the peer "gone (killed or crashed)". That
-  // is a defect of the lockstep wait (WireBus::LockstepClock::PeerStillTakingTurns), not of
-  // this test: the outcome is checked either way, the message by which one it was.
+  // out removing the segment (killed instead, it could not, and the segment would stay): with
+  // peer_stopped, the peer having stopped on a fault. Whenever SIGSTOP caught it, even in the
+  // middle of the lockstep wait, it reads the peer's announced stop before the peer's pid.
   ASSERT_EQ(::kill(hung.pid(), SIGCONT), 0);
   const auto continued_at = SteadyClock::now();
   const auto [hung_status, hung_after_s] = EndOf(hung, continued_at);
   EXPECT_LT(hung_after_s, 1.0);
   const Json report = ReadJson(Path(FaultTheTwin() ? "twin.json" : "ecs.json"));
   EXPECT_EQ(report["outputs_safe"], true);
-  if (report["stop_reason"] == "peer_stopped") {
-    EXPECT_EQ(hung_status.code, 0) << hung_status.Describe();
-    EXPECT_EQ(report["peer_stopped"], FaultTheTwin()
-                                          ? "wire: the ECS stopped on a fault (see its report)"
-                                          : "wire: the twin stopped on a fault (see its report)");
-  } else {
-    EXPECT_EQ(hung_status.code, 5) << hung_status.Describe();
-    EXPECT_EQ(report["stop_reason"], "io_fault");
-    EXPECT_NE(report["fault"]["reason"].get<std::string>().find("process is gone"),
-              std::string::npos)
-        << report["fault"];
-  }
+  EXPECT_EQ(hung_status.code, 0) << hung_status.Describe() << report;
+  EXPECT_EQ(report["stop_reason"], "peer_stopped");
+  EXPECT_EQ(report["peer_stopped"], FaultTheTwin()
+                                        ? "wire: the ECS stopped on a fault (see its report)"
+                                        : "wire: the twin stopped on a fault (see its report)");
 }
 
 // A peer that never comes: one side alone with --wait-peer 1 ends as an I/O fault within 1 s
