@@ -191,7 +191,7 @@ class LockstepHil : public Lockstep {};
 TEST_F(LockstepHil, FiveRunsBesideACpuHogAreByteIdenticalButForWallTime) {
   ASSERT_TRUE(fs::exists("/usr/bin/stress-ng")) << "stress-ng is missing: scripts/setup.sh";
   auto hog =
-      hiltwin::test::Spawn({"/usr/bin/stress-ng", "--cpu", "2", "--timeout", "60", "--quiet"});
+      hiltwin::test::Spawn({"/usr/bin/stress-ng", "--cpu", "2", "--timeout", "600", "--quiet"});
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   struct Outcome {
     int exit_code;
