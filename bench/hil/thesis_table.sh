@@ -25,9 +25,11 @@ environment:
   COPY_TO            also copy the small files (reports, assess JSON, summary) to this folder
 outputs in OUT_DIR:
   table.md           the markdown table of docs/RESULTS.md
+  table51.md         Table 5.1 in detail: misses, longest run, worst wake-up latency
   summary.json       every figure of every run, with median, min, max and N per figure
   runs.csv           one row per run and figure
   lockstep_identical.txt   whether the two lockstep runs of each figure are identical
+  */openloop_*/rest_offset.csv   the twin's offset from the reference at each rest of the profile
 TEXT
 }
 [[ "${1:-}" == "-h" || "${1:-}" == "--help" ]] && { usage; exit 0; }
@@ -53,42 +55,53 @@ reference_and_assess() {  # DIR SECONDS
     --rate 4000 --duration "$s" --no-progress --log "$d/ref.csv" > "$d/ref.out"
   "$hiltwin" assess --sim "$d/ref.csv:wheel_right_m" --exp "$d/ecs.csv:wheel_right_m" \
     --max-delay 0.01 --json > "$d/assess.json"
-  offset_per_second "$d"
+  rest_offset "$d"
 }
 
-# offset.csv: per second of the run, the mean of (ECS-measured right wheel - reference right
-# wheel) and the twin's worst wake-up latency and misses in that second. Shows what a stall
-# does to the open loop.
-offset_per_second() {  # DIR
+# rest_offset.csv: the openloop profile holds the wheels still (zero duty) from 12.3 s to 13.0 s
+# of every 36 s repetition. At rest the twin's delay does not matter, so the twin's position
+# minus the reference's there is the offset the run has built up (nothing corrects it in open
+# loop). One row per repetition: the twin's own position (twin.csv) and the position the ECS
+# measured through the encoder lines (ecs.csv, whole counts of 0.0785 mm) against the reference,
+# and the twin's worst wake-up latency and misses since the previous rest.
+rest_offset() {  # DIR
   python3 - "$1" <<'PY'
-import csv, sys, math
+import sys
 d = sys.argv[1]
-ref = {}
-with open(f"{d}/ref.csv") as f:
-    r = csv.reader(f); h = next(r); ti = h.index("time_s"); wi = h.index("wheel_right_m")
-    for row in r:
-        k = round(float(row[ti]) * 4000)
-        if k % 4 == 0:
-            ref[k // 4] = float(row[wi])
-sec = {}
-with open(f"{d}/ecs.csv") as f:
-    r = csv.reader(f); h = next(r); ti = h.index("time_s"); wi = h.index("wheel_right_m")
-    for row in r:
-        t = float(row[ti]); k = round(t * 1000)
-        if k in ref:
-            s = sec.setdefault(int(math.floor(t + 1e-9)), [0.0, 0, 0.0, 0])
-            s[0] += float(row[wi]) - ref[k]; s[1] += 1
+T, A, B = 36.0, 12.4, 12.9
+def rest(path, rate):
+    out = {}
+    with open(path) as f:
+        h = f.readline().strip().split(","); ti = h.index("time_s"); wi = h.index("wheel_right_m")
+        for line in f:
+            p = line.split(",", wi + 1)
+            t = float(p[ti])
+            if A <= t % T <= B:
+                out[round(t * rate)] = float(p[wi])
+    return out
+ref = rest(f"{d}/ref.csv", 4000)
+def per_rep(vals, rate):
+    rep = {}
+    for k, v in vals.items():
+        kr = k * 4000 // rate
+        if kr in ref:
+            s = rep.setdefault(int((k / rate) // T), [0.0, 0]); s[0] += v - ref[kr]; s[1] += 1
+    return {k: 1e3 * s[0] / s[1] for k, s in rep.items()}
+twin = per_rep(rest(f"{d}/twin.csv", 4000), 4000)
+ecs = per_rep(rest(f"{d}/ecs.csv", 1000), 1000)
+lat, miss = {}, {}
 with open(f"{d}/twin.csv") as f:
-    r = csv.reader(f); h = next(r); ti = h.index("time_s"); li = h.index("latency_us"); mi = h.index("missed")
-    for row in r:
-        s = sec.setdefault(int(math.floor(float(row[ti]) - 1e-9)), [0.0, 0, 0.0, 0])
-        s[2] = max(s[2], float(row[li])); s[3] += int(float(row[mi]))
-with open(f"{d}/offset.csv", "w") as f:
-    f.write("second,mean_offset_mm,twin_worst_latency_ms,twin_misses\n")
-    for k in sorted(sec):
-        s = sec[k]
-        if s[1]:
-            f.write(f"{k},{1e3 * s[0] / s[1]:.4f},{s[2] / 1e3:.3f},{s[3]}\n")
+    h = f.readline().strip().split(","); ti = h.index("time_s"); li = h.index("latency_us"); mi = h.index("missed")
+    for line in f:
+        p = line.split(",")
+        k = int((float(p[ti]) - B) // T) + 1   # repetition whose rest this cycle precedes
+        l = float(p[li])
+        if l > lat.get(k, 0.0): lat[k] = l
+        if p[mi].strip() not in ("0", "0.0"): miss[k] = miss.get(k, 0) + 1
+with open(f"{d}/rest_offset.csv", "w") as f:
+    f.write("repetition,rest_s,twin_minus_reference_mm,ecs_measured_minus_reference_mm,twin_worst_latency_ms_since_last_rest,twin_misses_since_last_rest\n")
+    for k in sorted(twin):
+        f.write(f"{k},{k * T + A:.1f}-{k * T + B:.1f},{twin[k]:.4f},{ecs.get(k, float('nan')):.4f},{lat.get(k, 0.0) / 1e3:.3f},{miss.get(k, 0)}\n")
 PY
 }
 
@@ -152,8 +165,11 @@ if [[ "${SUMMARY_ONLY:-0}" != 1 ]]; then
 fi
 
 log "summary"
+for d in "$out"/lockstep/openloop_? "$out"/realtime/openloop_r*; do
+  if [[ -f "$d/assess.json" && ! -f "$d/rest_offset.csv" ]]; then rest_offset "$d"; fi
+done
 python3 - "$out" <<'PY'
-import csv, glob, hashlib, json, os, re, statistics, sys
+import csv, glob, hashlib, json, math, os, re, statistics, sys
 out = sys.argv[1]
 def load(p):
     with open(p) as f:
@@ -202,6 +218,8 @@ with open(f"{out}/lockstep_identical.txt", "w") as f:
     f.write("".join(f"{k}: {'IDENTICAL' if v else 'NOT IDENTICAL'}\n" for k, v in identical.items()))
 
 # --- per-run figures
+def load1(p):  # the 1-minute load average when the run started (other work on the machine)
+    return float(open(p).read().split()[0]) if os.path.exists(p) else float("nan")
 def finished(p):
     h = load(p)
     return h["exit_code"] in (0, 3) and h["ecs"]["stop_reason"] == "finished"
@@ -212,37 +230,39 @@ def openloop_figs(d):
     f = {
         "e_raw_m": td["e_t"], "e_comp_m": tc["e_t"], "delay_ms": 1e3 * a["delay_s"],
         "eta_raw": td["eta"], "eta_comp": tc["eta"], "range_m": td["eps_t"] / 0.05,
+        # the thesis's 5.6 threshold eps_t = 0.1854 m (K_e = 0.75), so the score compares like with like
+        "eta_raw_thesis_eps": 0.75 * 0.1854 / math.hypot(0.75 * 0.1854, td["e_t"]),
         "twin_misses": h["twin"]["deadline_misses"], "twin_cycles": h["twin"]["cycles_run"],
         "twin_worst_latency_ms": h["twin"]["latency_ns"]["max"] / 1e6,
         "edges": h["ecs"]["encoder_lines"]["edges"],
         "edge_errors": sum(h["ecs"]["encoder_lines"][k] for k in ("illegal_transitions", "too_fast_edges", "resyncs")),
         "link_errors": h["link_errors"],
+        "load1_at_start": load1(f"{d}/loadavg"),
     }
-    if os.path.exists(f"{d}/offset.csv"):
-        rows = list(csv.DictReader(open(f"{d}/offset.csv")))
-        offs = [float(r["mean_offset_mm"]) for r in rows]
-        f["offset_first_s_mm"] = offs[0]
-        f["offset_last_s_mm"] = offs[-1]
-        f["offset_max_abs_mm"] = max(abs(o) for o in offs)
-        # the largest jump of the per-second offset, and the twin's worst wake-up in that second
-        j = max(range(1, len(offs)), key=lambda i: abs(offs[i] - offs[i - 1]), default=0)
-        f["offset_biggest_jump_mm"] = offs[j] - offs[j - 1] if j else 0.0
-        f["offset_biggest_jump_at_s"] = int(rows[j]["second"])
-        f["offset_biggest_jump_twin_latency_ms"] = float(rows[j]["twin_worst_latency_ms"])
+    rest = list(csv.DictReader(open(f"{d}/rest_offset.csv"))) if os.path.exists(f"{d}/rest_offset.csv") else []
+    tw = [float(r["twin_minus_reference_mm"]) for r in rest]
+    if tw:
+        f["rest_offset_max_abs_mm"] = max(abs(o) for o in tw)
+        f["rest_offset_last_mm"] = tw[-1]
+        f["rest_offset_last_at"] = rest[-1]["rest_s"]
+        # how much the offset moved between consecutive rests: the largest step
+        f["rest_offset_biggest_step_mm"] = max((abs(tw[i] - tw[i - 1]) for i in range(1, len(tw))), default=0.0)
     return f
 def closedloop_figs(d):
     h = load(f"{d}/hil.json")
     return {
+        "max_mm": 1e3 * max(h["tracking_error_max_m"].values()),
         "max_left_mm": 1e3 * h["tracking_error_max_m"]["left"], "max_right_mm": 1e3 * h["tracking_error_max_m"]["right"],
         "rms_mm": 1e3 * h["tracking_error_rms_m"], "final_mm": 1e3 * h["final_error_m"],
         "twin_worst_latency_ms": h["twin"]["latency_ns"]["max"] / 1e6,
         "ecs_worst_latency_ms": h["ecs"]["latency_ns"]["max"] / 1e6,
+        "load1_at_start": load1(f"{d}/loadavg"),
     }
 def table51_figs(p):
     t = load(p)["twin"]
     return {"misses": t["deadline_misses"], "cycles": t["cycles_run"], "miss_pct": t["miss_pct"],
             "longest_run": t["max_consecutive_misses"], "worst_latency_ms": t["latency_ns"]["max"] / 1e6,
-            "verdict": t["verdict"]}
+            "verdict": t["verdict"], "load1_at_start": load1(p[:-len(".json")] + ".loadavg")}
 
 rows = {}   # figure -> list of (run, figs)
 for d in sorted(glob.glob(f"{out}/realtime/openloop_r*"), key=rnum):
@@ -305,8 +325,11 @@ T.append("|---|---|---|---|")
 T.append(f"| open-loop RMS position error, raw (§5.2) | {rt('openloop_realtime', 'e_raw_m', '%.3g', 1e3)} mm | {ls('openloop_lockstep', 'e_raw_m', '%.3g', 1e3)} mm | 0.922 mm |")
 T.append(f"| open-loop RMS position error, delay-compensated (§5.3) | {rt('openloop_realtime', 'e_comp_m', '%.3g', 1e3)} mm | {ls('openloop_lockstep', 'e_comp_m', '%.3g', 1e3)} mm | 0.0971 mm |")
 T.append(f"| open-loop delay, twin behind the reference (§5.3) | {rt('openloop_realtime', 'delay_ms', '%.3f')} ms | {ls('openloop_lockstep', 'delay_ms', '%.3f')} ms | 2 ms |")
-T.append(f"| credibility η, raw (§5.6; Kp 0.05 of this run's range) | {rt('openloop_realtime', 'eta_raw', '%.10f')} | {ls('openloop_lockstep', 'eta_raw', '%.10f')} | 0.999978 |")
-T.append(f"| open-loop offset in the last second of the run | {rt('openloop_realtime', 'offset_last_s_mm', '%.3f')} mm | {ls('openloop_lockstep', 'offset_last_s_mm', '%.3f')} mm | — |")
+T.append(f"| credibility η, raw, with the thesis's threshold ε_t = 0.1854 m (§5.6) | {rt('openloop_realtime', 'eta_raw_thesis_eps', '%.7f')} | {ls('openloop_lockstep', 'eta_raw_thesis_eps', '%.7f')} | 0.999978 |")
+T.append(f"| credibility η, raw, as `hiltwin assess` scores it (ε_t = 0.05 × this run's range) | {rt('openloop_realtime', 'eta_raw', '%.10f')} | {ls('openloop_lockstep', 'eta_raw', '%.10f')} | — |")
+T.append(f"| open-loop offset of the twin at rest, largest of the 17 rests (twin − reference) | {rt('openloop_realtime', 'rest_offset_max_abs_mm', '%.3f')} mm | {ls('openloop_lockstep', 'rest_offset_max_abs_mm', '%.3f')} mm | — |")
+last_rest = next((f.get("rest_offset_last_at") for _, f in rows.get("openloop_lockstep", [])), None)
+T.append(f"| the same at the last rest ({last_rest} s) | {rt('openloop_realtime', 'rest_offset_last_mm', '%.3f')} mm | {ls('openloop_lockstep', 'rest_offset_last_mm', '%.3f')} mm | — |")
 T.append(f"| encoder edges decoded in the open-loop run; illegal / too fast / resyncs | {rt('openloop_realtime', 'edges', '%d')}; {rt('openloop_realtime', 'edge_errors', '%d')} | {ls('openloop_lockstep', 'edges', '%d')}; {ls('openloop_lockstep', 'edge_errors', '%d')} | — |")
 if io:
     T.append(f"| encoder messages sent / received / missed (Table 5.2; deterministic, 1 run) | {io['encoder_messages_sent']:,} / {io['encoder_messages_received']:,} / {io['encoder_messages_missed']:,} | same | 720,000 / 720,000 / 0 |")
@@ -316,7 +339,7 @@ for khz in (1, 4, 8, 16):
     cyc = stats(fig, "cycles")
     cycs = f" of {int(cyc['median']):,}" if cyc else ""
     T.append(f"| twin's missed deadlines at {khz} kHz, under the controller (Table 5.1) | {rt(fig, 'misses', '%d')}{cycs} = {rt(fig, 'miss_pct', '%.3f')} % | — (no deadlines) | {thesis51[khz]} |")
-T.append(f"| closed-loop max tracking error, per wheel (§7.2) | {rt('closedloop_realtime', 'max_right_mm', '%.2f')} mm | {ls('closedloop_lockstep', 'max_right_mm', '%.3f')} mm | below 3 mm |")
+T.append(f"| closed-loop max tracking error, per wheel (§7.2) | {rt('closedloop_realtime', 'max_mm', '%.2f')} mm | {ls('closedloop_lockstep', 'max_mm', '%.3f')} mm | below 3 mm |")
 T.append(f"| closed-loop RMS tracking error | {rt('closedloop_realtime', 'rms_mm', '%.3f')} mm | {ls('closedloop_lockstep', 'rms_mm', '%.3f')} mm | — |")
 T.append(f"| closed-loop final error | {rt('closedloop_realtime', 'final_mm', '%.4f')} mm | {ls('closedloop_lockstep', 'final_mm', '%.4f')} mm | no steady-state error |")
 if failed:
@@ -327,16 +350,28 @@ if identical:
     T.append("Lockstep runs repeated and compared: " + ", ".join(f"{k} {'identical' if v else 'NOT identical'}" for k, v in identical.items()) + ".")
 open(f"{out}/table.md", "w").write("\n".join(T) + "\n")
 print("\n".join(T))
+
+# Table 5.1 in detail, and the stalls behind the real-time rows
+D = ["| run | misses | miss % | longest run of misses | twin's worst wake-up latency | thesis |", "|---|---|---|---|---|---|"]
+for khz in (1, 4, 8, 16):
+    fig = f"table51_{khz}k"
+    D.append(f"| {khz} kHz | {rt(fig, 'misses', '%d')} | {rt(fig, 'miss_pct', '%.3f')} | {rt(fig, 'longest_run', '%d')} | {rt(fig, 'worst_latency_ms', '%.1f')} ms | {thesis51[khz]} |")
+D.append(f"| open loop, 4 kHz, {int(stats('openloop_realtime', 'twin_cycles')['median']) if stats('openloop_realtime', 'twin_cycles') else 0} cycles | {rt('openloop_realtime', 'twin_misses', '%d')} | — | — | {rt('openloop_realtime', 'twin_worst_latency_ms', '%.1f')} ms | — |")
+D.append(f"| closed loop, 4 kHz, 12 s | — | — | — | {rt('closedloop_realtime', 'twin_worst_latency_ms', '%.1f')} ms | — |")
+open(f"{out}/table51.md", "w").write("\n".join(D) + "\n")
+print()
+print("\n".join(D))
 PY
 
 if [[ -n "${COPY_TO:-}" ]]; then
   mkdir -p "$COPY_TO"
-  cp "$out"/{table.md,summary.json,runs.csv,lockstep_identical.txt,machine.txt,io_test.json} "$COPY_TO"/ 2>/dev/null || true
+  cp "$out"/{table.md,table51.md,summary.json,runs.csv,lockstep_identical.txt,machine.txt,io_test.json} "$COPY_TO"/ 2>/dev/null || true
   for d in "$out"/lockstep/*_a "$out"/realtime/openloop_r* "$out"/realtime/closedloop_r*; do
     [[ -d "$d" ]] || continue
     n="$(basename "$(dirname "$d")")_$(basename "$d")"
     [[ -f "$d/hil.json" ]] && cp "$d/hil.json" "$COPY_TO/$n.hil.json"
     [[ -f "$d/assess.json" ]] && cp "$d/assess.json" "$COPY_TO/$n.assess.json"
+    [[ -f "$d/rest_offset.csv" ]] && cp "$d/rest_offset.csv" "$COPY_TO/$n.rest_offset.csv"
   done
   for p in "$out"/realtime/table51_*/r*.json; do
     [[ -f "$p" ]] && cp "$p" "$COPY_TO/realtime_$(basename "$(dirname "$p")")_$(basename "$p")"
