@@ -311,14 +311,16 @@ with open(f"{out}/runs.csv", "w") as f:
 # --- the markdown table
 def g(x, fmt):
     return fmt % x
+def fm(fmt, x):  # "%d" gets thousands separators
+    return f"{int(round(x)):,}" if fmt == "%d" else fmt % x
 def rt(fig, key, fmt, scale=1.0):
     s = stats(fig, key)
     if not s:
         return "not run"
-    return f"{fmt % (scale * s['median'])} ({fmt % (scale * s['min'])}–{fmt % (scale * s['max'])}, N={s['n']})"
+    return f"{fm(fmt, scale * s['median'])} ({fm(fmt, scale * s['min'])}–{fm(fmt, scale * s['max'])}, N={s['n']})"
 def ls(fig, key, fmt, scale=1.0):
     s = stats(fig, key)
-    return fmt % (scale * s["median"]) if s else "not run"
+    return fm(fmt, scale * s["median"]) if s else "not run"
 T = []
 T.append("| figure | real time: median (range, N runs) | lockstep (exact) | thesis |")
 T.append("|---|---|---|---|")
@@ -356,7 +358,7 @@ D = ["| run | misses | miss % | longest run of misses | twin's worst wake-up lat
 for khz in (1, 4, 8, 16):
     fig = f"table51_{khz}k"
     D.append(f"| {khz} kHz | {rt(fig, 'misses', '%d')} | {rt(fig, 'miss_pct', '%.3f')} | {rt(fig, 'longest_run', '%d')} | {rt(fig, 'worst_latency_ms', '%.1f')} ms | {thesis51[khz]} |")
-D.append(f"| open loop, 4 kHz, {int(stats('openloop_realtime', 'twin_cycles')['median']) if stats('openloop_realtime', 'twin_cycles') else 0} cycles | {rt('openloop_realtime', 'twin_misses', '%d')} | — | — | {rt('openloop_realtime', 'twin_worst_latency_ms', '%.1f')} ms | — |")
+D.append(f"| open loop, 4 kHz, {int(stats('openloop_realtime', 'twin_cycles')['median']) if stats('openloop_realtime', 'twin_cycles') else 0:,} cycles | {rt('openloop_realtime', 'twin_misses', '%d')} | — | — | {rt('openloop_realtime', 'twin_worst_latency_ms', '%.1f')} ms | — |")
 D.append(f"| closed loop, 4 kHz, 12 s | — | — | — | {rt('closedloop_realtime', 'twin_worst_latency_ms', '%.1f')} ms | — |")
 open(f"{out}/table51.md", "w").write("\n".join(D) + "\n")
 print()
