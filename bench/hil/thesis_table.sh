@@ -7,7 +7,7 @@
 # gives their median and range. Lockstep rows (--clock virtual: closed loop and open loop) run
 # once per figure, and a second time to check that both runs are identical. The encoder-link
 # row (io-test over mock) is deterministic and runs once.
-# With the defaults this takes about 75 minutes (RUNS x (600 s + 4 x 60 s + 12 s) + overhead).
+# With the defaults this takes about 80 minutes (RUNS x (600 s + 4 x 60 s + 12 s) + overhead).
 # Every report, assess output and log stays in OUT_DIR; the per-cycle CSV logs of a 600 s run
 # are several hundred MB.
 set -euo pipefail
