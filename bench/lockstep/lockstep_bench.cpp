@@ -3,25 +3,31 @@
 // 1. The whole `hiltwin hil --clock virtual --no-progress` command, the 12 s closed loop (48,000
 //    twin and 12,000 ECS cycles in two processes on one virtual time base shared through the
 //    wire): wall time from the start of the command to its exit, the speed-up against real time
-//    (12 s / wall), and the part of it that is the loop (each side's run report, wall_time_s:
-//    from the start of its loop to its end), the rest being start-up and shut-down. With
-//    --openloop N, N rounds of the 600 s open loop as well (`--mode openloop --duration 600`).
-// 2. The peer: the same closed loop in one process on one virtual timeline (tests/unit/app/
+//    (12 s / wall), the part of it that is the loop (the twin's run report, wall_time_s: from
+//    the start of its loop to its end; the rest is start-up and shut-down), the CPU time and
+//    the voluntary context switches of the three processes (in lockstep nearly all of them futex
+//    sleeps). As it comes, and with all three processes on one CPU (what a loaded machine makes
+//    of it when the scheduler puts both sides on the same CPU). With --openloop N, N rounds of
+//    the 600 s open loop as well.
+// 2. The peer: the same loop in one process on one virtual timeline (tests/unit/app/
 //    in_process_hil.h: both emulated boards joined in memory, the twin and the ECS stepped by
-//    hand, no session, no wire), and the ratio lockstep / in-process. Rounds alternate between
-//    the command and the peer, so both see the same machine.
+//    hand, no session, no wire), and the ratio lockstep / in-process. Rounds run every variant
+//    and the peer in turn, so all see the same machine.
 // 3. The cost of one lockstep hand-over: two processes (this one, the twin, and a forked child,
 //    the ECS), each owning one side of a fresh wire, each waiting on its lockstep clock for
 //    interleaved times (ECS at odd ns, twin at even ns), so that every wait hands the turn to
-//    the other side: wall / hand-overs, and how many waits went to the futex. Once on whatever
-//    CPUs the scheduler gives (the spin path: each side spins up to 20 µs on its own CPU), once
-//    with both processes pinned to one CPU (the futex path: the waiting side spins out its 20 µs,
-//    then sleeps, and only then can the other run).
+//    the other side: wall / hand-overs, and how many hand-overs went to the futex. Not pinned,
+//    pinned apart (the spin path: the waiting side spins on its own CPU and sees the turn
+//    come), and both on one CPU (the futex path: the waiting side spins out its 20 µs while the
+//    other cannot run, then sleeps).
 //
-// Usage: hiltwin_bench_lockstep [--rounds N=5] [--handovers N=200000] [--pinned-handovers
-//        N=20000] [--cpu C=0] [--openloop N=0]
-//   --handovers / --pinned-handovers: timed waits per side (after 1,000 untimed ones)
-//   --openloop N: N rounds of the 600 s open loop too (each ~15-30 s; off by default)
+// Usage: hiltwin_bench_lockstep [--rounds N=5] [--handovers N=20000] [--cpu C=0]
+//                               [--openloop N=0] [--part all|command|handover]
+//   --handovers: timed waits per side and round (after 1,000 untimed ones)
+//   --cpu: the CPU of the pinned variants (pinned apart: C and C + 1)
+//   --openloop N: N rounds of the 600 s open loop too, not pinned (~10 s each on an idle
+//                 machine; off by default)
+//   --part: the commands (and the peer) only, or the hand-over only
 #include <sched.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -63,10 +69,11 @@ constexpr long kWarmupWaits = 1'000;
 
 struct Options {
   int rounds = 5;
-  long handovers = 200'000;
-  long pinned_handovers = 20'000;
+  long handovers = 20'000;
   int cpu = 0;
   int openloop_rounds = 0;
+  bool command = true;   ///< --part command|handover|all
+  bool handover = true;
 };
 
 std::optional<Options> ParseOptions(int argc, char** argv) {
@@ -79,12 +86,15 @@ std::optional<Options> ParseOptions(int argc, char** argv) {
       o.rounds = static_cast<int>(value);
     } else if (flag == "--handovers" && value > 0) {
       o.handovers = value;
-    } else if (flag == "--pinned-handovers" && value > 0) {
-      o.pinned_handovers = value;
     } else if (flag == "--cpu" && value >= 0) {
       o.cpu = static_cast<int>(value);
     } else if (flag == "--openloop" && value >= 0) {
       o.openloop_rounds = static_cast<int>(value);
+    } else if (flag == "--part" && (std::string(argv[i]) == "command" ||
+                                    std::string(argv[i]) == "handover" ||
+                                    std::string(argv[i]) == "all")) {
+      o.command = std::string(argv[i]) != "handover";
+      o.handover = std::string(argv[i]) != "command";
     } else {
       return std::nullopt;
     }
@@ -109,30 +119,45 @@ Spread SpreadOf(const std::vector<double>& values) {
           *std::max_element(values.begin(), values.end())};
 }
 
+/// This process (and the children it starts from now on) on `cpu` alone.
+bool PinTo(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(static_cast<std::size_t>(cpu), &set);
+  return sched_setaffinity(0, sizeof set, &set) == 0;
+}
+
 // ---------------------------------------------------------------------------------------------
 // 1. The whole command
 
 struct CommandRun {
   double wall_s = 0.0;       ///< start of the command to its exit
   double cpu_s = 0.0;        ///< user + system time of hil and its two sides
+  long sleeps = 0;           ///< their voluntary context switches
   double twin_loop_s = 0.0;  ///< the twin's run report: wall_time_s
   double ecs_loop_s = 0.0;
   double max_error_m = 0.0;  ///< closed loop: the larger wheel's max |tracking error|
 };
 
-/// User + system time of the children waited for so far (hil waits for its two sides).
-double ChildrenCpuS() {
+/// What the children waited for so far used (hil waits for its two sides).
+struct ChildrenUsage {
+  double cpu_s = 0.0;          ///< user + system
+  long voluntary_switches = 0;  ///< sleeps: in lockstep, almost all of them on the futex
+};
+
+ChildrenUsage ChildrenUsageNow() {
   rusage usage{};
   getrusage(RUSAGE_CHILDREN, &usage);
   const auto s = [](const timeval& t) {
     return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
   };
-  return s(usage.ru_utime) + s(usage.ru_stime);
+  return {s(usage.ru_utime) + s(usage.ru_stime), usage.ru_nvcsw};
 }
 
 /// Runs `hiltwin hil --clock virtual --no-progress` + `extra`; exits the benchmark when the
 /// command fails or its sides did not run the planned cycles.
-CommandRun RunCommand(const std::vector<std::string>& extra, double length_s) {
+CommandRun RunCommand(const std::vector<std::string>& extra, double length_s,
+                      std::optional<int> cpu) {
   const std::filesystem::path report =
       std::filesystem::temp_directory_path() /
       ("hiltwin-bench-lockstep-" + std::to_string(::getpid()) + ".json");
@@ -142,11 +167,18 @@ CommandRun RunCommand(const std::vector<std::string>& extra, double length_s) {
   kernel_glue::ProcessOptions streams;
   streams.out = kernel_glue::OutputTarget::Capture();
   streams.err = kernel_glue::OutputTarget::Capture();
-  const double cpu_before_s = ChildrenCpuS();
+  cpu_set_t own{};
+  sched_getaffinity(0, sizeof own, &own);
+  if (cpu && !PinTo(*cpu)) {
+    std::fprintf(stderr, "cannot pin to CPU %d: %s\n", *cpu, std::strerror(errno));
+    std::exit(1);
+  }
+  const ChildrenUsage before = ChildrenUsageNow();
   const BenchClock::time_point start = BenchClock::now();
   const kernel_glue::ProcessResult run = kernel_glue::RunProcess(argv, streams);
   const BenchClock::time_point end = BenchClock::now();
-  const double cpu_s = ChildrenCpuS() - cpu_before_s;
+  const ChildrenUsage after = ChildrenUsageNow();
+  sched_setaffinity(0, sizeof own, &own);
   if (!run.status.Success()) {
     std::fprintf(stderr, "hiltwin hil failed (%s):\n%s%s", run.status.Describe().c_str(),
                  run.out.c_str(), run.err.c_str());
@@ -169,10 +201,11 @@ CommandRun RunCommand(const std::vector<std::string>& extra, double length_s) {
   }
   CommandRun r;
   r.wall_s = Seconds(start, end);
-  r.cpu_s = cpu_s;
+  r.cpu_s = after.cpu_s - before.cpu_s;
+  r.sleeps = after.voluntary_switches - before.voluntary_switches;
   r.twin_loop_s = json["twin"]["wall_time_s"].get<double>();
   r.ecs_loop_s = json["ecs"]["wall_time_s"].get<double>();
-  if (json.contains("tracking_error_max_m")) {
+  if (json.contains("tracking_error_max_m") && json["tracking_error_max_m"].is_object()) {
     r.max_error_m = std::max(json["tracking_error_max_m"]["left"].get<double>(),
                              json["tracking_error_max_m"]["right"].get<double>());
   }
@@ -225,6 +258,8 @@ InProcessRun RunInProcessLoop(bool closed_loop, double length_s) {
 struct SideResult {
   double wall_ns = 0.0;  ///< from the end of its last untimed wait to the end of its last wait
   io::LockstepCounts counts{};  ///< over the timed waits
+  int cpu_at_end = -1;          ///< the CPU it ran on after its last wait
+  long involuntary_switches = 0;  ///< over the timed waits: preempted while it spun or ran
   char error[256] = {};
 };
 
@@ -250,10 +285,16 @@ SideResult RunSide(const std::string& wire, bool ecs, long n) {
     long i = 0;
     for (; i < kWarmupWaits; ++i) clock.SleepUntilNs(2 * i + offset);
     const io::LockstepCounts before = bus.lockstep_counts();
+    rusage usage_before{};
+    getrusage(RUSAGE_SELF, &usage_before);
     const BenchClock::time_point start = BenchClock::now();
     for (; i < kWarmupWaits + n; ++i) clock.SleepUntilNs(2 * i + offset);
     const BenchClock::time_point end = BenchClock::now();
     const io::LockstepCounts after = bus.lockstep_counts();
+    rusage usage_after{};
+    getrusage(RUSAGE_SELF, &usage_after);
+    r.cpu_at_end = sched_getcpu();
+    r.involuntary_switches = usage_after.ru_nivcsw - usage_before.ru_nivcsw;
     bus.AnnounceStop(io::StopCause::kFinished);  // releases the peer's last wait
     r.wall_ns = std::chrono::duration<double, std::nano>(end - start).count();
     r.counts.waits = after.waits - before.waits;
@@ -271,23 +312,12 @@ struct HandoverRun {
   SideResult ecs;
 };
 
-bool PinTo(int cpu) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(static_cast<std::size_t>(cpu), &set);
-  return sched_setaffinity(0, sizeof set, &set) == 0;
-}
-
-/// Forks the ECS side, runs the twin side here; both pinned to `cpu` when given.
-HandoverRun RunHandovers(long n, std::optional<int> cpu) {
+/// Forks the ECS side, runs the twin side here; each pinned to its CPU when given.
+HandoverRun RunHandovers(long n, std::optional<int> twin_cpu, std::optional<int> ecs_cpu) {
   const std::string wire = "bench-lockstep-" + std::to_string(::getpid());
   io::WireBus::Unlink(wire);
   cpu_set_t own{};
   sched_getaffinity(0, sizeof own, &own);
-  if (cpu && !PinTo(*cpu)) {
-    std::fprintf(stderr, "cannot pin to CPU %d: %s\n", *cpu, std::strerror(errno));
-    std::exit(1);
-  }
   int fds[2];
   if (pipe(fds) != 0) {
     std::perror("pipe");
@@ -300,15 +330,26 @@ HandoverRun RunHandovers(long n, std::optional<int> cpu) {
     std::perror("fork");
     std::exit(1);
   }
-  if (child == 0) {  // the ECS: inherits the pinning
+  if (child == 0) {  // the ECS
     close(fds[0]);
-    const SideResult r = RunSide(wire, true, n);
+    SideResult r;
+    if (ecs_cpu && !PinTo(*ecs_cpu)) {
+      std::snprintf(r.error, sizeof r.error, "cannot pin to CPU %d: %s", *ecs_cpu,
+                    std::strerror(errno));
+    } else {
+      r = RunSide(wire, true, n);
+    }
     const ssize_t written = write(fds[1], &r, sizeof r);
     _exit(written == static_cast<ssize_t>(sizeof r) ? 0 : 1);
   }
   close(fds[1]);
   HandoverRun run;
-  run.twin = RunSide(wire, false, n);
+  if (twin_cpu && !PinTo(*twin_cpu)) {
+    std::snprintf(run.twin.error, sizeof run.twin.error, "cannot pin to CPU %d: %s", *twin_cpu,
+                  std::strerror(errno));
+  } else {
+    run.twin = RunSide(wire, false, n);
+  }
   std::size_t got = 0;
   auto* bytes = reinterpret_cast<char*>(&run.ecs);
   while (got < sizeof run.ecs) {
@@ -337,60 +378,70 @@ HandoverRun RunHandovers(long n, std::optional<int> cpu) {
 
 // ---------------------------------------------------------------------------------------------
 
-void PrintCommand(const char* label, const std::vector<CommandRun>& runs, double length_s) {
+/// Prints the command's figures; returns the median wall time of the whole command.
+double PrintCommand(const char* label, const std::vector<CommandRun>& runs, double length_s) {
   std::vector<double> wall;
   std::vector<double> loop;
   std::vector<double> rest;
-  std::vector<double> ecs_loop;
   std::vector<double> cpu;
+  std::vector<double> sleeps;
   for (const CommandRun& r : runs) {
-    cpu.push_back(r.cpu_s);
+    sleeps.push_back(static_cast<double>(r.sleeps));
     wall.push_back(r.wall_s);
     loop.push_back(r.twin_loop_s);
-    ecs_loop.push_back(r.ecs_loop_s);
     rest.push_back(r.wall_s - r.twin_loop_s);
+    cpu.push_back(r.cpu_s);
   }
   const Spread w = SpreadOf(wall);
   const Spread l = SpreadOf(loop);
-  const Spread e = SpreadOf(ecs_loop);
   const Spread s = SpreadOf(rest);
   const Spread c = SpreadOf(cpu);
-  std::printf("  %s, whole command %8.3f s  (%.3f .. %.3f)  speed-up %.0fx real time (%.0f .. %.0f)\n",
-              label, w.median, w.min, w.max, length_s / w.median, length_s / w.max,
-              length_s / w.min);
-  std::printf("    of it, the loop (twin report)   %8.3f s  (%.3f .. %.3f)  %.0f ns per ECS cycle; ECS report %.3f s\n",
-              l.median, l.min, l.max, l.median * 1e9 / (length_s * 1000.0), e.median);
-  std::printf("    start-up + shut-down            %8.3f s  (%.3f .. %.3f)\n", s.median, s.min,
-              s.max);
-  std::printf("    CPU time, user + sys, 3 processes %6.3f s  (%.3f .. %.3f)\n", c.median, c.min,
-              c.max);
-}
-
-double PrintInProcess(const char* label, const std::vector<InProcessRun>& runs, double length_s) {
-  std::vector<double> wall;
-  for (const InProcessRun& r : runs) wall.push_back(r.wall_s);
-  const Spread w = SpreadOf(wall);
-  std::printf("  peer: %s, in-process %8.3f s  (%.3f .. %.3f)  speed-up %.0fx real time; %.0f ns per ECS cycle\n",
-              label, w.median, w.min, w.max, length_s / w.median,
-              w.median * 1e9 / (length_s * 1000.0));
+  const Spread z = SpreadOf(sleeps);
+  std::printf("  %-40s %8.3f s  (%.3f .. %.3f)  %.0fx real time (%.0f .. %.0f)\n", label,
+              w.median, w.min, w.max, length_s / w.median, length_s / w.max, length_s / w.min);
+  std::printf("    loop (twin's report)        %8.3f s  (%.3f .. %.3f)  %.1f us per ECS cycle\n",
+              l.median, l.min, l.max, l.median * 1e6 / (length_s * 1000.0));
+  std::printf("    start-up + shut-down        %8.3f s  (%.3f .. %.3f)\n", s.median, s.min, s.max);
+  std::printf("    CPU time, 3 processes       %8.3f s  (%.3f .. %.3f)  user + sys\n", c.median,
+              c.min, c.max);
+  std::printf("    sleeps, 3 processes         %8.0f    (%.0f .. %.0f)  voluntary context switches, %.2f per ECS cycle\n",
+              z.median, z.min, z.max, z.median / (length_s * 1000.0));
+  std::printf("    rounds, whole command, s   ");
+  for (const double v : wall) std::printf(" %.3f", v);
+  std::printf("\n");
   return w.median;
 }
 
-void PrintHandovers(const char* label, const std::vector<HandoverRun>& runs, long n) {
+/// Prints the peer's figures; returns its median wall time.
+double PrintInProcess(const std::vector<InProcessRun>& runs, double length_s) {
+  std::vector<double> wall;
+  for (const InProcessRun& r : runs) wall.push_back(r.wall_s);
+  const Spread w = SpreadOf(wall);
+  std::printf("  %-40s %8.3f s  (%.3f .. %.3f)  %.0fx real time; %.1f us per ECS cycle\n",
+              "peer: in-process loop (RunInProcess)", w.median, w.min, w.max,
+              length_s / w.median, w.median * 1e6 / (length_s * 1000.0));
+  return w.median;
+}
+
+/// The median and range of ns per hand-over, then every round: ns, the share of hand-overs
+/// that went to the futex, the CPUs the sides ended on and how often they were preempted.
+double PrintHandovers(const char* label, const std::vector<HandoverRun>& runs, long n) {
   std::vector<double> ns;
   for (const HandoverRun& r : runs) ns.push_back(r.ns_per_handover);
   const Spread s = SpreadOf(ns);
-  // The counts of the median round.
-  const auto median_run = std::find_if(runs.begin(), runs.end(), [&](const HandoverRun& r) {
-    return r.ns_per_handover == s.median;
-  });
-  const HandoverRun& m = *median_run;
-  std::printf("  %s %8.0f ns  (%.0f .. %.0f)\n", label, s.median, s.min, s.max);
-  std::printf("    median round: %ld waits per side; hand-overs twin %llu, ECS %llu; futex sleeps twin %llu, ECS %llu\n",
-              n, static_cast<unsigned long long>(m.twin.counts.handovers),
-              static_cast<unsigned long long>(m.ecs.counts.handovers),
-              static_cast<unsigned long long>(m.twin.counts.sleeps),
-              static_cast<unsigned long long>(m.ecs.counts.sleeps));
+  std::printf("  %-40s %8.0f ns  (%.0f .. %.0f)  %ld waits per side and round\n", label,
+              s.median, s.min, s.max, n);
+  std::printf("    rounds: ns (futex sleeps / hand-overs; CPU twin/ECS at the end; preempted twin/ECS)\n     ");
+  for (const HandoverRun& r : runs) {
+    const std::uint64_t handovers = r.twin.counts.handovers + r.ecs.counts.handovers;
+    const std::uint64_t sleeps = r.twin.counts.sleeps + r.ecs.counts.sleeps;
+    std::printf(" %.0f (%.2f; %d/%d; %ld/%ld)", r.ns_per_handover,
+                handovers == 0 ? 0.0 : static_cast<double>(sleeps) / static_cast<double>(handovers),
+                r.twin.cpu_at_end, r.ecs.cpu_at_end, r.twin.involuntary_switches,
+                r.ecs.involuntary_switches);
+  }
+  std::printf("\n");
+  return s.median;
 }
 
 }  // namespace
@@ -399,68 +450,91 @@ int main(int argc, char** argv) {
   const std::optional<Options> parsed = ParseOptions(argc, argv);
   if (!parsed) {
     std::fprintf(stderr,
-                 "usage: %s [--rounds N>0] [--handovers N>0] [--pinned-handovers N>0] [--cpu C] "
-                 "[--openloop N]\n",
+                 "usage: %s [--rounds N>0] [--handovers N>0] [--cpu C] "
+                 "[--openloop N] [--part all|command|handover]\n",
                  argv[0]);
     return 2;
   }
   const Options& o = *parsed;
-  std::printf("lockstep benchmark: %d rounds, each the command then its peer; median (min .. max)\n",
+  std::printf("lockstep benchmark: %d rounds, each runs every variant, then the peer; median (min .. max)\n",
               o.rounds);
 
-  std::vector<CommandRun> closed;
-  std::vector<InProcessRun> closed_peer;
-  for (int r = 0; r < o.rounds; ++r) {
-    closed.push_back(RunCommand({}, kClosedLoopS));
-    closed_peer.push_back(RunInProcessLoop(true, kClosedLoopS));
-  }
-  std::printf("closed loop, 12 s (48,000 twin + 12,000 ECS cycles), `hiltwin hil --clock virtual --no-progress`\n");
-  PrintCommand("lockstep", closed, kClosedLoopS);
-  const double peer_s = PrintInProcess("closed loop", closed_peer, kClosedLoopS);
-  std::vector<double> wall;
-  std::vector<double> loop;
-  for (const CommandRun& r : closed) {
-    wall.push_back(r.wall_s);
-    loop.push_back(r.twin_loop_s);
-  }
-  std::printf("  ratio lockstep / in-process: whole command %.1f, loop alone %.1f\n",
-              bench::Median(wall) / peer_s, bench::Median(loop) / peer_s);
-  std::printf("  same result: max |tracking error| lockstep %.6f mm, in-process %.6f mm\n",
-              closed.front().max_error_m * 1e3, closed_peer.front().max_error_m * 1e3);
-
-  if (o.openloop_rounds > 0) {
-    std::vector<CommandRun> open;
-    std::vector<InProcessRun> open_peer;
-    for (int r = 0; r < o.openloop_rounds; ++r) {
-      open.push_back(RunCommand({"--mode", "openloop", "--duration", "600"}, kOpenLoopS));
-      open_peer.push_back(RunInProcessLoop(false, kOpenLoopS));
+  const int other_cpu =
+      (o.cpu + 1) % std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  // The command as it comes, then with all three processes on one CPU (as `taskset -c C`: the
+  // children inherit this process's affinity; every hand-over then goes through the futex, as on
+  // a loaded machine when the scheduler puts both sides on the same CPU). The sides' own --cpu
+  // does not pin the loop on the virtual clock (no real-time set-up there), hence the affinity.
+  struct Variant {
+    std::string label;
+    std::optional<int> cpu;  ///< the CPU of all three processes, or the scheduler's choice
+  };
+  const std::vector<Variant> variants = {
+      {"lockstep, not pinned", std::nullopt},
+      {"lockstep, all on CPU " + std::to_string(o.cpu) + " (taskset)", o.cpu}};
+  /// Rounds of every variant of the command and the in-process peer, in turn.
+  const auto compare = [&](const char* what, const std::vector<std::string>& mode, double length_s,
+                           bool closed_loop, int rounds, std::size_t variant_count) {
+    std::vector<std::vector<CommandRun>> runs(variant_count);
+    std::vector<InProcessRun> peer;
+    for (int r = 0; r < rounds; ++r) {
+      for (std::size_t v = 0; v < variant_count; ++v) {
+        runs[v].push_back(RunCommand(mode, length_s, variants[v].cpu));
+      }
+      peer.push_back(RunInProcessLoop(closed_loop, length_s));
     }
-    std::printf("open loop, 600 s (2,400,000 twin + 600,000 ECS cycles), `... --mode openloop --duration 600`, %d rounds\n",
-                o.openloop_rounds);
-    PrintCommand("lockstep", open, kOpenLoopS);
-    const double open_peer_s = PrintInProcess("open loop", open_peer, kOpenLoopS);
-    std::vector<double> open_wall;
-    for (const CommandRun& r : open) open_wall.push_back(r.wall_s);
-    std::printf("  ratio lockstep / in-process: whole command %.1f\n",
-                bench::Median(open_wall) / open_peer_s);
+    std::printf("%s, %d rounds\n", what, rounds);
+    std::vector<double> medians;
+    for (std::size_t v = 0; v < variant_count; ++v) {
+      medians.push_back(PrintCommand(variants[v].label.c_str(), runs[v], length_s));
+    }
+    const double peer_s = PrintInProcess(peer, length_s);
+    std::printf("  ratio lockstep / in-process (whole command): %.1f not pinned", medians[0] / peer_s);
+    if (variant_count > 1) std::printf(", %.1f on one CPU", medians[1] / peer_s);
+    std::printf("\n");
+    if (closed_loop) {
+      std::printf("  same result: max |tracking error| lockstep %.6f mm, in-process %.6f mm\n",
+                  runs[0].front().max_error_m * 1e3, peer.front().max_error_m * 1e3);
+    }
+    return peer_s;
+  };
+  double closed_peer_s = 0.0;
+  if (o.command) {
+    closed_peer_s = compare(
+        "closed loop, 12 s (48,000 twin + 12,000 ECS cycles): `hiltwin hil --clock virtual "
+        "--no-progress`",
+        {}, kClosedLoopS, true, o.rounds, variants.size());
+  }
+  if (o.openloop_rounds > 0) {
+    compare("open loop, 600 s (2,400,000 twin + 600,000 ECS cycles): `... --mode openloop "
+            "--duration 600`",
+            {"--mode", "openloop", "--duration", "600"}, kOpenLoopS, false, o.openloop_rounds,
+            1);  // not pinned only: on one CPU it would hold a CPU for ~40 s per round
   }
 
-  std::vector<HandoverRun> free_runs;
-  std::vector<HandoverRun> pinned_runs;
-  for (int r = 0; r < o.rounds; ++r) {
-    free_runs.push_back(RunHandovers(o.handovers, std::nullopt));
-    pinned_runs.push_back(RunHandovers(o.pinned_handovers, o.cpu));
+  if (o.handover) {
+    std::vector<HandoverRun> free_runs;
+    std::vector<HandoverRun> apart_runs;
+    std::vector<HandoverRun> same_runs;
+    for (int r = 0; r < o.rounds; ++r) {
+      free_runs.push_back(RunHandovers(o.handovers, std::nullopt, std::nullopt));
+      apart_runs.push_back(RunHandovers(o.handovers, o.cpu, other_cpu));
+      same_runs.push_back(RunHandovers(o.handovers, o.cpu, o.cpu));
+    }
+    std::printf("one lockstep hand-over: two processes, interleaved waits (every wait hands the turn over)\n");
+    char label[64];
+    const double free_ns = PrintHandovers("not pinned", free_runs, o.handovers);
+    std::snprintf(label, sizeof label, "pinned apart, CPUs %d and %d", o.cpu, other_cpu);
+    const double apart_ns = PrintHandovers(label, apart_runs, o.handovers);
+    std::snprintf(label, sizeof label, "both on CPU %d", o.cpu);
+    const double same_ns = PrintHandovers(label, same_runs, o.handovers);
+    std::printf("  the 12 s closed loop hands the turn over twice per ECS cycle, 24,000 times: %.0f ms "
+                "not pinned, %.0f ms apart, %.0f ms on one CPU\n",
+                24'000.0 * free_ns * 1e-6, 24'000.0 * apart_ns * 1e-6, 24'000.0 * same_ns * 1e-6);
+    if (closed_peer_s > 0.0) {
+      std::printf("  for scale: the in-process closed loop spends %.0f ns per ECS cycle on all of its work\n",
+                  closed_peer_s * 1e9 / (kClosedLoopS * 1000.0));
+    }
   }
-  std::printf("one lockstep hand-over (two processes, interleaved waits: every wait hands the turn over)\n");
-  PrintHandovers("not pinned (spin path)        ", free_runs, o.handovers);
-  char pinned_label[64];
-  std::snprintf(pinned_label, sizeof pinned_label, "both on CPU %d (futex path)     ", o.cpu);
-  PrintHandovers(pinned_label, pinned_runs, o.pinned_handovers);
-  std::printf("  the 12 s closed loop hands over twice per ECS cycle: 24,000 hand-overs, %.1f ms at the spin path's median\n",
-              24'000.0 * bench::Median([&] {
-                std::vector<double> ns;
-                for (const HandoverRun& r : free_runs) ns.push_back(r.ns_per_handover);
-                return ns;
-              }()) * 1e-6);
   return 0;
 }
