@@ -66,6 +66,9 @@ using bench::BenchClock;
 constexpr double kClosedLoopS = 12.0;
 constexpr double kOpenLoopS = 600.0;
 constexpr long kWarmupWaits = 1'000;
+/// Hand-over loop: a heartbeat every this many waits (at most ~60 ms apart on one CPU, well
+/// inside the wire's 250 ms heartbeat timeout).
+constexpr long kPollEvery = 1'000;
 
 struct Options {
   int rounds = 5;
@@ -283,18 +286,37 @@ SideResult RunSide(const std::string& wire, bool ecs, long n) {
     kernel_glue::Clock& clock = *bus.lockstep_clock();
     const std::int64_t offset = ecs ? 1 : 2;
     long i = 0;
-    for (; i < kWarmupWaits; ++i) clock.SleepUntilNs(2 * i + offset);
+    for (; i < kWarmupWaits; ++i) {
+      clock.SleepUntilNs(2 * i + offset);
+      if (i % kPollEvery == 0) static_cast<void>(bus.Poll());
+    }
     const io::LockstepCounts before = bus.lockstep_counts();
     rusage usage_before{};
     getrusage(RUSAGE_SELF, &usage_before);
     const BenchClock::time_point start = BenchClock::now();
-    for (; i < kWarmupWaits + n; ++i) clock.SleepUntilNs(2 * i + offset);
+    for (; i < kWarmupWaits + n; ++i) {
+      clock.SleepUntilNs(2 * i + offset);
+      // Waits alone do not beat: keep this side's heartbeat fresh for the peer's checks, as an
+      // exchange every cycle does in a run (one Poll, ~1 us, per kPollEvery waits).
+      if (i % kPollEvery == 0) {
+        const io::BusStatus status = bus.Poll();
+        if (status.result != io::BusResult::kOk) {
+          std::snprintf(r.error, sizeof r.error, "the lockstep broke: %s", status.reason);
+          return r;
+        }
+      }
+    }
     const BenchClock::time_point end = BenchClock::now();
     const io::LockstepCounts after = bus.lockstep_counts();
     rusage usage_after{};
     getrusage(RUSAGE_SELF, &usage_after);
     r.cpu_at_end = sched_getcpu();
     r.involuntary_switches = usage_after.ru_nivcsw - usage_before.ru_nivcsw;
+    // A broken lockstep returns every wait at once: a fast figure that measured nothing.
+    const io::BusStatus status = bus.Poll();
+    if (status.result != io::BusResult::kOk && status.result != io::BusResult::kPeerStopped) {
+      std::snprintf(r.error, sizeof r.error, "the lockstep broke: %s", status.reason);
+    }
     bus.AnnounceStop(io::StopCause::kFinished);  // releases the peer's last wait
     r.wall_ns = std::chrono::duration<double, std::nano>(end - start).count();
     r.counts.waits = after.waits - before.waits;
