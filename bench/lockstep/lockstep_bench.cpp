@@ -183,6 +183,7 @@ CommandRun RunCommand(const std::vector<std::string>& extra, double length_s,
   const ChildrenUsage after = ChildrenUsageNow();
   sched_setaffinity(0, sizeof own, &own);
   if (!run.status.Success()) {
+    std::filesystem::remove(report);
     std::fprintf(stderr, "hiltwin hil failed (%s):\n%s%s", run.status.Describe().c_str(),
                  run.out.c_str(), run.err.c_str());
     std::exit(1);
@@ -194,11 +195,12 @@ CommandRun RunCommand(const std::vector<std::string>& extra, double length_s,
   const auto twin_cycles = json["twin"]["cycles_run"].get<std::uint64_t>();
   const auto ecs_cycles = json["ecs"]["cycles_run"].get<std::uint64_t>();
   const auto want_ecs = static_cast<std::uint64_t>(length_s * 1000.0);
-  if (ecs_cycles != want_ecs || twin_cycles != 4 * want_ecs) {
+  const std::uint64_t want_twin = 4 * want_ecs;  // hil's defaults: twin 4 kHz, ECS 1 kHz
+  if (ecs_cycles != want_ecs || twin_cycles != want_twin) {
     std::fprintf(stderr, "hiltwin hil ran %llu twin and %llu ECS cycles, not %llu and %llu\n",
                  static_cast<unsigned long long>(twin_cycles),
                  static_cast<unsigned long long>(ecs_cycles),
-                 static_cast<unsigned long long>(4 * want_ecs),
+                 static_cast<unsigned long long>(want_twin),
                  static_cast<unsigned long long>(want_ecs));
     std::exit(1);
   }
@@ -466,6 +468,72 @@ double PrintHandovers(const char* label, const std::vector<HandoverRun>& runs, l
   return s.median;
 }
 
+/// One way to run the command: as it comes, or with all three processes on one CPU (as
+/// `taskset -c C`: the children inherit this process's affinity; every hand-over then goes
+/// through the futex, as on a loaded machine when the scheduler puts both sides on the same
+/// CPU). The sides' own --cpu does not pin the loop on the virtual clock (no real-time set-up
+/// there), hence the affinity.
+struct Variant {
+  std::string label;
+  std::optional<int> cpu;  ///< the CPU of all three processes, or the scheduler's choice
+};
+
+/// Rounds of the first `variant_count` variants of the command and the in-process peer, in
+/// turn; prints them and returns the peer's median wall time.
+double CompareWithPeer(const char* what, const std::vector<std::string>& mode, double length_s,
+                       bool closed_loop, int rounds, const std::vector<Variant>& variants,
+                       std::size_t variant_count) {
+  std::vector<std::vector<CommandRun>> runs(variant_count);
+  std::vector<InProcessRun> peer;
+  for (int r = 0; r < rounds; ++r) {
+    for (std::size_t v = 0; v < variant_count; ++v) {
+      runs[v].push_back(RunCommand(mode, length_s, variants[v].cpu));
+    }
+    peer.push_back(RunInProcessLoop(closed_loop, length_s));
+  }
+  std::printf("%s, %d rounds\n", what, rounds);
+  std::vector<double> medians;
+  for (std::size_t v = 0; v < variant_count; ++v) {
+    medians.push_back(PrintCommand(variants[v].label.c_str(), runs[v], length_s));
+  }
+  const double peer_s = PrintInProcess(peer, length_s);
+  std::printf("  ratio lockstep / in-process (whole command): %.1f not pinned", medians[0] / peer_s);
+  if (variant_count > 1) std::printf(", %.1f on one CPU", medians[1] / peer_s);
+  std::printf("\n");
+  if (closed_loop) {
+    std::printf("  same result: max |tracking error| lockstep %.6f mm, in-process %.6f mm\n",
+                runs[0].front().max_error_m * 1e3, peer.front().max_error_m * 1e3);
+  }
+  return peer_s;
+}
+
+/// Rounds of the hand-over loop not pinned, pinned apart and on one CPU, in turn; prints them
+/// beside the in-process loop's cost per ECS cycle (`peer_s`, 0: not measured).
+void CompareHandovers(const Options& o, int other_cpu, double peer_s) {
+  std::vector<HandoverRun> free_runs;
+  std::vector<HandoverRun> apart_runs;
+  std::vector<HandoverRun> same_runs;
+  for (int r = 0; r < o.rounds; ++r) {
+    free_runs.push_back(RunHandovers(o.handovers, std::nullopt, std::nullopt));
+    apart_runs.push_back(RunHandovers(o.handovers, o.cpu, other_cpu));
+    same_runs.push_back(RunHandovers(o.handovers, o.cpu, o.cpu));
+  }
+  std::printf("one lockstep hand-over: two processes, interleaved waits (every wait hands the turn over)\n");
+  char label[64];
+  const double free_ns = PrintHandovers("not pinned", free_runs, o.handovers);
+  std::snprintf(label, sizeof label, "pinned apart, CPUs %d and %d", o.cpu, other_cpu);
+  const double apart_ns = PrintHandovers(label, apart_runs, o.handovers);
+  std::snprintf(label, sizeof label, "both on CPU %d", o.cpu);
+  const double same_ns = PrintHandovers(label, same_runs, o.handovers);
+  std::printf("  the 12 s closed loop hands the turn over twice per ECS cycle, 24,000 times: %.0f ms "
+              "not pinned, %.0f ms apart, %.0f ms on one CPU\n",
+              24'000.0 * free_ns * 1e-6, 24'000.0 * apart_ns * 1e-6, 24'000.0 * same_ns * 1e-6);
+  if (peer_s > 0.0) {
+    std::printf("  for scale: the in-process closed loop spends %.0f ns per ECS cycle on all of its work\n",
+                peer_s * 1e9 / (kClosedLoopS * 1000.0));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -480,83 +548,25 @@ int main(int argc, char** argv) {
   const Options& o = *parsed;
   std::printf("lockstep benchmark: %d rounds, each runs every variant, then the peer; median (min .. max)\n",
               o.rounds);
-
   const int other_cpu =
       (o.cpu + 1) % std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
-  // The command as it comes, then with all three processes on one CPU (as `taskset -c C`: the
-  // children inherit this process's affinity; every hand-over then goes through the futex, as on
-  // a loaded machine when the scheduler puts both sides on the same CPU). The sides' own --cpu
-  // does not pin the loop on the virtual clock (no real-time set-up there), hence the affinity.
-  struct Variant {
-    std::string label;
-    std::optional<int> cpu;  ///< the CPU of all three processes, or the scheduler's choice
-  };
   const std::vector<Variant> variants = {
       {"lockstep, not pinned", std::nullopt},
       {"lockstep, all on CPU " + std::to_string(o.cpu) + " (taskset)", o.cpu}};
-  /// Rounds of every variant of the command and the in-process peer, in turn.
-  const auto compare = [&](const char* what, const std::vector<std::string>& mode, double length_s,
-                           bool closed_loop, int rounds, std::size_t variant_count) {
-    std::vector<std::vector<CommandRun>> runs(variant_count);
-    std::vector<InProcessRun> peer;
-    for (int r = 0; r < rounds; ++r) {
-      for (std::size_t v = 0; v < variant_count; ++v) {
-        runs[v].push_back(RunCommand(mode, length_s, variants[v].cpu));
-      }
-      peer.push_back(RunInProcessLoop(closed_loop, length_s));
-    }
-    std::printf("%s, %d rounds\n", what, rounds);
-    std::vector<double> medians;
-    for (std::size_t v = 0; v < variant_count; ++v) {
-      medians.push_back(PrintCommand(variants[v].label.c_str(), runs[v], length_s));
-    }
-    const double peer_s = PrintInProcess(peer, length_s);
-    std::printf("  ratio lockstep / in-process (whole command): %.1f not pinned", medians[0] / peer_s);
-    if (variant_count > 1) std::printf(", %.1f on one CPU", medians[1] / peer_s);
-    std::printf("\n");
-    if (closed_loop) {
-      std::printf("  same result: max |tracking error| lockstep %.6f mm, in-process %.6f mm\n",
-                  runs[0].front().max_error_m * 1e3, peer.front().max_error_m * 1e3);
-    }
-    return peer_s;
-  };
   double closed_peer_s = 0.0;
   if (o.command) {
-    closed_peer_s = compare(
+    closed_peer_s = CompareWithPeer(
         "closed loop, 12 s (48,000 twin + 12,000 ECS cycles): `hiltwin hil --clock virtual "
         "--no-progress`",
-        {}, kClosedLoopS, true, o.rounds, variants.size());
+        {}, kClosedLoopS, true, o.rounds, variants, variants.size());
   }
   if (o.openloop_rounds > 0) {
-    compare("open loop, 600 s (2,400,000 twin + 600,000 ECS cycles): `... --mode openloop "
-            "--duration 600`",
-            {"--mode", "openloop", "--duration", "600"}, kOpenLoopS, false, o.openloop_rounds,
-            1);  // not pinned only: on one CPU it would hold a CPU for ~40 s per round
+    // Not pinned only: on one CPU it would hold a CPU for ~40 s per round.
+    CompareWithPeer("open loop, 600 s (2,400,000 twin + 600,000 ECS cycles): `... --mode openloop "
+                    "--duration 600`",
+                    {"--mode", "openloop", "--duration", "600"}, kOpenLoopS, false,
+                    o.openloop_rounds, variants, 1);
   }
-
-  if (o.handover) {
-    std::vector<HandoverRun> free_runs;
-    std::vector<HandoverRun> apart_runs;
-    std::vector<HandoverRun> same_runs;
-    for (int r = 0; r < o.rounds; ++r) {
-      free_runs.push_back(RunHandovers(o.handovers, std::nullopt, std::nullopt));
-      apart_runs.push_back(RunHandovers(o.handovers, o.cpu, other_cpu));
-      same_runs.push_back(RunHandovers(o.handovers, o.cpu, o.cpu));
-    }
-    std::printf("one lockstep hand-over: two processes, interleaved waits (every wait hands the turn over)\n");
-    char label[64];
-    const double free_ns = PrintHandovers("not pinned", free_runs, o.handovers);
-    std::snprintf(label, sizeof label, "pinned apart, CPUs %d and %d", o.cpu, other_cpu);
-    const double apart_ns = PrintHandovers(label, apart_runs, o.handovers);
-    std::snprintf(label, sizeof label, "both on CPU %d", o.cpu);
-    const double same_ns = PrintHandovers(label, same_runs, o.handovers);
-    std::printf("  the 12 s closed loop hands the turn over twice per ECS cycle, 24,000 times: %.0f ms "
-                "not pinned, %.0f ms apart, %.0f ms on one CPU\n",
-                24'000.0 * free_ns * 1e-6, 24'000.0 * apart_ns * 1e-6, 24'000.0 * same_ns * 1e-6);
-    if (closed_peer_s > 0.0) {
-      std::printf("  for scale: the in-process closed loop spends %.0f ns per ECS cycle on all of its work\n",
-                  closed_peer_s * 1e9 / (kClosedLoopS * 1000.0));
-    }
-  }
+  if (o.handover) CompareHandovers(o, other_cpu, closed_peer_s);
   return 0;
 }
