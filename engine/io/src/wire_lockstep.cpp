@@ -85,6 +85,15 @@ bool WireBus::LockstepClock::PeerStillTakingTurns() noexcept {
   }
   const bool same_peer = peer().sessions.load(std::memory_order_relaxed) == peer_sessions_;
   if (status == BusResult::kOk && same_peer) return true;
+  // Still in its set-up (lockstep time 0: its loop has not waited yet). It beat at its INIT,
+  // which made it count as up, and beats again only once it polls for this side or runs: under
+  // load (a sanitizer, a busy machine) its set-up in between may outlast the heartbeat timeout.
+  // Alive, it is given kLockstepSetUpNs before it counts as hung.
+  if (status == BusResult::kPeerLost && same_peer &&
+      peer().lockstep_ns.load(std::memory_order_relaxed) == 0) {
+    if (set_up_seen_ns_ < 0) set_up_seen_ns_ = wall_ns;
+    if (wall_ns - set_up_seen_ns_ < kLockstepSetUpNs) return true;
+  }
   // A new session, or a side attached but not beating yet: another process; else its
   // heartbeat is stale (hung, SIGSTOP).
   broken_ = status == BusResult::kOk || status == BusResult::kPeerAbsent ? kPeerNew[column]

@@ -30,6 +30,9 @@ class WireBus::LockstepClock final : public kernel_glue::Clock {
   /// Spinning beyond this costs more than the futex sleep it avoids.
   static constexpr kernel_glue::TimeNs kLockstepSpinNs = 20'000;
   static constexpr kernel_glue::TimeNs kLockstepSliceNs = 10'000'000;
+  /// How long a live peer may stay in its set-up (between its INIT and its loop's first wait)
+  /// without a heartbeat before it counts as hung.
+  static constexpr kernel_glue::TimeNs kLockstepSetUpNs = 30'000'000'000;
 
   /// Binds to `bus`, whose segment it reaches only once the loop waits (after the bus mapped it).
   explicit LockstepClock(WireBus& bus) noexcept;
@@ -65,6 +68,7 @@ class WireBus::LockstepClock final : public kernel_glue::Clock {
   bool ecs_side_;
   kernel_glue::TimeNs now_ns_ = 0;
   std::uint32_t peer_sessions_ = 0;  ///< the peer's session count when the loop began
+  kernel_glue::TimeNs set_up_seen_ns_ = -1;  ///< wall time this side first saw the peer in set-up
   const char* broken_ = nullptr;
   LockstepCounts counts_{};
 };

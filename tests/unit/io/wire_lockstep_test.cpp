@@ -195,12 +195,16 @@ TEST(WireLockstep, AStoppedPeerReleasesTheWaiterWhoseExchangeThenSaysWhy) {
   EXPECT_STREQ(status.peer_stopped, "wire: the ECS finished its run");
 }
 
-/// A child process that attaches as the ECS in lockstep, comes up and then only polls (so it
-/// holds the lockstep at time 0, as a side still setting up does) until it is signalled.
+/// A child process that attaches as the ECS in lockstep, comes up, takes its turn at 1 ms and
+/// then holds it, only polling (alive, beating, but never releasing the time) until signalled.
 pid_t StartPollingEcs(const std::string& name) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
+    while (ecs.Poll().result != BusResult::kOk) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ecs.lockstep_clock()->SleepUntilNs(1'000'000);
     for (;;) {
       static_cast<void>(ecs.Poll());
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -218,9 +222,10 @@ bool UpBeside(WireBus& bus) {
   return bus.Poll().result == BusResult::kOk;
 }
 
-/// The twin waits for a turn the child ECS holds; `signal` reaches the child 200 ms into the
-/// wait. Returns how long the wait outlasted the signal.
+/// The twin runs its release at 250 µs, then waits at 1 ms for the turn the child ECS holds;
+/// `signal` reaches the child 200 ms into the wait. Returns how long the wait outlasted it.
 Wall::duration WaitWhileTheEcsGets(int signal, WireBus& twin, pid_t child) {
+  twin.lockstep_clock()->SleepUntilNs(250'000);  // the ECS waits at 1 ms: the twin's turn
   Wall::time_point signalled;
   std::thread signaller([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -230,7 +235,7 @@ Wall::duration WaitWhileTheEcsGets(int signal, WireBus& twin, pid_t child) {
     // reaps it only its heartbeat's age tells it is gone.
     if (signal == SIGKILL) ::waitpid(child, nullptr, 0);
   });
-  twin.lockstep_clock()->SleepUntilNs(250'000);
+  twin.lockstep_clock()->SleepUntilNs(1'000'000);  // the ECS's turn first, which it keeps
   const Wall::time_point released = Wall::now();
   signaller.join();
   return released - signalled;
