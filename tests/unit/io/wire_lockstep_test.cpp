@@ -261,6 +261,34 @@ TEST(WireLockstep, AKilledPeerBreaksTheLockstepWithinASecond) {
       << status.reason;
 }
 
+// A side counts as up from its INIT's beat; its session's set-up follows before its loop waits
+// for the first time, and under load (a sanitizer, a busy machine) that may outlast the
+// heartbeat timeout. Still in its set-up (lockstep time 0) and alive, it is not hung.
+TEST(WireLockstep, APeerWhoseSetUpOutlastsTheHeartbeatTimeoutIsWaitedFor) {
+  const std::string name = FreshName("setup");
+  WireBus twin_bus(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
+    while (ecs.Poll().result != BusResult::kOk) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    std::this_thread::sleep_for(std::chrono::nanoseconds(2 * kWireLockstepHeartbeatTimeoutNs));
+    ecs.lockstep_clock()->SleepUntilNs(1'000'000);  // its loop's first wait, after a slow set-up
+    ecs.AnnounceStop(StopCause::kFinished);
+    ::_exit(0);
+  }
+  ASSERT_GT(child, 0);
+  ASSERT_TRUE(UpBeside(twin_bus));
+  IcoBoardInverse twin(twin_bus);
+  ASSERT_TRUE(twin.Init(250'000).ok);
+  twin_bus.lockstep_clock()->SleepUntilNs(250'000);  // held by the ECS's set-up, then its turn
+  TwinInputs in{};
+  const ExchangeStatus status = twin.Exchange({0, 0, 0, 0}, in);
+  EXPECT_TRUE(status.ok()) << status.reason;
+  ::waitpid(child, nullptr, 0);
+}
+
 TEST(WireLockstep, AStoppedPeerThatStopsTakingTurnsBreaksTheLockstepWithinASecond) {
   const std::string name = FreshName("sigstop");
   WireBus twin_bus(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
