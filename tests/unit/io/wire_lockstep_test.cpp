@@ -195,15 +195,22 @@ TEST(WireLockstep, AStoppedPeerReleasesTheWaiterWhoseExchangeThenSaysWhy) {
   EXPECT_STREQ(status.peer_stopped, "wire: the ECS finished its run");
 }
 
+/// Polls until the peer is up (at most 10 s); true when it is.
+bool UpBeside(WireBus& bus) {
+  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
+  while (bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return bus.Poll().result == BusResult::kOk;
+}
+
 /// A child process that attaches as the ECS in lockstep, comes up, takes its turn at 1 ms and
 /// then holds it, only polling (alive, beating, but never releasing the time) until signalled.
 pid_t StartPollingEcs(const std::string& name) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
-    while (ecs.Poll().result != BusResult::kOk) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    if (!UpBeside(ecs)) ::_exit(1);
     ecs.lockstep_clock()->SleepUntilNs(1'000'000);
     for (;;) {
       static_cast<void>(ecs.Poll());
@@ -213,13 +220,16 @@ pid_t StartPollingEcs(const std::string& name) {
   return pid;
 }
 
-/// Polls until the peer is up (at most 10 s); true when it is.
-bool UpBeside(WireBus& bus) {
-  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
-  while (bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+/// StartPollingEcs, up beside `twin_bus`, whose board `twin` is initialised; -1 on failure.
+pid_t StartHoldingEcsBeside(const std::string& name, WireBus& twin_bus, IcoBoardInverse& twin) {
+  const pid_t child = StartPollingEcs(name);
+  if (child <= 0) return -1;
+  if (!UpBeside(twin_bus) || !twin.Init(250'000).ok) {
+    ::kill(child, SIGKILL);
+    ::waitpid(child, nullptr, 0);
+    return -1;
   }
-  return bus.Poll().result == BusResult::kOk;
+  return child;
 }
 
 /// The twin runs its release at 250 µs, then waits at 1 ms for the turn the child ECS holds;
@@ -244,11 +254,9 @@ Wall::duration WaitWhileTheEcsGets(int signal, WireBus& twin, pid_t child) {
 TEST(WireLockstep, AKilledPeerBreaksTheLockstepWithinASecond) {
   const std::string name = FreshName("kill");
   WireBus twin_bus(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
-  const pid_t child = StartPollingEcs(name);
-  ASSERT_GT(child, 0);
-  ASSERT_TRUE(UpBeside(twin_bus));
   IcoBoardInverse twin(twin_bus);
-  ASSERT_TRUE(twin.Init(250'000).ok);
+  const pid_t child = StartHoldingEcsBeside(name, twin_bus, twin);
+  ASSERT_GT(child, 0) << "the forked ECS did not come up, or the twin's INIT failed";
   const Wall::duration late = WaitWhileTheEcsGets(SIGKILL, twin_bus, child);
   EXPECT_GE(late, Wall::duration::zero()) << "the wait ended before the kill";
   EXPECT_LT(late, std::chrono::seconds(1));
@@ -270,9 +278,7 @@ TEST(WireLockstep, APeerWhoseSetUpOutlastsTheHeartbeatTimeoutIsWaitedFor) {
   const pid_t child = ::fork();
   if (child == 0) {
     WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
-    while (ecs.Poll().result != BusResult::kOk) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    if (!UpBeside(ecs)) ::_exit(1);
     std::this_thread::sleep_for(std::chrono::nanoseconds(2 * kWireLockstepHeartbeatTimeoutNs));
     ecs.lockstep_clock()->SleepUntilNs(1'000'000);  // its loop's first wait, after a slow set-up
     ecs.AnnounceStop(StopCause::kFinished);
@@ -292,11 +298,9 @@ TEST(WireLockstep, APeerWhoseSetUpOutlastsTheHeartbeatTimeoutIsWaitedFor) {
 TEST(WireLockstep, AStoppedPeerThatStopsTakingTurnsBreaksTheLockstepWithinASecond) {
   const std::string name = FreshName("sigstop");
   WireBus twin_bus(name, Image::kIcoboardInverse, {}, WireClock::kLockstep);
-  const pid_t child = StartPollingEcs(name);
-  ASSERT_GT(child, 0);
-  ASSERT_TRUE(UpBeside(twin_bus));
   IcoBoardInverse twin(twin_bus);
-  ASSERT_TRUE(twin.Init(250'000).ok);
+  const pid_t child = StartHoldingEcsBeside(name, twin_bus, twin);
+  ASSERT_GT(child, 0) << "the forked ECS did not come up, or the twin's INIT failed";
   const Wall::duration late = WaitWhileTheEcsGets(SIGSTOP, twin_bus, child);
   ::kill(child, SIGKILL);
   ::waitpid(child, nullptr, 0);
