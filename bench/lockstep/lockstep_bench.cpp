@@ -428,7 +428,8 @@ double PrintCommand(const char* label, const std::vector<CommandRun>& runs, doub
   std::printf("    start-up + shut-down        %8.3f s  (%.3f .. %.3f)\n", s.median, s.min, s.max);
   std::printf("    CPU time, 3 processes       %8.3f s  (%.3f .. %.3f)  user + sys\n", c.median,
               c.min, c.max);
-  std::printf("    sleeps, 3 processes         %8.0f    (%.0f .. %.0f)  voluntary context switches, %.2f per ECS cycle\n",
+  std::printf("    sleeps, 3 processes         %8.0f    (%.0f .. %.0f)  "
+              "voluntary context switches, %.2f per ECS cycle\n",
               z.median, z.min, z.max, z.median / (length_s * 1000.0));
   std::printf("    rounds, whole command, s   ");
   for (const double v : wall) std::printf(" %.3f", v);
@@ -455,7 +456,8 @@ double PrintHandovers(const char* label, const std::vector<HandoverRun>& runs, l
   const Spread s = SpreadOf(ns);
   std::printf("  %-40s %8.0f ns  (%.0f .. %.0f)  %ld waits per side and round\n", label,
               s.median, s.min, s.max, n);
-  std::printf("    rounds: ns (futex sleeps / hand-overs; CPU twin/ECS at the end; preempted twin/ECS)\n     ");
+  std::printf("    rounds: ns (futex sleeps / hand-overs; CPU twin/ECS "
+              "at the end; preempted twin/ECS)\n     ");
   for (const HandoverRun& r : runs) {
     const std::uint64_t handovers = r.twin.counts.handovers + r.ecs.counts.handovers;
     const std::uint64_t sleeps = r.twin.counts.sleeps + r.ecs.counts.sleeps;
@@ -497,7 +499,8 @@ double CompareWithPeer(const char* what, const std::vector<std::string>& mode, d
     medians.push_back(PrintCommand(variants[v].label.c_str(), runs[v], length_s));
   }
   const double peer_s = PrintInProcess(peer, length_s);
-  std::printf("  ratio lockstep / in-process (whole command): %.1f not pinned", medians[0] / peer_s);
+  std::printf("  ratio lockstep / in-process (whole "
+              "command): %.1f not pinned", medians[0] / peer_s);
   if (variant_count > 1) std::printf(", %.1f on one CPU", medians[1] / peer_s);
   std::printf("\n");
   if (closed_loop) {
@@ -518,18 +521,21 @@ void CompareHandovers(const Options& o, int other_cpu, double peer_s) {
     apart_runs.push_back(RunHandovers(o.handovers, o.cpu, other_cpu));
     same_runs.push_back(RunHandovers(o.handovers, o.cpu, o.cpu));
   }
-  std::printf("one lockstep hand-over: two processes, interleaved waits (every wait hands the turn over)\n");
+  std::printf("one lockstep hand-over: two processes, interleaved "
+              "waits (every wait hands the turn over)\n");
   char label[64];
   const double free_ns = PrintHandovers("not pinned", free_runs, o.handovers);
   std::snprintf(label, sizeof label, "pinned apart, CPUs %d and %d", o.cpu, other_cpu);
   const double apart_ns = PrintHandovers(label, apart_runs, o.handovers);
   std::snprintf(label, sizeof label, "both on CPU %d", o.cpu);
   const double same_ns = PrintHandovers(label, same_runs, o.handovers);
-  std::printf("  the 12 s closed loop hands the turn over twice per ECS cycle, 24,000 times: %.0f ms "
+  std::printf("  the 12 s closed loop hands the turn over twice per "
+              "ECS cycle, 24,000 times: %.0f ms "
               "not pinned, %.0f ms apart, %.0f ms on one CPU\n",
               24'000.0 * free_ns * 1e-6, 24'000.0 * apart_ns * 1e-6, 24'000.0 * same_ns * 1e-6);
   if (peer_s > 0.0) {
-    std::printf("  for scale: the in-process closed loop spends %.0f ns per ECS cycle on all of its work\n",
+    std::printf("  for scale: the in-process closed loop spends %.0f "
+                "ns per ECS cycle on all of its work\n",
                 peer_s * 1e9 / (kClosedLoopS * 1000.0));
   }
 }
@@ -546,7 +552,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const Options& o = *parsed;
-  std::printf("lockstep benchmark: %d rounds, each runs every variant, then the peer; median (min .. max)\n",
+  std::printf("lockstep benchmark: %d rounds, each runs every variant, "
+              "then the peer; median (min .. max)\n",
               o.rounds);
   const int other_cpu =
       (o.cpu + 1) % std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
