@@ -112,10 +112,11 @@ void WireBus::LockstepClock::WaitForTurn(kernel_glue::TimeNs t_ns) noexcept {
   // the peer's side is another process, which a lockstep run cannot take.
   if (counts_.waits == 1) peer_sessions_ = peer().sessions.load(std::memory_order_relaxed);
   WireSegment& seg = *bus_.segment_;
-  Publish(t_ns);
   // A wait is a sign of life: the peer that gets the turn now may look at this side's
-  // heartbeat before this side transfers again (after a long set-up, a long log wait).
+  // heartbeat before this side transfers again (after a long set-up, a long log wait). Before
+  // the publish, which hands the turn over: the peer must find the beat already there.
   bus_.Beat(bus_.wall_.NowNs());
+  Publish(t_ns);
   bool handed_over = false;
   kernel_glue::TimeNs waiting_since_ns = 0;
   kernel_glue::TimeNs looked_ns = 0;  // when the peer was last looked at
