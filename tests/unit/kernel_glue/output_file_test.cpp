@@ -1,11 +1,15 @@
 // OpenOutputFile: user-named output files are created or truncated, never written through a
-// symbolic link, and every refusal names the flag, the path and the fix.
+// symbolic link, and every refusal names the flag, the path and the fix. ReplacementFile: a
+// report replaces the old file only once it is whole, refuses what OpenOutputFile refuses, and
+// leaves no temporary file behind.
 #include "hiltwin/kernel_glue/output_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <fcntl.h>
+
+#include <sys/stat.h>
 
 #include <cerrno>
 #include <filesystem>
@@ -105,6 +109,59 @@ TEST_F(OutputFileTest, AMissingFolderAFolderAndAFileAsFolderAreExplained) {
   const OutputFileError e = ErrorFor(Path("plain/r.json"), "--report");
   EXPECT_EQ(e.error_number(), ENOTDIR);
   EXPECT_NE(std::string(e.what()).find("is not a folder"), std::string::npos) << e.what();
+}
+
+TEST_F(OutputFileTest, AReplacementReplacesTheOldFileOnlyWhenCommitted) {
+  std::ofstream(Path("r.json")) << "previous\n";
+  {
+    ReplacementFile file(Path("r.json"), "--report");
+    ASSERT_TRUE(file.is_open());
+    // Beside the report, hidden, in the same folder (one file system: rename is atomic).
+    EXPECT_EQ(fs::path(file.temporary_path()).parent_path(), dir_);
+    EXPECT_EQ(fs::path(file.temporary_path()).filename().string().rfind(".r.json.hiltwin-", 0),
+              0U);
+    EXPECT_TRUE(fs::exists(file.temporary_path()));
+    EXPECT_EQ(ReadText(Path("r.json")), "previous\n");
+    EXPECT_EQ(file.Commit("new\n"), 0);
+    EXPECT_FALSE(file.is_open());
+    EXPECT_EQ(file.Commit("again\n"), EBADF);  // once only
+  }
+  EXPECT_EQ(ReadText(Path("r.json")), "new\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+TEST_F(OutputFileTest, AReplacementNeverCommittedLeavesTheOldFileAndNoTemporaryFile) {
+  std::ofstream(Path("r.json")) << "previous\n";
+  { const ReplacementFile file(Path("r.json"), "--report"); }
+  { const ReplacementFile file(Path("new.json"), "--report"); }
+  EXPECT_EQ(ReadText(Path("r.json")), "previous\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+TEST_F(OutputFileTest, AReplacementRefusesWhatOpenOutputFileRefusesNamingThePath) {
+  std::ofstream(Path("precious")) << "keep\n";
+  fs::create_symlink(Path("precious"), Path("link.json"));
+  for (const std::string& path : {Path("link.json"), Path("nope/r.json"), dir_.string()}) {
+    const std::string expected = ErrorFor(path, "--report").what();
+    try {
+      const ReplacementFile file(path, "--report");
+      ADD_FAILURE() << path << " opened";
+    } catch (const OutputFileError& e) {
+      EXPECT_EQ(std::string(e.what()), expected);
+      EXPECT_EQ(e.path(), path);
+    }
+  }
+  EXPECT_EQ(ReadText(Path("precious")), "keep\n");
+  EXPECT_TRUE(fs::is_symlink(Path("link.json")));
+}
+
+TEST_F(OutputFileTest, AReplacementOfADeviceWritesIntoItInPlace) {
+  ReplacementFile file("/dev/null", "--report");
+  EXPECT_TRUE(file.temporary_path().empty());
+  EXPECT_EQ(file.Commit("discarded\n"), 0);
+  struct stat status {};
+  ASSERT_EQ(::stat("/dev/null", &status), 0);
+  EXPECT_TRUE(S_ISCHR(status.st_mode));  // the device node is still there, not a file
 }
 
 }  // namespace

@@ -41,4 +41,45 @@ class OutputFileError : public std::runtime_error {
 /// in messages ("--log"). Throws OutputFileError.
 [[nodiscard]] int OpenOutputFile(const std::string& path, const std::string& name);
 
+/// An output file written whole or not at all (a report): the text goes to a new file beside
+/// `path` (same folder, hidden name `.<file>.hiltwin-<pid>-<n>`, so one file system and an
+/// atomic rename(2)), which replaces `path` only once it is whole and on the disk. A write that
+/// fails (a full disk, a size limit) leaves `path` as it was, a previous run's file included;
+/// only the temporary file is removed. `path` is checked when this is made, so a path that
+/// cannot be written fails before the work whose result it is meant to hold: a final symbolic
+/// link, a folder, a missing folder and a file the user may not write are refused as
+/// OpenOutputFile refuses them (OutputFileError naming `path`). An existing `path` that is not a
+/// regular file (a device such as /dev/null, a FIFO) is opened in place instead: it holds
+/// nothing to keep, and a rename would replace the device node.
+class ReplacementFile {
+ public:
+  ReplacementFile() = default;  ///< nothing to write
+  /// `name` says who named `path` in messages ("--report"). Throws OutputFileError.
+  ReplacementFile(std::string path, const std::string& name);
+  /// Not committed: removes the temporary file; `path` stays as it was.
+  ~ReplacementFile();
+  ReplacementFile(ReplacementFile&& other) noexcept;
+  ReplacementFile& operator=(ReplacementFile&&) = delete;
+  ReplacementFile(const ReplacementFile&) = delete;
+  ReplacementFile& operator=(const ReplacementFile&) = delete;
+
+  /// A file is open to be written (not default-made, not committed yet).
+  [[nodiscard]] bool is_open() const noexcept { return fd_ >= 0; }
+  /// The path as given.
+  [[nodiscard]] const std::string& path() const noexcept { return path_; }
+  /// The temporary file's name; empty when `path` is written in place.
+  [[nodiscard]] const std::string& temporary_path() const noexcept { return temporary_; }
+
+  /// Writes `text`, flushes it to the disk (fsync) and renames it over `path`. Returns 0, or
+  /// the errno of the step that failed, after removing the temporary file. Once only.
+  [[nodiscard]] int Commit(const std::string& text) noexcept;
+
+ private:
+  void Discard() noexcept;
+
+  std::string path_;
+  std::string temporary_;
+  int fd_ = -1;
+};
+
 }  // namespace hiltwin::kernel_glue
