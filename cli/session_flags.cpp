@@ -9,6 +9,8 @@
 #include "hiltwin/io/link_fault_injection.h"
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/qos/rules.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/scheduler/overrun_policy.h"
 
@@ -109,6 +111,17 @@ std::vector<io::LinkFaultInjection> LinkFaultsOf(const std::vector<std::string>&
   return faults;
 }
 
+/// Every file `run` reads and writes: --input (unless built in), --plant-map, --config, the
+/// FMU of --plant fmu:PATH, and the shared outputs.
+std::vector<NamedFile> TwinRunFiles(const TwinRunFlags& f) {
+  std::vector<NamedFile> files = SessionOutputFiles(f.session);
+  files.push_back(ProfileFile("--input", f.input, BuiltinProfileNames()));
+  files.push_back({"--plant-map", f.plant_map_path, false});
+  files.push_back({"--config", f.config_path, false});
+  files.push_back({"--plant", FmuPathOf(f.plant), false});
+  return files;
+}
+
 /// --input-rate, or its documented default.
 double ControllerRateOf(const TwinRunFlags& f) {
   return f.input_rate_hz == 0.0 ? std::min(1000.0, f.session.rate_hz) : f.input_rate_hz;
@@ -195,6 +208,12 @@ void AddTelemetryFlags(CLI::App& app, telemetry::TelemetryOptions& t) {
       ->capture_default_str();
 }
 
+std::vector<NamedFile> SessionOutputFiles(const SessionFlags& f) {
+  return {{"--log", f.log_path, true},
+          {"--timing-log", f.timing_log_path, true},
+          {"--report", f.report_path, true}};
+}
+
 runtime::ClockKind ClockKindOf(const std::string& text) {
   if (text == "virtual") return runtime::ClockKind::kVirtual;
   if (text != "realtime") ThrowUsage("--clock " + text + ": use realtime or virtual");
@@ -261,7 +280,8 @@ void AddTwinRunFlags(CLI::App& app, TwinRunFlags& o) {
                  "delay-answer or stuck-encoder (to the end without count) (repeatable)");
 }
 
-TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command) {
+TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command,
+                                  const std::vector<NamedFile>& more_files) {
   TwinRunOptions o;
   o.session = SessionNumbersOf(f.session);
   o.controller_rate_hz = ControllerRateOf(f);
@@ -275,6 +295,9 @@ TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command) {
   ValidateTwinRunNumbers(o);
   ParseSessionTexts(f.session, TwinRole(command, o.controller_rate_hz), o.session);
   o.link_faults = LinkFaultsOf(f.inject_link_faults);
+  std::vector<NamedFile> files = TwinRunFiles(f);
+  files.insert(files.end(), more_files.begin(), more_files.end());
+  CheckFilesDistinct(files);
   return o;
 }
 

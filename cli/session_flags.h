@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "hiltwin/runs/output_files.h"
 #include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/session_settings.h"
 #include "hiltwin/runs/twin_run.h"
@@ -68,6 +69,10 @@ void AddTelemetryFlags(CLI::App& app, telemetry::TelemetryOptions& t);
 /// default (m,k) rule for role's rate pair unless --qos is given) and --inject-overrun.
 void ParseSessionTexts(const SessionFlags& f, const SessionRole& role, SessionSettings& s);
 
+/// The shared flags' output files (--log, --timing-log, --report), for CheckFilesDistinct
+/// beside the command's own inputs and outputs.
+[[nodiscard]] std::vector<NamedFile> SessionOutputFiles(const SessionFlags& f);
+
 /// "realtime" or "virtual" (--clock, checked by CLI11 to be one of them).
 [[nodiscard]] runtime::ClockKind ClockKindOf(const std::string& text);
 
@@ -87,8 +92,10 @@ struct TwinRunFlags {
 void AddTwinRunFlags(CLI::App& app, TwinRunFlags& f);
 
 /// The typed options of `run`'s flags: the controller rate resolved, the session's settings
-/// (SessionSettingsFrom) and --inject-link-fault parsed. `command` ("run", "trace") names the
-/// command in messages.
-[[nodiscard]] TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command);
+/// (SessionSettingsFrom), --inject-link-fault parsed, and no output naming an input or another
+/// output (CheckFilesDistinct over the run's files and the command's `more_files`, e.g. what
+/// `trace` writes). `command` ("run", "trace") names the command in messages.
+[[nodiscard]] TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command,
+                                                const std::vector<NamedFile>& more_files = {});
 
 }  // namespace hiltwin::app

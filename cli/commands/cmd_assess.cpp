@@ -11,10 +11,12 @@
 #include <string_view>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include "commands.h"
 #include "hiltwin/assess/assessment.h"
 #include "hiltwin/runs/assess_run.h"
+#include "hiltwin/runs/output_files.h"
 #include "hiltwin/tracing/csv.h"
 
 namespace hiltwin::app {
@@ -139,6 +141,18 @@ std::string FlagPrefix(const AssessCliOptions& o, analysis::AssessOption option)
   return std::string(FlagOf(option)) + (value.empty() ? "" : " " + value) + ": ";
 }
 
+// Every file assess reads and writes, for CheckFilesDistinct: a curve's file as the flag that
+// named it (FILE when it is the positional one), and --plot.
+std::vector<NamedFile> AssessFiles(const AssessCliOptions& o, const AssessRunOptions& run) {
+  const auto curve_file = [&o](const char* flag, const CurveSpec& spec) {
+    return NamedFile{spec.file == o.file ? "FILE" : flag, spec.file, false};
+  };
+  std::vector<NamedFile> files = {curve_file("--sim", run.sim), curve_file("--exp", run.exp),
+                                  {"--plot", o.plot, true}};
+  if (run.input) files.push_back(curve_file("--input", *run.input));
+  return files;
+}
+
 // The flags' text, read once: the curves' specs, the weights and ranges as numbers, and the
 // library's options, which name their choices by flag (FlagOf) and the flags' values as typed.
 AssessRunOptions AssessRunOptionsOf(const AssessCliOptions& o) {
@@ -166,6 +180,7 @@ AssessRunOptions AssessRunOptionsOf(const AssessCliOptions& o) {
   run.plot = o.plot;
   run.json = o.json;
   run.flag_prefix = [o](analysis::AssessOption option) { return FlagPrefix(o, option); };
+  CheckFilesDistinct(AssessFiles(o, run));
   return run;
 }
 

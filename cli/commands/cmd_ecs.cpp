@@ -5,9 +5,13 @@
 // Flags -> EcsRunOptions (typed, read once) -> RunEcs (hiltwin/runs/ecs_run.h).
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/ecs_run.h"
+#include "hiltwin/runs/output_files.h"
 #include "session_flags.h"
 
 namespace hiltwin::app {
@@ -24,7 +28,18 @@ struct EcsFlags {
   std::string config_path;
 };
 
-/// The flags, read once (exit 2 naming the flag).
+/// Every file `ecs` reads and writes: the profiles (unless built in), --gains, --config and the
+/// shared outputs.
+std::vector<NamedFile> EcsFiles(const EcsFlags& f) {
+  std::vector<NamedFile> files = SessionOutputFiles(f.session);
+  files.push_back(ProfileFile("--setpoint", f.setpoint, BuiltinSetpointNames()));
+  files.push_back(ProfileFile("--input", f.input, BuiltinProfileNames()));
+  files.push_back({"--gains", f.gains_path, false});
+  files.push_back({"--config", f.config_path, false});
+  return files;
+}
+
+/// The flags, read once (exit 2 naming the flag); no output names an input or another output.
 EcsRunOptions EcsRunOptionsOf(const EcsFlags& f) {
   EcsRunOptions o;
   o.session = SessionSettingsFrom(f.session, EcsRole(f.session.rate_hz));
@@ -34,6 +49,7 @@ EcsRunOptions EcsRunOptionsOf(const EcsFlags& f) {
   o.input = f.input;
   o.gains_path = f.gains_path;
   o.config_path = f.config_path;
+  CheckFilesDistinct(EcsFiles(f));
   return o;
 }
 

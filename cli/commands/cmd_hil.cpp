@@ -68,9 +68,11 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
   }
 }
 
-/// The flags, read once, in the order they are checked (exit 2 naming the flag): the rates and
-/// the duration (0: the profile's length, read here), the telemetry flags and the wire's name.
+/// The flags, read once, in the order they are checked (exit 2 naming the flag): the files (no
+/// output names an input or another output), the rates and the duration (0: the profile's
+/// length, read here), the telemetry flags and the wire's name.
 HilRunOptions HilRunOptionsOf(HilRunOptions o) {
+  CheckFilesDistinct(HilFiles(o));
   Validate(o);
   ValidateTelemetry(o.telemetry);
   if (o.wire.empty()) o.wire = "hil-" + std::to_string(::getpid());

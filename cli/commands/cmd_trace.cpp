@@ -64,7 +64,7 @@ Command AddTraceCommand(CLI::App& parent) {
                                    "--pid goes with --analyze: a recording made by trace keeps "
                                    "only its own process");
               }
-              o->run = TwinRunOptionsFrom(*run_flags, "trace");
+              o->run = TwinRunOptionsFrom(*run_flags, "trace", TraceOutputFiles(o->output_dir));
               return TraceTwin(*o);
             }
             RefuseRunFlagsWithAnalyze(*app);

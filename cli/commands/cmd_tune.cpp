@@ -3,17 +3,17 @@
 // TuneOptions (typed, read once) -> RunTune -> one TuneReport -> text, JSON, plot.
 #include <unistd.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "hiltwin/tuning/tuning_report.h"
 #include "commands.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/runs/output_files.h"
 #include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runs/tune.h"
 #include "session_flags.h"
@@ -68,20 +68,21 @@ void CheckOutputPath(const std::string& path, const char* flag) {
   }
 }
 
-void WriteReportFile(const std::string& path, const analysis::TuneReport& report) {
-  std::ofstream file(path, std::ios::out | std::ios::trunc);
-  file << analysis::ToJson(report).dump(2) << '\n';
-  if (!file.flush()) {
-    throw CommandError(ExitCode::kIo,
-                       "--report " + path + ": cannot write it (" + std::strerror(errno) + ")");
-  }
+/// Every file tune reads and writes, for CheckFilesDistinct.
+std::vector<NamedFile> TuneFiles(const TuneCommandOptions& o) {
+  return {ProfileFile("--input", o.tune.input, BuiltinProfileNames()),
+          {"--config", o.tune.config_path, false},
+          {"--report", o.report_path, true},
+          {"--plot", o.plot_path, true}};
 }
 
 int RunTuneCommand(const TuneCommandOptions& flags) {
   TuneCommandOptions o = flags;
   o.tune.clock = ClockKindOf(flags.clock);
   CheckTuneOptions(o.tune);
-  CheckOutputPath(o.report_path, "--report");
+  CheckFilesDistinct(TuneFiles(o));
+  // Made now (a bad path fails before minutes of measuring), written whole at the end.
+  ReportFile report_file(o.report_path);
   CheckOutputPath(o.plot_path, "--plot");
   analysis::TuneReport report;
   {
@@ -95,7 +96,7 @@ int RunTuneCommand(const TuneCommandOptions& flags) {
     std::fputs(analysis::FormatTuneText(report).c_str(), stdout);
   }
   std::fflush(stdout);
-  if (!o.report_path.empty()) WriteReportFile(o.report_path, report);
+  report_file.Write(analysis::ToJson(report).dump(2) + '\n');
   if (!o.plot_path.empty()) {
     try {
       analysis::WriteTunePlotHtml(report, o.plot_path);

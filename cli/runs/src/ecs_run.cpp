@@ -147,9 +147,8 @@ int RunEcs(const EcsRunOptions& options) {
   const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
   const EcsFigures figures =
       EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
-  PrintOutcome(role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
-               report_file);
-  return static_cast<int>(runtime::ExitCodeFor(report));
+  return PrintOutcome(role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
+                      report_file);
 }
 
 }  // namespace hiltwin::app

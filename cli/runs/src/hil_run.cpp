@@ -22,6 +22,8 @@
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/process.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/command.h"
 #include "hiltwin/runs/hil_report.h"
 #include "hiltwin/runs/session_assembly.h"
@@ -37,6 +39,15 @@ using kernel_glue::Process;
 constexpr double kTwinExtraS = 2.0;
 /// After one side ended, how long the other may take to notice before it is told to stop.
 constexpr auto kPeerGrace = std::chrono::seconds(3);
+
+/// What each side leaves in the work folder: <side>.json, <side>.csv (with --log-dir), <side>.out.
+constexpr const char* kReport = ".json";
+constexpr const char* kLog = ".csv";
+constexpr const char* kOutput = ".out";
+
+std::string SideFile(const fs::path& dir, const std::string& side, const char* suffix) {
+  return (dir / (side + suffix)).string();
+}
 
 /// The folder for reports, logs and the two processes' output: --log-dir, or a temporary
 /// one removed at the end.
@@ -101,8 +112,8 @@ std::vector<std::string> TwinArgv(const HilRunOptions& o, const std::string& wir
                                    o.clock,
                                    "--no-progress",
                                    "--report",
-                                   (dir / "twin.json").string()};
-  if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", (dir / "twin.csv").string()});
+                                   SideFile(dir, "twin", kReport)};
+  if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", SideFile(dir, "twin", kLog)});
   if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
   AddRules(argv, o.twin_qos, o.twin_max_miss_pct, o.on_violation);
   AddTelemetry(argv, o.telemetry, "twin", true);
@@ -128,13 +139,13 @@ std::vector<std::string> EcsArgv(const HilRunOptions& o, const std::string& wire
                                    o.clock,
                                    "--no-progress",
                                    "--report",
-                                   (dir / "ecs.json").string()};
+                                   SideFile(dir, "ecs", kReport)};
   if (o.mode == "closedloop") {
     argv.insert(argv.end(), {"--setpoint", o.setpoint});
   } else {
     argv.insert(argv.end(), {"--input", o.input});
   }
-  if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", (dir / "ecs.csv").string()});
+  if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", SideFile(dir, "ecs", kLog)});
   if (!o.gains_path.empty()) argv.insert(argv.end(), {"--gains", o.gains_path});
   if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
   AddRules(argv, o.ecs_qos, o.ecs_max_miss_pct, o.on_violation);
@@ -153,7 +164,7 @@ struct Child {
 
 Child Start(const char* name, const std::vector<std::string>& argv, const fs::path& dir) {
   kernel_glue::ProcessOptions options;
-  options.out = kernel_glue::OutputTarget::File(dir / (std::string(name) + ".out"));
+  options.out = kernel_glue::OutputTarget::File(SideFile(dir, name, kOutput));
   options.err = kernel_glue::OutputTarget::SameAsStdout();
   return Child{name, Process::Start(argv, options), std::nullopt, std::nullopt};
 }
@@ -221,7 +232,7 @@ std::optional<nlohmann::ordered_json> ReadReport(const fs::path& path) {
 void ShowOutputOf(const Child& child, const fs::path& dir) {
   const int code = ExitCodeOf(*child.status);
   if (code == 0 || code == 3) return;
-  std::ifstream file(dir / (std::string(child.name) + ".out"));
+  std::ifstream file(SideFile(dir, child.name, kOutput));
   std::string line;
   std::fprintf(stderr, "hiltwin hil: the %s ended with %s; its output:\n", child.name,
                child.status->Describe().c_str());
@@ -229,6 +240,22 @@ void ShowOutputOf(const Child& child, const fs::path& dir) {
 }
 
 }  // namespace
+
+std::vector<NamedFile> HilFiles(const HilRunOptions& o) {
+  std::vector<NamedFile> files = {
+      ProfileFile("--setpoint", o.setpoint, BuiltinSetpointNames()),
+      ProfileFile("--input", o.input, BuiltinProfileNames()),
+      {"--gains", o.gains_path, false},
+      {"--config", o.config_path, false},
+      {"--report", o.report_path, true}};
+  if (o.log_dir.empty()) return files;  // a fresh temporary folder: nothing there to clobber
+  for (const char* side : {"twin", "ecs"}) {
+    for (const char* suffix : {kReport, kLog, kOutput}) {
+      files.push_back({"--log-dir", SideFile(o.log_dir, side, suffix), true});
+    }
+  }
+  return files;
+}
 
 int RunHil(const HilRunOptions& o) {
   const std::string& name = o.wire;
@@ -250,12 +277,12 @@ int RunHil(const HilRunOptions& o) {
   ShowOutputOf(twin, dir->path);
   ShowOutputOf(ecs, dir->path);
   const HilResult result =
-      CombineHil(wire, o.mode, HilSide{"twin", *twin.status, ReadReport(dir->path / "twin.json")},
-                 HilSide{"ecs", *ecs.status, ReadReport(dir->path / "ecs.json")});
+      CombineHil(wire, o.mode,
+                 HilSide{"twin", *twin.status, ReadReport(SideFile(dir->path, "twin", kReport))},
+                 HilSide{"ecs", *ecs.status, ReadReport(SideFile(dir->path, "ecs", kReport))});
   std::fputs(FormatHilSummary(result).c_str(), stdout);
   std::fflush(stdout);
-  report_file.Write(ToJson(result).dump(2) + '\n');
-  return result.exit_code;
+  return report_file.WriteAtEnd(ToJson(result).dump(2) + '\n', "hil", result.exit_code);
 }
 
 }  // namespace hiltwin::app

@@ -4,13 +4,10 @@
 #include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"
 
-#include <sys/stat.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <utility>
 
 #include "hiltwin/runtime/overrun_injection.h"
@@ -195,60 +192,18 @@ runtime::RunReport RunSessionOf(runtime::SessionConfig config, runtime::RunTask&
   return session->Run();
 }
 
-ReportFile::ReportFile(std::string path) : path_(std::move(path)) {
-  if (path_.empty()) return;
-  try {
-    fd_ = kernel_glue::OpenOutputFile(path_, "--report");  // a link or a missing folder: exit 2
-  } catch (const kernel_glue::OutputFileError& e) {
-    ThrowUsage(e.what());
-  }
-}
-
-ReportFile::ReportFile(ReportFile&& other) noexcept
-    : path_(std::move(other.path_)), fd_(std::exchange(other.fd_, -1)) {}
-
-ReportFile::~ReportFile() {
-  if (fd_ < 0) return;
-  // Never written: remove it, but only if the path still names the file this created.
-  struct stat ours {};
-  struct stat named {};
-  if (::fstat(fd_, &ours) == 0 && ::lstat(path_.c_str(), &named) == 0 &&
-      ours.st_dev == named.st_dev && ours.st_ino == named.st_ino) {
-    ::unlink(path_.c_str());
-  }
-  ::close(fd_);
-}
-
-void ReportFile::Write(const std::string& text) {
-  if (fd_ < 0) return;
-  std::size_t done = 0;
-  int error = 0;
-  while (done < text.size() && error == 0) {
-    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-    } else if (n < 0 && errno != EINTR) {
-      error = errno;
-    }
-  }
-  if (::close(std::exchange(fd_, -1)) != 0 && error == 0) error = errno;
-  if (error != 0) {
-    throw CommandError(ExitCode::kIo, "--report " + path_ + ": cannot write the run report (" +
-                                          std::strerror(error) +
-                                          "); check the disk has space and the folder is writable");
-  }
-}
-
-void PrintOutcome(const SessionRole& role,
-                  const runtime::RunReport& report, const nlohmann::ordered_json& json,
-                  const std::string& extra_summary, ReportFile& report_file) {
-  report_file.Write(json.dump(2) + '\n');
+int PrintOutcome(const SessionRole& role, const runtime::RunReport& report,
+                 const nlohmann::ordered_json& json, const std::string& extra_summary,
+                 ReportFile& report_file) {
+  // The summary first: a report the disk refuses must not cost the run's outcome on screen.
   std::fputs(extra_summary.c_str(), stdout);
   std::fputs(runtime::FormatSummary(report).c_str(), stdout);
   std::fflush(stdout);
   for (const std::string& line : runtime::Problems(report)) {
     std::fprintf(stderr, "hiltwin %s: %s\n", role.command, line.c_str());
   }
+  return report_file.WriteAtEnd(json.dump(2) + '\n', role.command,
+                                static_cast<int>(runtime::ExitCodeFor(report)));
 }
 
 }  // namespace hiltwin::app

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,6 +31,16 @@ namespace hiltwin::app {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// The files trace writes into its folder: its own, then the jitter module's (html, Perfetto,
+/// the pictures), named here too so that no run output is pointed at one of them.
+constexpr const char* kRunReportName = "run_report.json";
+constexpr const char* kTextReportName = "jitter_report.txt";
+constexpr const char* kJsonReportName = "jitter_report.json";
+constexpr std::array<const char*, 8> kFolderFileNames = {
+    kRunReportName,        kTextReportName,       kJsonReportName,
+    "jitter_report.html",  "perfetto_trace.json", "jitter_latency_histogram.png",
+    "jitter_timeline.png", "jitter_causes.png"};
 
 /// A folder for a new recording: created when missing, refused when it already holds files
 /// (LTTng would mix two runs' streams, and the report would describe neither).
@@ -108,7 +119,7 @@ void WriteOutputs(const analysis::JitterReport& report, const analysis::TimingTr
                   const std::string& dir) {
   spdlog::info("writing the jitter report into {}", dir);
   const std::string text = analysis::FormatJitterText(report);
-  std::vector<std::string> files = {dir + "/jitter_report.txt", dir + "/jitter_report.json"};
+  std::vector<std::string> files = {dir + "/" + kTextReportName, dir + "/" + kJsonReportName};
   WriteText(files[0], text);
   WriteText(files[1], analysis::JitterToJson(report).dump(2) + "\n");
   for (std::string& png : WritePictures(report, trace, dir)) files.push_back(std::move(png));
@@ -160,6 +171,15 @@ void CompareSummary(const char* name, const scheduler::TimingSummary& run,
 
 }  // namespace
 
+std::vector<NamedFile> TraceOutputFiles(const std::string& dir) {
+  std::vector<NamedFile> files;
+  if (dir.empty()) return files;
+  for (const char* name : kFolderFileNames) {
+    files.push_back({"--output", (fs::path(dir) / name).string(), true});
+  }
+  return files;
+}
+
 std::vector<std::string> CompareWithRunReport(const runtime::RunReport& run,
                                               const analysis::JitterReport& trace) {
   std::vector<std::string> out;
@@ -189,7 +209,8 @@ int TraceTwin(const TraceOptions& o) {
     if (capture.kernel) kernel = capture.kernel->Stop();
     const trace_capture::LttngChannelFigures figures = capture.lttng->Stop();
     spdlog::info("LTTng session stopped: {} events discarded", figures.discarded_events);
-    WriteText(o.output_dir + "/run_report.json", runtime::ToJson(outcome.report).dump(2) + "\n");
+    WriteText(o.output_dir + "/" + kRunReportName,
+              runtime::ToJson(outcome.report).dump(2) + "\n");
     const analysis::TimingTrace trace =
         analysis::ReadCtfTrace(o.output_dir, static_cast<int>(::getpid()));
     analysis::JitterReport report = Analyze(trace, kernel ? &*kernel : nullptr);
@@ -213,6 +234,9 @@ int AnalyzeTrace(const TraceOptions& o) {
   std::error_code ec;
   const bool is_folder = fs::is_directory(path, ec);
   if (dir.empty()) dir = is_folder ? path : path + ".jitter";
+  std::vector<NamedFile> files = TraceOutputFiles(dir);
+  files.push_back({"--analyze", path, false});
+  CheckFilesDistinct(files);
   try {
     spdlog::info("reading {}", path);
     const analysis::TimingTrace trace = analysis::ReadTrace(path, o.analyze_pid);

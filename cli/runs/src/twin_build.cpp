@@ -26,8 +26,8 @@ std::string KnownPlants() {
 std::unique_ptr<plant::Plant> OpenPlant(const TwinRunOptions& o,
                                         const plant::PlantEntry** entry_out) {
   const plant::PlantOptions options{o.config_path, o.integrator};
-  if (o.plant.starts_with(kFmuPrefix)) {
-    return fmi::OpenFmuPlant(o.plant.substr(kFmuPrefix.size()), options);
+  if (const std::string fmu = FmuPathOf(o.plant); !fmu.empty()) {
+    return fmi::OpenFmuPlant(fmu, options);
   }
   const plant::PlantEntry* entry = plant::FindPlant(o.plant);
   if (entry == nullptr) {
@@ -38,6 +38,10 @@ std::unique_ptr<plant::Plant> OpenPlant(const TwinRunOptions& o,
 }
 
 }  // namespace
+
+std::string FmuPathOf(const std::string& plant) {
+  return plant.starts_with(kFmuPrefix) ? plant.substr(kFmuPrefix.size()) : std::string();
+}
 
 void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin) {
   try {

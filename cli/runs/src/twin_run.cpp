@@ -132,7 +132,7 @@ TwinRunOutcome RunTwin(const TwinRunOptions& o, const char* command) {
   }
   runtime::RunTask& task = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
   const runtime::RunReport report = RunSessionOf(std::move(config), task);
-  PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
+  const int exit_code = PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
   if (report.fault && report.fault->kind == lifecycle::StopReason::kModelFault &&
       o.plant == kRelbotPlantName) {
     std::fprintf(
@@ -141,7 +141,6 @@ TwinRunOutcome RunTwin(const TwinRunOptions& o, const char* command) {
         command);
   }
   twin->plant->Finish();
-  const int exit_code = static_cast<int>(runtime::ExitCodeFor(report));
   return {report, exit_code};
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hiltwin/runs/output_files.h"
 #include "hiltwin/telemetry/sinks.h"
 
 namespace hiltwin::app {
@@ -36,6 +37,10 @@ struct HilRunOptions {
   /// Checked.
   telemetry::TelemetryOptions telemetry;
 };
+
+/// Every file hil reads and writes, for CheckFilesDistinct: the profiles (unless built in),
+/// --gains, --config, --report and, with --log-dir, each side's report, log and output there.
+[[nodiscard]] std::vector<NamedFile> HilFiles(const HilRunOptions& o);
 
 /// Starts both sides, waits for them (a stop signal is passed on), prints the combined summary
 /// and writes the combined report; returns the worse of the two sides' exit codes. Throws

@@ -11,6 +11,7 @@
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/runs/command.h"
+#include "hiltwin/runs/output_files.h"
 #include "hiltwin/runs/session_settings.h"
 #include "hiltwin/runtime/run_report.h"
 #include "hiltwin/runtime/run_session.h"
@@ -53,36 +54,12 @@ void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns);
 [[nodiscard]] runtime::RunReport RunSessionOf(runtime::SessionConfig config,
                                               runtime::RunTask& task);
 
-/// The --report file. Created before the run (kernel_glue::OpenOutputFile: a link or a missing
-/// folder is exit 2), so a path that cannot be written fails first, not after the run; written
-/// once, at the end, through the descriptor that created it. A report that was never written
-/// (the command failed before or during its run, e.g. the wrong FPGA image at INIT) is removed
-/// again: an empty file would read as a run that said nothing.
-class ReportFile {
- public:
-  ReportFile() = default;  ///< no --report
-  explicit ReportFile(std::string path);
-  ~ReportFile();
-  ReportFile(ReportFile&& other) noexcept;
-  ReportFile& operator=(ReportFile&&) = delete;
-  ReportFile(const ReportFile&) = delete;
-  ReportFile& operator=(const ReportFile&) = delete;
-
-  /// A report was asked for.
-  [[nodiscard]] bool wanted() const noexcept { return fd_ >= 0; }
-  /// Writes `text` and closes the file; CommandError (exit 5) naming the path when it cannot.
-  void Write(const std::string& text);
-
- private:
-  std::string path_;
-  int fd_ = -1;
-};
-
-/// Writes `json` to the report (exit 5 when it cannot), prints the summary on stdout and the
-/// problems on stderr, prefixed with "hiltwin <command>: ".
-void PrintOutcome(const SessionRole& role,
-                  const runtime::RunReport& report, const nlohmann::ordered_json& json,
-                  const std::string& extra_summary, ReportFile& report_file);
+/// Prints the summary on stdout and the problems on stderr, prefixed with "hiltwin <command>: ",
+/// then writes `json` to the report. Returns the run's exit code (runtime::ExitCodeFor), made
+/// at least as bad as 5 when the report could not be written (said on stderr, as a log's).
+[[nodiscard]] int PrintOutcome(const SessionRole& role, const runtime::RunReport& report,
+                               const nlohmann::ordered_json& json,
+                               const std::string& extra_summary, ReportFile& report_file);
 
 /// A number as a person writes it (4000, 0.25), for messages.
 [[nodiscard]] std::string Num(double value);

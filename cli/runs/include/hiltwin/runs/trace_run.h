@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hiltwin/jitter/jitter_report.h"
+#include "hiltwin/runs/output_files.h"
 #include "hiltwin/runs/twin_run.h"
 #include "hiltwin/runtime/run_report.h"
 
@@ -20,6 +21,11 @@ struct TraceOptions {
   std::string analyze_path;  ///< set: analyse this trace folder or timing log, run nothing
   int analyze_pid = 0;       ///< with analyze_path: the process of the trace to report on
 };
+
+/// The files trace writes into its folder `dir` (--output), as outputs for CheckFilesDistinct
+/// beside the run's: the run report, the jitter report's text, JSON, HTML and pictures, the
+/// Perfetto trace. None without a folder.
+[[nodiscard]] std::vector<NamedFile> TraceOutputFiles(const std::string& dir);
 
 /// Records, runs, analyses; returns the run's exit code (or 5 when the recording or its
 /// analysis failed after a run that was otherwise fine). Throws CommandError before the run.

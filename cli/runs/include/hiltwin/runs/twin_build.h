@@ -39,6 +39,9 @@ struct Twin {
   std::string input_name;
 };
 
+/// The FMU's path of `--plant fmu:PATH`; empty for a plant named by its name.
+[[nodiscard]] std::string FmuPathOf(const std::string& plant);
+
 /// Reads --config, --integrator and --input (exit 2 naming the problem) into `twin`.
 void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin);
 
