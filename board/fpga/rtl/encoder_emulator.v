@@ -8,7 +8,10 @@
 //   m = 0            -> nothing
 //   1 <= m <= 8191   -> m pulses up      (Table 4.1 case A, and case D: negative with overflow)
 //   8192 <= m        -> 2^14 - m down    (case B, and case C: positive with overflow)
-// N = min(plan, S); `limit` (PULSE_LIMIT) when plan > S. The pulses are spread over the S
+// N = min(plan, S, 8191); `limit` (PULSE_LIMIT) when plan > N. 8191, not 8192: a move of half
+// the 14-bit range (m = 8192) reads the same as its opposite after the wrap, so it is never
+// emitted in one period, whatever S (io::MaxPulsesPerPeriod); the last count follows in the next
+// period, flagged like any change over the limit. The pulses are spread over the S
 // sub-ticks with a division-free accumulator: acc += N each sub-tick, and when acc >= S one edge
 // is emitted and acc -= S, so edge j comes at sub-tick ceil(j*S/N) (io::PulseSegment).
 //
@@ -31,7 +34,8 @@ module encoder_emulator (
   reg [13:0] target_r;
   reg [13:0] diff_up;              // (target - reached) mod 2^14
   reg [13:0] diff_down;            // (reached - target) mod 2^14
-  reg [13:0] pulses;               // N (<= 8192)
+  reg [13:0] pulses;               // N (<= 8191)
+  reg [12:0] most;                 // min(S, 8191): the most pulses one period emits
   reg        up;                   // direction of this period
   reg [16:0] acc;                  // < S
   reg [17:0] acc_minus;            // acc + N - S (negative: no edge at the next tick)
@@ -83,8 +87,8 @@ module encoder_emulator (
       // T0+2: Table 4.1 and the pulse-rate limit.
       if (plan_stage[1]) begin
         up <= !diff_up[13];
-        if ({2'b00, plan} > subticks) begin
-          pulses <= subticks[13:0];  // S < plan <= 8192 here, so S fits 14 bits
+        if (plan > {1'b0, most}) begin
+          pulses <= {1'b0, most};
           limit  <= 1'b1;
         end else begin
           pulses <= plan;
@@ -94,6 +98,8 @@ module encoder_emulator (
       // T0+3: where this period ends (io::EncoderEmulator::PositionAt(t + step)).
       if (plan_stage[2]) end_position <= up ? position + pulses : position - pulses;
     end
+    // S changes only at INIT, at least one whole transfer (~300 clocks) before an ALL uses it.
+    most          <= (subticks > 16'd8191) ? 13'd8191 : subticks[12:0];
     // Registered look-ahead for the next tick (ticks are >= 4 clocks apart).
     acc_plus      <= acc + {3'b000, pulses};
     acc_minus     <= {1'b0, acc} + {4'b0000, pulses} - {2'b00, subticks};

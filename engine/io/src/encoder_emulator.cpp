@@ -20,8 +20,7 @@ std::uint32_t SubticksPerStep(std::int64_t step_ns, std::uint32_t divider) noexc
 }
 
 std::uint32_t MaxCountsPerStep(std::int64_t step_ns, std::uint32_t divider) noexcept {
-  const std::uint32_t subticks = SubticksPerStep(step_ns, divider);
-  return subticks < kMaxRepresentablePulses - 1 ? subticks : kMaxRepresentablePulses - 1;
+  return MaxPulsesPerPeriod(SubticksPerStep(step_ns, divider));
 }
 
 PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
@@ -102,8 +101,11 @@ bool EncoderEmulator::StartPeriod(std::int32_t target_counts, std::int64_t t_ns)
   const PulsePlan plan = PlanPulses(reached, WrapToRelative(target_counts));
   last_case_ = plan.difference_case;
   segment_.direction = plan.direction;
-  if (plan.pulses > segment_.subticks) {
-    segment_.pulses = segment_.subticks;
+  // At most one edge per sub-tick, and never half a turn: a move of 8192 on the 14-bit wrapping
+  // position reads as -8192, so its direction would be a guess (the gateware caps the same way).
+  const std::uint32_t most = MaxPulsesPerPeriod(segment_.subticks);
+  if (plan.pulses > most) {
+    segment_.pulses = most;
     ++limit_events_;
     return false;
   }

@@ -108,6 +108,55 @@ TEST(Pins, EncoderEdgesMatchThePulseSegmentsEdgeForEdge) {
               static_cast<long long>(latency));
 }
 
+/// Edges recorded on the twin's channel `c` (either line) since recording started.
+std::size_t EdgesOnChannel(const RtlBench& bench, std::size_t c) {
+  return SplitByChannel(bench.edges())[c].size();
+}
+
+/// The twin's ENC c read-back: where its emulator's current period ends.
+std::int32_t EncReadBack(VerilatedBoardDevice& device, std::size_t c, std::uint8_t& seq) {
+  io::FrameBytes miso{};
+  device.Exchange(Simple(io::EncOpcode(c), seq++, io::Image::kIcoboardInverse), miso);
+  device.Exchange(Noop(seq++), miso);
+  io::Frame answer;
+  EXPECT_EQ(io::Decode(miso, io::Direction::kAnswer, io::Image::kIcoboardInverse, answer),
+            io::FrameError::kOk)
+      << Hex(miso);
+  return answer.enc[c].counts;
+}
+
+TEST(Pins, AHalfTurnIsCappedAt8191AndFlaggedEvenWhenThePeriodHoldsIt) {
+  // 1 kHz: D = 12, S = 8,333 sub-ticks, room for 8,192 edges; but a move of exactly half the
+  // 14-bit range (0 -> -8192) is ambiguous in direction, so the board emits 8,191 with
+  // PULSE_LIMIT (spi-protocol.md, "Pulse-rate limit") and the last count in the next period.
+  constexpr std::uint32_t kHalfTurnStepNs = 1'000'000;
+  RtlBench bench(true, false, false);
+  VerilatedBoardDevice device(bench, io::Image::kIcoboardInverse);
+  const std::uint32_t divider = io::ClockDividerForStep(kHalfTurnStepNs);
+  ASSERT_GE(io::SubticksPerStep(kHalfTurnStepNs, divider), 8192U);
+  io::FrameBytes miso{};
+  std::uint8_t seq = 0;
+  device.Exchange(Init(seq++, kHalfTurnStepNs, divider, io::Image::kIcoboardInverse), miso);
+  device.Exchange(Noop(seq++), miso);
+  bench.StartRecording();
+  device.Exchange(AllTwin(seq++, {-8192, 8191, 0, 0}), miso);
+  device.Exchange(Noop(seq++), miso);
+  EXPECT_NE(miso[10] & io::kStatusPulseLimit, 0) << "ALL answer " << Hex(miso);
+  EXPECT_EQ(EncReadBack(device, 0, seq), -8191);
+  EXPECT_EQ(EncReadBack(device, 1, seq), 8191);  // 8191 up fits: no cap
+  // The period's edges are all out one step after the ALL.
+  bench.RunUntil(bench.now_ps() + std::int64_t{kHalfTurnStepNs} * 1000);
+  EXPECT_EQ(EdgesOnChannel(bench, 0), 8191U);
+  EXPECT_EQ(EdgesOnChannel(bench, 1), 8191U);
+  device.Exchange(AllTwin(seq++, {-8192, 8191, 0, 0}), miso);  // the carried-over count
+  device.Exchange(Noop(seq++), miso);
+  EXPECT_EQ(miso[10] & io::kStatusPulseLimit, 0) << "ALL answer " << Hex(miso);
+  EXPECT_EQ(EncReadBack(device, 0, seq), -8192);
+  bench.RunUntil(bench.now_ps() + std::int64_t{kHalfTurnStepNs} * 1000);
+  EXPECT_EQ(EdgesOnChannel(bench, 0), 8192U);  // one more, at the end of the period
+  EXPECT_EQ(EdgesOnChannel(bench, 1), 8191U);
+}
+
 TEST(Pins, PwmGeneratorIsHighFor2mClocksOfEvery4096) {
   RtlBench bench(false, true, false);
   VerilatedBoardDevice device(bench, io::Image::kIcoboard);

@@ -199,6 +199,23 @@ TEST(IcoBoardInverse, ChangesBeyondThePulseLimitAreReported) {
   EXPECT_NE(in.board_status & kStatusPulseLimit, 0);
 }
 
+TEST(IcoBoardInverse, AHalfTurnRaisesPulseLimitEvenWhenThePeriodHasTheSubticks) {
+  // 1 kHz: S = 8333 sub-ticks, yet a change of 8192 is half a turn (ambiguous in direction): the
+  // board emits 8191, answers PULSE_LIMIT, and the ENC read-back shows where the period ends.
+  constexpr std::int64_t kStepNs = 1'000'000;
+  TwinRig rig;
+  ASSERT_TRUE(rig.driver.Init(kStepNs).ok);
+  ASSERT_GE(SubticksPerStep(kStepNs, rig.driver.clock_divider()), 8192U);
+  TwinInputs in;
+  const ExchangeStatus s = rig.driver.Exchange({-8192, 0, 0, 0}, in);
+  ASSERT_TRUE(s.ok()) << s.reason;
+  EXPECT_NE(in.board_status & kStatusPulseLimit, 0);
+  EXPECT_EQ(rig.driver.counters().pulse_limit_events, 1U);
+  EXPECT_EQ(rig.driver.counters().counts_over_limit, 1U);  // the driver agrees with the board
+  EXPECT_EQ(rig.board.encoder(0).segment().pulses, 8191U);
+  EXPECT_EQ(rig.board.encoder(0).PositionAt(2 * kStepNs), -8191);
+}
+
 TEST(IcoBoardLink, EveryDamagedRequestBitIsCountedAsCorruptedNotMissed) {
   // The board echoes a damaged request's opcode and sequence bytes in its REQUEST_REJECTED answer:
   // a flip in the sequence byte must not pass for a stale answer. The hook flips bit 0, 1, ... 95

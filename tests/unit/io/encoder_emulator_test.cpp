@@ -94,6 +94,38 @@ TEST(EncoderEmulator, ChangesAboveTheLimitAreReportedAndCaughtUp) {
   EXPECT_EQ(e.limit_events(), 1U);
 }
 
+TEST(EncoderEmulator, AHalfTurnIsCappedAt8191AndFlaggedWhateverTheSubticks) {
+  // A move of exactly 8192 on the 14-bit wrapping position cannot be told from -8192: even when
+  // the period has sub-ticks for it (S >= 8192), at most 8191 are emitted, the limit is flagged
+  // and the last count follows in the next period (as the gateware's encoder_emulator.v does).
+  struct Rate {
+    std::int64_t step_ns;
+    std::uint32_t divider;
+  };
+  for (const Rate rate : {Rate{1'000'000, 12}, Rate{5'242'800, 8}}) {  // S = 8333, 65535
+    EncoderEmulator e;
+    ASSERT_TRUE(e.Configure(rate.step_ns, rate.divider));
+    ASSERT_GE(e.segment().subticks, 8192U);
+    EXPECT_FALSE(e.StartPeriod(-8192, 0)) << rate.divider;  // from 0: 8192 down
+    EXPECT_EQ(e.segment().pulses, 8191U) << rate.divider;
+    EXPECT_EQ(e.segment().direction, -1);
+    EXPECT_EQ(e.limit_events(), 1U);
+    EXPECT_EQ(e.PositionAt(rate.step_ns), -8191);
+    EXPECT_TRUE(e.StartPeriod(-8192, rate.step_ns));
+    EXPECT_EQ(e.PositionAt(2 * rate.step_ns), -8192);
+    // Back by +8192 (reads as -8192 again: Table 4.1 case C, down): capped the same way.
+    EXPECT_FALSE(e.StartPeriod(0, 2 * rate.step_ns));
+    EXPECT_EQ(e.segment().pulses, 8191U);
+    EXPECT_EQ(e.limit_events(), 2U);
+    // 8191 itself fits in one period.
+    EXPECT_TRUE(e.StartPeriod(8191, 3 * rate.step_ns));
+    EXPECT_EQ(e.PositionAt(4 * rate.step_ns), 8191);
+  }
+  EXPECT_EQ(MaxPulsesPerPeriod(65'535), 8191U);
+  EXPECT_EQ(MaxPulsesPerPeriod(8192), 8191U);
+  EXPECT_EQ(MaxPulsesPerPeriod(6250), 6250U);
+}
+
 TEST(EncoderEmulator, StuckEmitsNothingAndEarlySamplingKeepsPartialProgress) {
   EncoderEmulator e;
   ASSERT_TRUE(e.Configure(1'000'000, 12));

@@ -69,7 +69,9 @@ TEST(EncoderLineReader, CountsAreDecodedEdgesUpToTheReadTime) {
   lines.Add(twin.Sample({0, 0, 0, 0}, 0));  // INIT
   EncoderLineReader reader;
   reader.Update(lines, 0, false);
-  lines.Add(twin.Sample({1000, -1000, 8191, -8192}, kLinesStepNs));
+  // The largest change one period emits both ways (-8192 from 0 would be half a turn: capped
+  // at 8191, EncoderEmulator.AHalfTurnIsCappedAt8191AndFlaggedWhateverTheSubticks).
+  lines.Add(twin.Sample({1000, -1000, 8191, -8191}, kLinesStepNs));
   const PulseSegment& ch0 = lines.periods.back().channels[0];
   for (const std::int64_t t : {kLinesStepNs, kLinesStepNs + 1, kLinesStepNs + 250'000, kLinesStepNs + 777'777, 2 * kLinesStepNs}) {
     reader.Update(lines, t, false);
@@ -80,9 +82,9 @@ TEST(EncoderLineReader, CountsAreDecodedEdgesUpToTheReadTime) {
   EXPECT_EQ(reader.relative_counts(0), 1000);
   EXPECT_EQ(reader.relative_counts(1), -1000);
   EXPECT_EQ(reader.relative_counts(2), 8191);
-  EXPECT_EQ(reader.relative_counts(3), -8192);
+  EXPECT_EQ(reader.relative_counts(3), -8191);
   EXPECT_EQ(reader.reader(2).counts(), 8191);  // the reader counted every edge, one at a time
-  EXPECT_EQ(reader.counters().edges, 1000U + 1000U + 8191U + 8192U);
+  EXPECT_EQ(reader.counters().edges, 1000U + 1000U + 8191U + 8191U);
   EXPECT_EQ(Errors(reader), 0U);
 }
 

@@ -5,8 +5,9 @@
 /// Pulse spreading: INIT gives the step in 100 MHz clocks and a clock divider D. A period has
 /// S = step_clocks / D sub-ticks; N pulses (quadrature counts, one A/B edge each) are spread over
 /// them with a division-free accumulator, edge j (1..N) at sub-tick ceil(j·S/N). So at most S
-/// counts fit in one period: that is the pulse-rate limit (100 MHz / D counts per second). A
-/// larger change is emitted at the limit, flagged, and the rest follows in the next periods.
+/// counts fit in one period (100 MHz / D counts per second), and never 8192 (half a turn, whose
+/// direction is ambiguous): the pulse-rate limit min(S, 8191). A larger change is emitted at the
+/// limit, flagged, and the rest follows in the next periods.
 
 #include <cstdint>
 
@@ -31,8 +32,14 @@ constexpr std::uint32_t kMaxRepresentablePulses = 8192;
 [[nodiscard]] std::uint32_t ClockDividerForStep(std::int64_t step_ns) noexcept;
 /// Sub-ticks per period S = step_clocks / divider (0 when the divider is 0).
 [[nodiscard]] std::uint32_t SubticksPerStep(std::int64_t step_ns, std::uint32_t divider) noexcept;
+/// Most pulses one period of S sub-ticks emits: one per sub-tick, and never half a turn (a move
+/// of 8192 on the 14-bit wrapping position reads as -8192: its direction is ambiguous), so
+/// min(S, 8191). The gateware caps at the same value and raises PULSE_LIMIT.
+[[nodiscard]] constexpr std::uint32_t MaxPulsesPerPeriod(std::uint32_t subticks) noexcept {
+  return subticks < kMaxRepresentablePulses - 1 ? subticks : kMaxRepresentablePulses - 1;
+}
 /// Largest position change per period that is emitted within that period:
-/// min(S, 8191) counts (8192 is ambiguous: it reads as -8192).
+/// MaxPulsesPerPeriod(SubticksPerStep(step_ns, divider)).
 [[nodiscard]] std::uint32_t MaxCountsPerStep(std::int64_t step_ns, std::uint32_t divider) noexcept;
 
 /// Thesis Table 4.1: sign of (new - old) and whether it overflowed the relative range.
@@ -84,7 +91,8 @@ class EncoderEmulator {
   void Reset() noexcept;
   /// The sampling moment at `t_ns`: plans the pulses from the position reached so far to
   /// `target_counts` (relative) and spreads them over [t_ns, t_ns + step). Returns false when the
-  /// change needs more pulses than the period holds (emitted at the limit, rest carried over).
+  /// change needs more pulses than MaxPulsesPerPeriod (emitted at the limit, rest carried over):
+  /// a change of exactly half a turn (8192) included, whatever S.
   bool StartPeriod(std::int32_t target_counts, std::int64_t t_ns) noexcept;
   /// While stuck, StartPeriod emits nothing (fault injection: a frozen encoder line).
   void SetStuck(bool stuck) noexcept { stuck_ = stuck; }
