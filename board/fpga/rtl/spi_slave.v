@@ -3,6 +3,11 @@
 // SCLK domain (the only logic not clocked by `clk`):
 //  * rx_count counts rising SCLK edges; it is reset asynchronously while CS is high, so every
 //    transfer starts at bit 0 whatever the previous one did (a short transfer is forgotten).
+//    Only CS ends a transfer: a host that keeps CS low across two frames gets the second one
+//    ignored, so every transfer must be framed by CS (docs/spi-protocol.md). Both bit counters
+//    also start at 0 (iCE40 flip-flops configure to 0, as por.v relies on): CS is high from
+//    power-up, so no CS edge resets them before the first transfer, and a simulator would
+//    otherwise start with X on MISO and frame the first request at an arbitrary bit.
 //  * shift collects MOSI; on the 96th rising edge the whole request is copied into `holding` and
 //    `toggle` flips. `holding` is then left alone until the 96th edge of a later transfer, i.e.
 //    for at least 95 SCLK periods (3 us at 31.25 MHz).
@@ -32,8 +37,8 @@ module spi_slave (
   output wire        cs_idle       // synchronised CS (1 = no transfer in progress)
 );
   // ---- SCLK domain -------------------------------------------------------------------------
-  reg [6:0]  rx_count;
-  reg [6:0]  tx_count;
+  reg [6:0]  rx_count = 7'd0;
+  reg [6:0]  tx_count = 7'd0;
   reg [94:0] shift;
   reg [95:0] holding;
   reg        toggle = 1'b0;
