@@ -108,10 +108,44 @@ io::LinkFault::Kind ParseFaultKind(const std::string& spec, const std::string& k
   BadFault(spec, "unknown fault '" + kind + "'");
 }
 
-/// `--inject-fault KIND[,at=FRAME][,count=N]` (mock only): what the boards do wrong, when. A
-/// fault that would come after the last of `frames` data frames is refused: it would test nothing.
+/// Whether `kind` acts on the ECS's data frames. Those are one more than --frames: frame 0 reads
+/// the lines at rest after INIT and frame k + 1 reads encoder message k (sent in the twin's frame
+/// k), so only ECS frames 1..frames carry a message, and every twin frame 0..frames - 1 does.
+bool HitsEcsFrames(io::LinkFault::Kind kind) {
+  return kind == io::LinkFault::Kind::kStuckReader || kind == io::LinkFault::Kind::kCorruptCounts;
+}
+
+/// at=FRAME must hit a frame that carries an encoder message, or the fault would test nothing
+/// (and the run would pass, or fail without a lost message to name).
+void CheckFaultFrame(const std::string& spec, const io::LinkFault& fault, std::int64_t frames) {
+  const std::string at = "at=" + std::to_string(fault.at_frame);
+  const std::string runs = std::to_string(frames) + " (--frames " + std::to_string(frames) + ")";
+  if (!HitsEcsFrames(fault.kind)) {
+    if (fault.at_frame >= frames) {
+      BadFault(spec, at + " comes after the last of the run's " + std::to_string(frames) +
+                         " data frames (--frames); choose a smaller at");
+    }
+    return;
+  }
+  if (fault.at_frame == 0) {
+    BadFault(spec, "at=0 hits no encoder message: the ECS's data frame 0 reads the lines at rest "
+                   "after INIT, and its frame k + 1 reads encoder message k; choose at between 1 "
+                   "and " + runs);
+  }
+  if (fault.at_frame > frames) {
+    BadFault(spec, at + " comes after the ECS's last data frame, " + runs +
+                       ", which reads the last encoder message; choose at between 1 and " +
+                       std::to_string(frames));
+  }
+}
+
+/// `--inject-fault KIND[,at=FRAME][,count=N]` (mock only): what the boards do wrong, when. FRAME
+/// defaults to the first data frame that carries an encoder message on the side the fault acts
+/// on (0 for the twin's emulator, 1 for the ECS's readers and answers); a fault that would hit
+/// no message is refused.
 io::LinkFault ParseLinkFault(const std::string& spec, std::int64_t frames) {
   io::LinkFault fault;
+  bool at_given = false;
   std::size_t start = 0;
   for (int item = 0; start <= spec.size(); ++item) {
     const std::size_t comma = std::min(spec.find(',', start), spec.size());
@@ -126,16 +160,15 @@ io::LinkFault ParseLinkFault(const std::string& spec, std::int64_t frames) {
     const std::string value = eq == std::string::npos ? "" : part.substr(eq + 1);
     if (key == "at") {
       fault.at_frame = ParseFaultNumber(spec, key, value, 0);
+      at_given = true;
     } else if (key == "count") {
       fault.frames = ParseFaultNumber(spec, key, value, 1);
     } else {
       BadFault(spec, "'" + part + "' is not at=FRAME or count=N");
     }
   }
-  if (fault.at_frame >= frames) {
-    BadFault(spec, "at=" + std::to_string(fault.at_frame) + " comes after the last of the run's " +
-                       std::to_string(frames) + " data frames (--frames); choose a smaller at");
-  }
+  if (!at_given) fault.at_frame = HitsEcsFrames(fault.kind) ? 1 : 0;
+  CheckFaultFrame(spec, fault, frames);
   return fault;
 }
 
@@ -184,7 +217,11 @@ void AddIoTestFlags(CLI::App* app, IoTestFlags& options) {
       ->check(CLI::Range(0.0, 3600.0));
   app->add_option("--inject-fault", options.inject_fault,
                   std::string("mock only: make the boards fail to see io-test catch it: ") +
-                      kFaultForms + " (data frame FRAME on, N frames)");
+                      kFaultForms +
+                      " (data frame FRAME on, N frames; stuck-emulator acts on the twin's frames, "
+                      "whose frame k sends encoder message k, FRAME 0 by default; stuck-reader "
+                      "and corrupt-counts on the ECS's, whose frame k + 1 reads it, FRAME 1 by "
+                      "default)");
   app->add_flag("--json", options.json,
                 "print the summary as JSON (frames_sent, frames_received, frames_corrupted, "
                 "frames_missed, init_frames_*, test_frames_*, count_errors, counts_over_limit, "

@@ -420,26 +420,39 @@ void PrintText(const IoTestOptions& options, const IoTestOutcome& o) {
   std::printf("%s\n", o.ok ? "PASS" : "FAIL");
 }
 
-/// What the first lost message of one direction was, for the error message.
-std::string DescribeMiss(const char* what, const io::MessageTally& tally,
-                         const io::FirstMiss& first, const char* reader) {
-  std::string text = std::string(what) + " messages: " + std::to_string(tally.received) + " of " +
-                     std::to_string(tally.sent) + " arrived as sent, " +
+/// One direction of the mock's messages, for the error message: message k is sent in data frame
+/// k and read by `reader` in its data frame k + `read_later`.
+struct MessagePath {
+  const char* what;
+  const char* reader;
+  int read_later;
+};
+
+/// What the first lost message of one direction was, named by its number and the frames that
+/// carried it, for the error message.
+std::string DescribeMiss(const MessagePath& path, const io::MessageTally& tally,
+                         const io::FirstMiss& first) {
+  std::string text = std::string(path.what) + " messages: " + std::to_string(tally.received) +
+                     " of " + std::to_string(tally.sent) + " arrived as sent, " +
                      std::to_string(tally.missed()) + " missed";
   if (first.frame < 0) return text;
-  text += "; the first at data frame " + std::to_string(first.frame);
-  if (*first.reason != '\0') return text + ", whose frame failed (" + first.reason + ")";
+  text += "; the first is " + std::string(path.what) + " message " +
+          std::to_string(first.frame) + " (sent in data frame " + std::to_string(first.frame) +
+          ", read in " + path.reader + "'s data frame " +
+          std::to_string(first.frame + path.read_later) + ")";
+  if (*first.reason != '\0') return text + ", whose reading frame failed (" + first.reason + ")";
   return text + ", channel " + std::to_string(first.channel) + ": sent " +
-         std::to_string(first.sent) + ", " + reader + " " + std::to_string(first.read);
+         std::to_string(first.sent) + ", " + path.reader + " read " + std::to_string(first.read);
 }
 
 /// Mock: the end-to-end figures that failed, and the way out.
 std::string MockFailure(const IoTestOptions& options, const MockFigures& m) {
   std::string what;
   if (m.tally.encoder.missed() > 0) {
-    what = DescribeMiss("encoder", m.tally.encoder, m.tally.first_encoder_miss, "the ECS decoded");
+    // The ECS reads encoder message k in its next frame: the emulator spreads it over a period.
+    what = DescribeMiss({"encoder", "the ECS", 1}, m.tally.encoder, m.tally.first_encoder_miss);
   } else if (m.tally.pwm.missed() > 0) {
-    what = DescribeMiss("PWM", m.tally.pwm, m.tally.first_pwm_miss, "the twin read");
+    what = DescribeMiss({"PWM", "the twin", 0}, m.tally.pwm, m.tally.first_pwm_miss);
   } else {
     what = "the link had errors (see the summary above)";
   }

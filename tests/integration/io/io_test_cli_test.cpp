@@ -136,10 +136,15 @@ TEST(IoTestCli, AFaultOnTheEncoderPathFailsTheRun) {
   // Each fault passes every frame-level check but one (the CRC of corrupt-counts); only the
   // end-to-end decode sees the stuck lines.
   const InjectedFault faults[] = {
-      {"stuck-emulator,at=1000,count=5", 5, "the first at data frame 1000, channel 0: sent "},
-      {"stuck-reader,at=1000,count=5", 2001, "the first at data frame 999, channel 0: sent "},
+      {"stuck-emulator,at=1000,count=5", 5,
+       "the first is encoder message 1000 (sent in data frame 1000, read in the ECS's data frame "
+       "1001), channel 0: sent "},
+      {"stuck-reader,at=1000,count=5", 2001,
+       "the first is encoder message 999 (sent in data frame 999, read in the ECS's data frame "
+       "1000), channel 0: sent "},
       {"corrupt-counts,at=1000", 1,
-       "the first at data frame 999, whose frame failed (answer failed its CRC-8 check)"},
+       "the first is encoder message 999 (sent in data frame 999, read in the ECS's data frame "
+       "1000), whose reading frame failed (answer failed its CRC-8 check)"},
   };
   for (const InjectedFault& fault : faults) {
     const auto r =
@@ -160,6 +165,54 @@ TEST(IoTestCli, AFaultOnTheEncoderPathFailsTheRun) {
         std::string::npos)
         << r.err;
   }
+}
+
+TEST(IoTestCli, AFaultWithoutAtHitsTheFirstFrameThatCarriesAnEncoderMessage) {
+  // The ECS's data frame 0 reads the lines at rest after INIT: a reader-side fault there would
+  // lose nothing. Without at= each fault hits the first frame that carries encoder message 0.
+  constexpr const char* kFirst =
+      "the first is encoder message 0 (sent in data frame 0, read in the ECS's data frame 1)";
+  for (const char* spec : {"stuck-emulator", "stuck-reader", "corrupt-counts"}) {
+    const auto r = IoTest({"--io", "mock", "--frames", "300", "--inject-fault", spec, "--json"});
+    EXPECT_EQ(r.exit_code, 5) << spec << r.out << r.err;
+    if (r.exit_code != 5) continue;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_GE(j["encoder_messages_missed"], 1) << spec;
+    EXPECT_EQ(j["ok"], false) << spec;
+    EXPECT_NE(r.err.find(kFirst), std::string::npos) << spec << ": " << r.err;
+  }
+  const auto corrupt =
+      IoTest({"--io", "mock", "--frames", "300", "--inject-fault", "corrupt-counts"});
+  EXPECT_EQ(corrupt.exit_code, 5) << corrupt.out << corrupt.err;
+  EXPECT_NE(corrupt.err.find(std::string(kFirst) +
+                             ", whose reading frame failed (answer failed its CRC-8 check)"),
+            std::string::npos)
+      << corrupt.err;
+  // The ECS sends one data frame more than --frames: with one frame, its second reads message 0.
+  const auto one = IoTest({"--io", "mock", "--frames", "1", "--inject-fault", "stuck-reader"});
+  EXPECT_EQ(one.exit_code, 5) << one.out << one.err;
+  EXPECT_NE(one.err.find(kFirst), std::string::npos) << one.err;
+}
+
+TEST(IoTestCli, AReaderFaultOnAFrameWithoutAnEncoderMessageIsRefused) {
+  for (const char* kind : {"stuck-reader", "corrupt-counts"}) {
+    const std::string spec = std::string(kind) + ",at=0";
+    const auto r = IoTest({"--io", "mock", "--frames", "300", "--inject-fault", spec});
+    EXPECT_EQ(r.exit_code, 2) << spec << r.out << r.err;
+    EXPECT_NE(r.err.find("--inject-fault " + spec +
+                         ": at=0 hits no encoder message: the ECS's data frame 0 reads the lines "
+                         "at rest after INIT, and its frame k + 1 reads encoder message k; choose "
+                         "at between 1 and 300 (--frames 300)"),
+              std::string::npos)
+        << r.err;
+  }
+  const auto late =
+      IoTest({"--io", "mock", "--frames", "100", "--inject-fault", "stuck-reader,at=101"});
+  EXPECT_EQ(late.exit_code, 2) << late.out << late.err;
+  EXPECT_NE(late.err.find("at=101 comes after the ECS's last data frame, 100 (--frames 100), "
+                          "which reads the last encoder message; choose at between 1 and 100"),
+            std::string::npos)
+      << late.err;
 }
 
 TEST(IoTestCli, UsageErrorsExitTwoAndSayWhatIsAccepted) {
@@ -192,7 +245,7 @@ TEST(IoTestCli, UsageErrorsExitTwoAndSayWhatIsAccepted) {
   r = IoTest({"--io", "mock", "--inject-fault", "stuck-reader,count=0"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("count=0 is not a whole number >= 1"), std::string::npos) << r.err;
-  r = IoTest({"--io", "mock", "--frames", "100", "--inject-fault", "stuck-reader,at=100"});
+  r = IoTest({"--io", "mock", "--frames", "100", "--inject-fault", "stuck-emulator,at=100"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("at=100 comes after the last of the run's 100 data frames (--frames)"),
             std::string::npos)
