@@ -12,12 +12,33 @@
 #include "hiltwin/fpga_sim/verilated_backend.h"
 #endif
 
+namespace {
+
+extern "C" void OnBrokenPipe(int /*signal_number*/) {}
+
+/// `hiltwin run ... | head -1`: once the reader has gone, SIGPIPE's default would kill the
+/// process at its next write to stdout, and exit 141 would replace the verdict's code. Caught,
+/// the write fails with EPIPE instead, which stdio records and the command ignores: the run,
+/// its log, its report and its exit code are untouched. A handler rather than SIG_IGN: a
+/// caught signal is reset to its default across exec, so the programs hiltwin starts (gnuplot,
+/// lttng-sessiond, hil's two sides) keep the usual behaviour.
+void SurviveAClosedPipe() {
+  struct sigaction action {};
+  action.sa_handler = &OnBrokenPipe;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  sigaction(SIGPIPE, &action, nullptr);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using hiltwin::app::ExitCode;
   // Past a file-size limit (ulimit -f) the kernel sends SIGXFSZ, whose default kills the
   // process mid-run with a core dump. Ignored, the write fails with EFBIG instead: the log ends
   // on its last whole row and the run ends as an I/O fault (exit 5) with its report.
   std::signal(SIGXFSZ, SIG_IGN);
+  SurviveAClosedPipe();
 #if defined(HILTWIN_HAS_FPGA_SIM)
   hiltwin::fpga_sim::RegisterVerilatedBackend();  // --io verilated: the RTL under Verilator
 #endif

@@ -173,13 +173,21 @@ void Poll(Child& child) {
   if (!child.status) child.status = child.process.WaitFor(std::chrono::milliseconds(0));
 }
 
-/// Asks a side to stop (SIGTERM: report and log written); kills it when it has not stopped
-/// kPeerGrace later.
+/// The signal that asks a side to stop: SIGTERM, unless SIGTERM is what stopped `hil`. A
+/// signal to the whole process group (Ctrl-C, a closed terminal's SIGHUP, `kill -TERM -PGID`)
+/// reaches the sides too, and their stop handlers are one-shot: the same signal again from
+/// here would kill them with their reports unwritten.
+int ForwardedStopSignal() noexcept {
+  return kernel_glue::StopSignal() == SIGTERM ? SIGINT : SIGTERM;
+}
+
+/// Asks a side to stop (report and log written); kills it when it has not stopped kPeerGrace
+/// later.
 void Stop(Child& child, const char* why) {
   const auto now = std::chrono::steady_clock::now();
   if (!child.told_to_stop) {
     std::fprintf(stderr, "\nhiltwin hil: stopping the %s (%s)\n", child.name, why);
-    ::kill(child.process.pid(), SIGTERM);
+    ::kill(child.process.pid(), ForwardedStopSignal());
     child.told_to_stop = now;
   } else if (now - *child.told_to_stop > kPeerGrace) {
     std::fprintf(stderr, "\nhiltwin hil: the %s did not stop; killing it\n", child.name);
@@ -204,7 +212,11 @@ void WaitForBoth(Child& twin, Child& ecs, double duration_s, bool progress) {
     const bool overdue = first_end && Clock::now() - *first_end > kPeerGrace;
     for (Child* child : {&twin, &ecs}) {
       if (child->status) continue;
-      if (kernel_glue::StopRequested()) Stop(*child, "stop requested");
+      if (kernel_glue::StopRequested()) {
+        const std::string why =
+            std::string("hil got ") + kernel_glue::StopSignalName(kernel_glue::StopSignal());
+        Stop(*child, why.c_str());
+      }
       if (overdue) Stop(*child, "its peer ended and it did not follow");
     }
     if (progress && Clock::now() - shown >= std::chrono::milliseconds(100)) {

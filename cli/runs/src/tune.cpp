@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -166,14 +165,14 @@ class TuneProcedure {
     steps_done_ += 1.0;
   }
 
-  /// SIGINT or SIGTERM ends the run in progress cleanly (RunSession), and tune with it: a
-  /// procedure missing a step recommends nothing.
+  /// A stop signal (SIGINT, SIGTERM, SIGHUP) ends the run in progress cleanly (RunSession), and
+  /// tune with it: a procedure missing a step recommends nothing.
   static void StopIfAsked(const std::string& next) {
     if (!kernel_glue::StopRequested()) return;
     throw CommandError(ExitCode::kAborted,
                        std::string("stopped by ") +
-                           (kernel_glue::StopSignal() == SIGTERM ? "SIGTERM" : "SIGINT") +
-                           " before " + next + ": no recommendation (run it again to the end)");
+                           kernel_glue::StopSignalName(kernel_glue::StopSignal()) + " before " +
+                           next + ": no recommendation (run it again to the end)");
   }
 
   void Measure(analysis::TuneReport& report);

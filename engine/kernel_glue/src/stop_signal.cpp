@@ -59,14 +59,25 @@ PauseRequest TakePauseRequest() noexcept {
 }
 
 void InstallStopSignalHandlers() {
-  Install(SIGINT);
-  Install(SIGTERM);
+  // SIGHUP too: a closed terminal or a dropped SSH session must end a run as cleanly as
+  // SIGTERM, not kill it with an empty report and its shared memory behind.
+  for (const int signal_number : kStopSignals) Install(signal_number);
   g_handlers_installed.store(true);
 }
 
 bool StopRequested() noexcept { return g_stop_signal.load(std::memory_order_relaxed) != 0; }
 
 int StopSignal() noexcept { return g_stop_signal.load(std::memory_order_relaxed); }
+
+const char* StopSignalName(int signal_number) noexcept {
+  switch (signal_number) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case -1: return "a stop request";
+    default: return "no stop signal";
+  }
+}
 
 void RequestStop() noexcept {
   int expected = 0;

@@ -26,6 +26,7 @@ class StopSignal : public ::testing::Test {
     ResetStopRequest();
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
+    std::signal(SIGHUP, SIG_DFL);
   }
 };
 
@@ -44,6 +45,21 @@ TEST_F(StopSignal, SigtermSetsTheFlagAndNamesTheSignal) {
   ASSERT_EQ(std::raise(SIGTERM), 0);
   EXPECT_TRUE(StopRequested());
   EXPECT_EQ(::hiltwin::kernel_glue::StopSignal(), SIGTERM);
+}
+
+// A closed terminal or a dropped SSH session (issue 34): a stop like SIGTERM, not a kill.
+TEST_F(StopSignal, SighupSetsTheFlagAndNamesTheSignal) {
+  ASSERT_EQ(std::raise(SIGHUP), 0);
+  EXPECT_TRUE(StopRequested());
+  EXPECT_EQ(::hiltwin::kernel_glue::StopSignal(), SIGHUP);
+  EXPECT_STREQ(StopSignalName(::hiltwin::kernel_glue::StopSignal()), "SIGHUP");
+}
+
+TEST_F(StopSignal, EveryStopSignalHasItsName) {
+  EXPECT_STREQ(StopSignalName(SIGINT), "SIGINT");
+  EXPECT_STREQ(StopSignalName(SIGTERM), "SIGTERM");
+  EXPECT_STREQ(StopSignalName(-1), "a stop request");
+  EXPECT_STREQ(StopSignalName(0), "no stop signal");
 }
 
 TEST_F(StopSignal, TheFirstCauseIsKept) {

@@ -1,23 +1,35 @@
 #pragma once
-/// SIGINT/SIGTERM as a stop request: the handler only sets a lock-free flag, which the loop
-/// polls once per cycle (scheduler::Executive::SetStopCheck(&StopRequested)), so the current
-/// cycle finishes and the run stops cleanly with its report written.
+/// SIGINT/SIGTERM/SIGHUP as a stop request: the handler only sets a lock-free flag, which the
+/// loop polls once per cycle (scheduler::Executive::SetStopCheck(&StopRequested)), so the
+/// current cycle finishes and the run stops cleanly with its report written. SIGHUP (a closed
+/// terminal, a dropped SSH session) is a stop like SIGTERM.
 ///
-/// The handlers are one-shot (SA_RESETHAND): the first SIGINT or SIGTERM asks for a stop, a
+/// The handlers are one-shot (SA_RESETHAND): the first of these signals asks for a stop, a
 /// second one of the same signal gets the default action and kills the process, so a stuck
 /// program can always be stopped with a second Ctrl-C.
 
+#include <array>
+#include <csignal>
+
 namespace hiltwin::kernel_glue {
 
-/// Installs the SIGINT and SIGTERM handlers (again, if already installed: this re-arms them).
+/// The signals that ask for a stop.
+inline constexpr std::array<int, 3> kStopSignals = {SIGINT, SIGTERM, SIGHUP};
+
+/// Installs the handlers of kStopSignals (again, if already installed: this re-arms them).
 /// Throws std::system_error when sigaction fails.
 void InstallStopSignalHandlers();
 
-/// True once SIGINT or SIGTERM was received (or RequestStop was called). Async-signal-safe.
+/// True once a stop signal was received (or RequestStop was called). Async-signal-safe.
 [[nodiscard]] bool StopRequested() noexcept;
 
-/// The signal that asked for the stop (SIGINT, SIGTERM), 0 for none, -1 for RequestStop.
+/// The signal that asked for the stop (SIGINT, SIGTERM, SIGHUP), 0 for none, -1 for
+/// RequestStop.
 [[nodiscard]] int StopSignal() noexcept;
+
+/// "SIGINT", "SIGTERM", "SIGHUP" for a StopSignal(); "a stop request" for -1, "no stop signal"
+/// for 0 (and any other number).
+[[nodiscard]] const char* StopSignalName(int signal_number) noexcept;
 
 /// Asks for a stop from code (e.g. a command or a watchdog) the same way a signal does.
 void RequestStop() noexcept;
