@@ -66,7 +66,9 @@ Command AddEcsCommand(CLI::App& parent) {
       "The same controller drives the twin (--io wire:NAME, with `hiltwin run --io wire:NAME`)\n"
       "or the robot (--io spidev:/dev/spidev0.0). Default (m,k) rule: (1,2), never two misses\n"
       "in a row. Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 internal.\n"
-      "SIGINT/SIGTERM stop it cleanly, SIGUSR1 pauses (zero duty), SIGUSR2 resumes.");
+      "No cycle judged, no verdict (NONE): 128+N when stopped by signal N first (130 SIGINT,\n"
+      "143 SIGTERM, 129 SIGHUP), 5 when the twin went first.\n"
+      "SIGINT/SIGTERM/SIGHUP stop it cleanly, SIGUSR1 pauses (zero duty), SIGUSR2 resumes.");
   AddSessionFlags(*app, o->session);
   app->get_option("--duration")
       ->description("run length in seconds (default: the profile's length)")

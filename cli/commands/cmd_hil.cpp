@@ -93,7 +93,9 @@ Command AddHilCommand(CLI::App& parent) {
       "The twin (`hiltwin run`) and the controller (`hiltwin ecs`) run on a fresh wire; one\n"
       "combined summary and report.\n"
       "The twin runs 2 s longer than the ECS, so the ECS's finish ends the pair. Exit: the worse\n"
-      "of the two sides' codes (0 < 3 FLAGGED < 4 ABORTED < 5 I/O < 2 bad input < 1 internal).");
+      "of the two sides' codes (0 < 3 FLAGGED < 4 ABORTED < 128+N stopped by signal N before any\n"
+      "cycle was judged < 5 I/O < 2 bad input < 1 internal). SIGINT/SIGTERM/SIGHUP stop both\n"
+      "sides cleanly; their reports are combined and the work folder removed.");
   app->add_option("--twin-rate", o->twin_rate_hz, "twin update rate in Hz")->capture_default_str();
   app->add_option("--ecs-rate", o->ecs_rate_hz, "controller rate in Hz")->capture_default_str();
   app->add_option("--duration", o->duration_s,

@@ -17,8 +17,10 @@ Command AddRunCommand(CLI::App& parent) {
       "The twin runs at --rate behind the FPGA link (--io) and is driven by --input played into\n"
       "the emulated board's PWM reader at --input-rate (mock) or by a controller (wire/spidev).\n"
       "Exit: 0 PASS, 2 bad input, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault/internal.\n"
-      "While it runs: SIGINT/SIGTERM stop it cleanly (report and log written), SIGUSR1 pauses\n"
-      "(link kept, safe outputs, model frozen, not judged) and SIGUSR2 resumes.");
+      "No cycle judged, no verdict (NONE): 128+N when stopped by signal N first (130 SIGINT,\n"
+      "143 SIGTERM, 129 SIGHUP), 5 when the controller went first.\n"
+      "While it runs: SIGINT/SIGTERM/SIGHUP stop it cleanly (report and log written), SIGUSR1\n"
+      "pauses (link kept, safe outputs, model frozen, not judged) and SIGUSR2 resumes.");
   AddTwinRunFlags(*app, *flags);
   return {app, [flags] { return RunTwin(TwinRunOptionsFrom(*flags, "run")).exit_code; }};
 }

@@ -42,8 +42,9 @@ Command AddTraceCommand(CLI::App& parent) {
       "--analyze PATH reports on a recording made earlier: a trace folder (also one recorded by\n"
       "hand with lttng while 'hiltwin run' ran) or a timing log ('hiltwin run --timing-log').\n"
       "Needs an lttng-sessiond (started when none runs and you are root or in group 'tracing').\n"
-      "Exit: as 'hiltwin run' (0 PASS, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault), 2 bad\n"
-      "input, 5 when tracing is not possible here or the trace could not be read.");
+      "Exit: as 'hiltwin run' (0 PASS, 3 FLAGGED, 4 ABORTED, 5 I/O fault, 1 model fault, 128+N\n"
+      "stopped by signal N before any cycle was judged), 2 bad input, 5 when tracing is not\n"
+      "possible here or the trace could not be read.");
   AddTwinRunFlags(*app, *run_flags);
   app->add_option("--output", o->output_dir,
                   "folder for the trace and the report (new or empty; with --analyze: where the "

@@ -16,9 +16,12 @@ int Severity(int code) noexcept {
     case 0: return 0;  // pass
     case 3: return 1;  // flagged
     case 4: return 2;  // aborted
-    case 5: return 3;  // I/O
-    case 2: return 4;  // usage
-    default: return 5;  // 1 internal, and anything unknown
+    case 5: return 4;  // I/O
+    case 2: return 5;  // usage
+    default:
+      // 129..159: stopped by a signal before any cycle was judged (no verdict, nothing failed)
+      if (code > 128 && code < 160) return 3;
+      return 6;  // 1 internal, and anything unknown
   }
 }
 
@@ -111,6 +114,7 @@ Json ToJson(const HilResult& r) {
   json["link_error_parts"] = {{"twin_frames_corrupted_or_missed", r.link.twin_frames},
                               {"ecs_frames_corrupted_or_missed", r.link.ecs_frames},
                               {"encoder_line_errors", r.link.encoder_line_errors}};
+  json["warnings"] = r.warnings;
   json["twin_exit"] = SideExit(r.twin);
   json["ecs_exit"] = SideExit(r.ecs);
   json["twin"] = r.twin.report ? *r.twin.report : Json(nullptr);
@@ -135,6 +139,7 @@ std::string FormatHilSummary(const HilResult& r) {
                 static_cast<unsigned long long>(r.link.ecs_frames),
                 static_cast<unsigned long long>(r.link.encoder_line_errors));
   out += text;
+  for (const std::string& warning : r.warnings) out += "warning   " + warning + "\n";
   std::snprintf(text, sizeof text, "hil       exit %d (the worse of twin %d and ECS %d)\n",
                 r.exit_code, ExitCodeOf(r.twin.status), ExitCodeOf(r.ecs.status));
   return out + text;

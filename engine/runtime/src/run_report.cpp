@@ -1,7 +1,10 @@
 #include "hiltwin/runtime/run_report.h"
 
+#include <csignal>
 #include <cstdarg>
 #include <cstdio>
+
+#include "hiltwin/kernel_glue/stop_signal.h"
 
 namespace hiltwin::runtime {
 namespace {
@@ -65,7 +68,10 @@ Json QosPart(const RunReport& r) {
 Json ContractPart(const RunReport& r) {
   Json constraints = Json::array();
   for (const qos::RuleStatus& status : r.constraints) constraints.push_back(Constraint(status));
-  return {{"verdict", qos::ToString(r.verdict)},
+  const Conclusion conclusion = ConclusionOf(r);
+  return {{"verdict", VerdictWord(conclusion)},
+          {"complete", conclusion.complete},
+          {"verdict_text", conclusion.text},
           {"stop_reason", lifecycle::ToString(r.stop_reason)},
           {"rate_hz", r.rate_hz},
           {"period_ns", r.period_ns},
@@ -123,6 +129,8 @@ Json ToJson(const RunReport& r) {
     if (!r.timing_log->error.empty()) json["timing_log_error"] = r.timing_log->error;
   }
   json["final_state"] = lifecycle::ToString(r.final_state);
+  json["stop_signal"] =
+      r.stop_signal > 0 ? Json(kernel_glue::StopSignalName(r.stop_signal)) : Json(nullptr);
   json["outputs_safe"] = r.outputs_safe;
   if (r.fault) {
     json["fault"] = {{"kind", lifecycle::ToString(r.fault->kind)},
@@ -131,6 +139,7 @@ Json ToJson(const RunReport& r) {
   }
   json["wall_time_s"] = r.wall_time_s;
   json["rt_setup"] = r.rt_setup ? Json(kernel_glue::ToJson(*r.rt_setup)) : Json(nullptr);
+  json["warnings"] = r.warnings;
   return json;
 }
 
@@ -202,8 +211,30 @@ std::string IncompleteLogLine(const char* what, const LogFigures& log) {
   return line;
 }
 
-std::string VerdictLine(const RunReport& r) {
-  std::string line = std::string("verdict    ") + qos::ToString(r.verdict);
+// "I/O fault at cycle 2000".
+std::string FaultAt(const RunFault& fault) {
+  return std::string(fault.kind == StopReason::kIoFault ? "I/O" : "model") + " fault at cycle " +
+         std::to_string(fault.cycle);
+}
+
+// Why no cycle was judged, from the stop reason.
+std::string WhyNoVerdict(const RunReport& r) {
+  std::string why = "NONE (no cycle was judged";
+  if (r.fault) return why + "; the run did NOT finish: " + FaultAt(*r.fault) + ")";
+  switch (r.stop_reason) {
+    case StopReason::kStopRequested:
+      return why + ": stopped by " +
+             (r.stop_signal > 0 ? kernel_glue::StopSignalName(r.stop_signal) : "a stop command") +
+             " before the first judged cycle)";
+    case StopReason::kPeerStopped:
+      return why + ": the " + r.link.peer_name + " stopped before the first judged cycle)";
+    default:
+      return why + "; stop: " + lifecycle::ToString(r.stop_reason) + ")";
+  }
+}
+
+std::string VerdictText(const RunReport& r) {
+  std::string line = qos::ToString(r.verdict);
   if (r.verdict == qos::Verdict::kFlagged)
     line += " (deadline constraints violated: results unreliable)";
   if (r.verdict == qos::Verdict::kAborted) {
@@ -215,20 +246,19 @@ std::string VerdictLine(const RunReport& r) {
   // on the verdict's own line, so a PASS is never read as "the run is good".
   if (r.fault) {
     line += std::string(" for the timing of the ") + std::to_string(r.cycles_run) +
-            " cycles run; the run did NOT finish: " +
-            (r.fault->kind == StopReason::kIoFault ? "I/O" : "model") + " fault at cycle " +
-            std::to_string(r.fault->cycle);
+            " cycles run; the run did NOT finish: " + FaultAt(*r.fault);
   }
-  return line + "\n";
+  return line;
 }
 
 }  // namespace
 
 std::string FormatSummary(const RunReport& r) {
   std::string out;
-  Append(out, "cycles     %llu of %llu at %.0f Hz (%s clock), stop: %s\n",
+  Append(out, "cycles     %llu of %llu at %.0f Hz (%s clock), stop: %s%s%s\n",
          static_cast<ull>(r.cycles_run), static_cast<ull>(r.cycles_planned), r.rate_hz,
-         ToString(r.clock), lifecycle::ToString(r.stop_reason));
+         ToString(r.clock), lifecycle::ToString(r.stop_reason), r.stop_signal > 0 ? " by " : "",
+         r.stop_signal > 0 ? kernel_glue::StopSignalName(r.stop_signal) : "");
   if (r.cycles_paused > 0)
     Append(out, "paused     %llu cycles\n", static_cast<ull>(r.cycles_paused));
   AppendMisses(out, r);
@@ -253,15 +283,30 @@ std::string FormatSummary(const RunReport& r) {
            static_cast<ull>(r.fault->cycle), r.fault->reason.c_str());
   }
   if (!r.outputs_safe) out += "outputs    the safe outputs could NOT be written: check the link\n";
-  return out + VerdictLine(r);
+  for (const std::string& warning : r.warnings) Append(out, "warning    %s\n", warning.c_str());
+  return out + "verdict    " + ConclusionOf(r).text + "\n";
+}
+
+Conclusion ConclusionOf(const RunReport& r) {
+  Conclusion c;
+  // A verdict over no judged cycle would be a PASS about nothing.
+  if (r.misses.cycles_judged == 0) {
+    c.text = WhyNoVerdict(r);
+    return c;
+  }
+  c.verdict = r.verdict;
+  c.complete = !r.fault;
+  c.text = VerdictText(r);
+  return c;
+}
+
+const char* VerdictWord(const Conclusion& c) noexcept {
+  return c.verdict ? qos::ToString(*c.verdict) : "NONE";
 }
 
 std::vector<std::string> Problems(const RunReport& r) {
   std::vector<std::string> lines;
-  if (r.fault) {
-    lines.push_back(std::string(r.fault->kind == StopReason::kIoFault ? "I/O" : "model") +
-                    " fault at cycle " + std::to_string(r.fault->cycle) + ": " + r.fault->reason);
-  }
+  if (r.fault) lines.push_back(FaultAt(*r.fault) + ": " + r.fault->reason);
   if (r.link.io_errors > 0) {
     lines.push_back("warning: " + std::to_string(r.link.io_errors) +
                     " frames on the link were corrupted or missed; the inputs were held over "
@@ -295,6 +340,13 @@ ExitCode ExitCodeFor(const RunReport& r) noexcept {
   }
   if (r.log && !r.log->error.empty()) return ExitCode::kIo;
   if (r.timing_log && !r.timing_log->error.empty()) return ExitCode::kIo;
+  if (r.misses.cycles_judged == 0) {
+    // No verdict. Stopped on request: the code the shell would show had the signal ended the
+    // process (a stop command stands for SIGTERM, as docs/telemetry.md says). Otherwise the peer
+    // went before the first judged cycle: the link's failure, as a peer that never came.
+    if (r.stop_reason != StopReason::kStopRequested) return ExitCode::kIo;
+    return StoppedBy(r.stop_signal > 0 ? r.stop_signal : SIGTERM);
+  }
   switch (r.verdict) {
     case qos::Verdict::kPass:
       return ExitCode::kPass;

@@ -3,6 +3,7 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -477,6 +478,9 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
   r.details = config_.details;
   r.verdict = monitor_.verdict();
   r.stop_reason = lifecycle_.stop_reason();
+  if (r.stop_reason == lifecycle::StopReason::kStopRequested) {
+    r.stop_signal = std::max(kernel_glue::StopSignal(), 0);  // -1: RequestStop from code
+  }
   r.fault_while_stopping = lifecycle_.fault_while_stopping();
   r.final_state = lifecycle_.state();
   const scheduler::ExecutiveStats& stats = executive_.stats();
@@ -511,6 +515,7 @@ RunReport RunSession::BuildReport(const LoopResult& result, double wall_time_s) 
   if (timing_log_) r.timing_log = LogFiguresOf(*timing_log_);
   r.wall_time_s = wall_time_s;
   if (result.rt) r.rt_setup = result.rt->record();
+  r.warnings = config_.warnings;
   return r;
 }
 

@@ -70,10 +70,11 @@ TEST(HilReport, AMissingReportLeavesTheFiguresOutAndACrashIsInternal) {
   EXPECT_NE(FormatHilSummary(r).find("ecs   no report"), std::string::npos);
 }
 
-TEST(HilReport, WorseExitCodeOrdersPassFlaggedAbortedIoUsageInternal) {
-  const int order[] = {0, 3, 4, 5, 2, 1};
-  for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) {
+// 143: a side stopped by SIGTERM before any cycle was judged (no verdict, nothing failed).
+TEST(HilReport, WorseExitCodeOrdersPassFlaggedAbortedStoppedIoUsageInternal) {
+  const int order[] = {0, 3, 4, 143, 5, 2, 1};
+  for (int i = 0; i < 7; ++i) {
+    for (int j = 0; j < 7; ++j) {
       EXPECT_EQ(WorseExitCode(order[i], order[j]), order[std::max(i, j)]) << i << "," << j;
     }
   }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <string>
 
 namespace hiltwin::runtime {
@@ -20,7 +21,16 @@ RunReport Finished(qos::Verdict verdict) {
   r.final_state = lifecycle::State::kStopped;
   r.rate_hz = 4000.0;
   r.cycles_planned = r.cycles_run = r.releases = 40'000;
-  r.misses.releases = 40'000;
+  r.misses.releases = r.misses.cycles_judged = 40'000;
+  return r;
+}
+
+/// A run that ended before its first judged cycle.
+RunReport Unjudged(StopReason stop, int signal_number = 0) {
+  RunReport r = Finished(qos::Verdict::kPass);  // the monitor's verdict over nothing
+  r.stop_reason = stop;
+  r.stop_signal = signal_number;
+  r.cycles_run = r.releases = r.misses.releases = r.misses.cycles_judged = 0;
   return r;
 }
 
@@ -46,6 +56,82 @@ TEST(ExitCodeFor, FaultsAndAnIncompleteLogOutrankTheVerdict) {
   EXPECT_EQ(ExitCodeFor(log), ExitCode::kIo);
   log.log->error.clear();
   EXPECT_EQ(ExitCodeFor(log), ExitCode::kPass);
+}
+
+// Issue 34: a twin that ran 0 cycles, or an ECS stopped while it waited for its peer, said PASS
+// and exit 0. No judged cycle: no verdict, and an exit code that is not a pass.
+TEST(ExitCodeFor, NoJudgedCycleIsNoVerdict) {
+  // Stopped on request: what the shell shows for a command that signal ended.
+  EXPECT_EQ(static_cast<int>(ExitCodeFor(Unjudged(StopReason::kStopRequested, SIGTERM))), 143);
+  EXPECT_EQ(static_cast<int>(ExitCodeFor(Unjudged(StopReason::kStopRequested, SIGINT))), 130);
+  EXPECT_EQ(static_cast<int>(ExitCodeFor(Unjudged(StopReason::kStopRequested, SIGHUP))), 129);
+  // A stop command stands for SIGTERM (docs/telemetry.md).
+  EXPECT_EQ(static_cast<int>(ExitCodeFor(Unjudged(StopReason::kStopRequested))), 143);
+  // The peer went before the first judged cycle: the link failed, as a peer that never came.
+  EXPECT_EQ(ExitCodeFor(Unjudged(StopReason::kPeerStopped)), ExitCode::kIo);
+  // A fault still says which.
+  RunReport model = Unjudged(StopReason::kModelFault);
+  model.fault = RunFault{StopReason::kModelFault, 0, "NaN"};
+  EXPECT_EQ(ExitCodeFor(model), ExitCode::kInternal);
+  // Cycles inside the grace period only are not judged either.
+  RunReport grace = Unjudged(StopReason::kStopRequested, SIGINT);
+  grace.cycles_run = grace.misses.releases = grace.misses.grace_cycles = 200;
+  EXPECT_EQ(static_cast<int>(ExitCodeFor(grace)), 130);
+}
+
+TEST(ConclusionOf, NoJudgedCycleSaysSoWithTheStopReasonInTheSummaryAndTheJson) {
+  RunReport r = Unjudged(StopReason::kStopRequested, SIGTERM);
+  const Conclusion c = ConclusionOf(r);
+  EXPECT_FALSE(c.verdict.has_value());
+  EXPECT_FALSE(c.complete);
+  EXPECT_EQ(c.text, "NONE (no cycle was judged: stopped by SIGTERM before the first judged cycle)");
+  const std::string summary = FormatSummary(r);
+  EXPECT_NE(summary.find("verdict    " + c.text + "\n"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("stop: stop_requested by SIGTERM\n"), std::string::npos) << summary;
+  const auto json = ToJson(r);
+  EXPECT_EQ(json["verdict"], "NONE");
+  EXPECT_EQ(json["complete"], false);
+  EXPECT_EQ(json["verdict_text"], c.text);
+  EXPECT_EQ(json["stop_signal"], "SIGTERM");
+
+  RunReport lost = Unjudged(StopReason::kPeerStopped);
+  lost.link.peer_name = "controller";
+  EXPECT_EQ(ConclusionOf(lost).text,
+            "NONE (no cycle was judged: the controller stopped before the first judged cycle)");
+  EXPECT_TRUE(ToJson(lost)["stop_signal"].is_null());
+  RunReport fault = Unjudged(StopReason::kIoFault);
+  fault.fault = RunFault{StopReason::kIoFault, 0, "no controller came up"};
+  EXPECT_EQ(ConclusionOf(fault).text,
+            "NONE (no cycle was judged; the run did NOT finish: I/O fault at cycle 0)");
+}
+
+// Issue 34: a model fault halfway gave "verdict": "PASS" in the JSON while the summary said the
+// run did NOT finish. Both now come from ConclusionOf.
+TEST(ConclusionOf, AFaultedRunsJsonVerdictCarriesWhatTheSummarySays) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  r.stop_reason = StopReason::kModelFault;
+  r.cycles_run = r.misses.cycles_judged = 2001;
+  r.fault = RunFault{StopReason::kModelFault, 2000, "the plant's output became non-finite"};
+  const auto json = ToJson(r);
+  EXPECT_EQ(json["verdict"], "PASS");  // the timing of the cycles run
+  EXPECT_EQ(json["complete"], false);  // but not the run asked for
+  const std::string text = json["verdict_text"];
+  EXPECT_EQ(text,
+            "PASS for the timing of the 2001 cycles run; the run did NOT finish: model "
+            "fault at cycle 2000");
+  EXPECT_NE(FormatSummary(r).find("verdict    " + text + "\n"), std::string::npos);
+  EXPECT_EQ(ToJson(Finished(qos::Verdict::kPass))["complete"], true);
+  EXPECT_EQ(ToJson(Finished(qos::Verdict::kPass))["verdict_text"], "PASS");
+}
+
+TEST(FormatSummary, WarningsAreInTheSummaryAndTheJson) {
+  RunReport r = Finished(qos::Verdict::kPass);
+  EXPECT_TRUE(ToJson(r)["warnings"].empty());
+  r.warnings = {"the controller reads too rarely"};
+  EXPECT_NE(FormatSummary(r).find("warning    the controller reads too rarely\nverdict    PASS\n"),
+            std::string::npos)
+      << FormatSummary(r);
+  EXPECT_EQ(ToJson(r)["warnings"], nlohmann::ordered_json::array({r.warnings[0]}));
 }
 
 TEST(FormatSummary, AnAbortedRunClaimsSafeOutputsOnlyWhenTheyWereWritten) {
@@ -81,12 +167,23 @@ TEST(FormatSummary, MissFiguresAreTheLedgersAndSayWhatWasJudged) {
 
 TEST(ToJson, KeepsTheContractKeysFirstAndInOrder) {
   const auto json = ToJson(Finished(qos::Verdict::kPass));
-  const std::vector<std::string> contract = {
-      "verdict",         "stop_reason",      "rate_hz",
-      "period_ns",       "cycles_planned",   "cycles_run",
-      "deadline_misses", "miss_pct",         "max_consecutive_misses",
-      "constraints",     "latency_ns",       "compute_ns",
-      "response_ns",     "log_rows_written", "log_rows_dropped"};
+  const std::vector<std::string> contract = {"verdict",
+                                             "complete",
+                                             "verdict_text",
+                                             "stop_reason",
+                                             "rate_hz",
+                                             "period_ns",
+                                             "cycles_planned",
+                                             "cycles_run",
+                                             "deadline_misses",
+                                             "miss_pct",
+                                             "max_consecutive_misses",
+                                             "constraints",
+                                             "latency_ns",
+                                             "compute_ns",
+                                             "response_ns",
+                                             "log_rows_written",
+                                             "log_rows_dropped"};
   std::vector<std::string> first;
   for (auto it = json.begin(); it != json.end() && first.size() < contract.size(); ++it) {
     first.push_back(it.key());

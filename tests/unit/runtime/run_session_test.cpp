@@ -10,10 +10,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
+
+#include "hiltwin/kernel_glue/stop_signal.h"
 
 namespace hiltwin::runtime {
 namespace {
@@ -127,6 +130,7 @@ class FakePeer final : public io::PeerLink {
  public:
   io::BusStatus Poll() noexcept override {
     ++polls;
+    if (hang_up_after >= 0 && polls > hang_up_after) std::raise(SIGHUP);
     if (stopped_after >= 0 && polls > stopped_after) {
       return {io::BusResult::kPeerStopped, "wire: the ECS aborted its run on its QoS policy"};
     }
@@ -139,6 +143,7 @@ class FakePeer final : public io::PeerLink {
   }
   int up_after = 0;
   int stopped_after = -1;  ///< >= 0: after this many polls the peer has run and stopped
+  int hang_up_after = -1;  ///< >= 0: after this many polls this process gets SIGHUP
   int polls = 0;
   int announcements = 0;
   io::StopCause announced = io::StopCause::kNone;
@@ -216,7 +221,29 @@ TEST(RunSessionPeer, APeerThatEndedWhileThisSideWaitedEndsItWithoutACycle) {
   EXPECT_FALSE(r.fault.has_value());
   EXPECT_TRUE(r.outputs_safe);
   EXPECT_EQ(peer.announced, io::StopCause::kPeerStopped);
-  EXPECT_EQ(ExitCodeFor(r), ExitCode::kPass);
+  // Nothing was judged: no verdict, and the lost peer is the link's failure (issue 34: this
+  // was PASS, exit 0).
+  EXPECT_FALSE(ConclusionOf(r).verdict.has_value());
+  EXPECT_EQ(ToJson(r)["verdict"], "NONE");
+  EXPECT_EQ(ExitCodeFor(r), ExitCode::kIo);
+}
+
+// A stop signal while this side waits for its peer (issue 34: `hiltwin ecs` given SIGTERM
+// before its twin came said PASS with 0 cycles): no verdict, the signal's shell exit code.
+TEST(RunSessionPeer, AStopSignalWhileWaitingForThePeerGivesNoVerdict) {
+  ScriptedTask task;
+  FakePeer peer;
+  peer.up_after = 1'000'000;
+  peer.hang_up_after = 2;
+  const RunReport r = RunScripted(task, WithPeer(VirtualConfig(200), peer, 5.0));
+  kernel_glue::ResetStopRequest();
+  for (const int signal_number : kernel_glue::kStopSignals) std::signal(signal_number, SIG_DFL);
+  EXPECT_EQ(r.cycles_run, 0U);
+  EXPECT_EQ(r.stop_reason, StopReason::kStopRequested);
+  EXPECT_EQ(r.stop_signal, SIGHUP);
+  EXPECT_FALSE(ConclusionOf(r).verdict.has_value());
+  EXPECT_EQ(static_cast<int>(ExitCodeFor(r)), 128 + SIGHUP);
+  EXPECT_EQ(peer.announced, io::StopCause::kStopRequested);
 }
 
 TEST(RunSessionPeer, AnIoFaultIsAnnouncedAsAFault) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "hiltwin/kernel_glue/process.h"
 
@@ -46,13 +47,17 @@ struct HilResult {
   std::optional<HilTracking> tracking;  ///< closed loop with an ECS report
   HilLinkErrors link;
   int exit_code = 0;  ///< the worse of the two (WorseExitCode)
+  /// What `hil` found doubtful about the pair before it started them (e.g. an --ecs-rate too
+  /// slow to follow the twin's encoders; relbot/encoder_reading.h).
+  std::vector<std::string> warnings;
 };
 
 /// The exit code a process's status stands for: its code, or 1 (internal) for a signal.
 [[nodiscard]] int ExitCodeOf(const kernel_glue::ExitStatus& status) noexcept;
 
-/// The worse of two exit codes, from best to worst: 0 pass, 3 flagged, 4 aborted, 5 I/O,
-/// 2 usage (the run could not happen as asked), 1 internal (crash, model fault).
+/// The worse of two exit codes, from best to worst: 0 pass, 3 flagged, 4 aborted, 128 + a
+/// signal (stopped before any cycle was judged: no verdict), 5 I/O, 2 usage (the run could not
+/// happen as asked), 1 internal (crash, model fault).
 [[nodiscard]] int WorseExitCode(int a, int b) noexcept;
 
 /// Combines the two sides. Reports that lack a key the ECS/twin always write are read as
@@ -61,7 +66,7 @@ struct HilResult {
 
 /// The combined JSON report: `twin`, `ecs` (each the full run report, null when missing),
 /// `tracking_error_max_m` {left, right}, `tracking_error_rms_m`, `final_error_m` (null in open
-/// loop), `link_errors` and its parts, each side's exit, the combined `exit_code`.
+/// loop), `link_errors` and its parts, each side's exit, the combined `exit_code`, `warnings`.
 [[nodiscard]] nlohmann::ordered_json ToJson(const HilResult& result);
 
 /// The combined summary: one line per side, tracking, link, and the combined exit.

@@ -11,6 +11,14 @@ enum class ExitCode : int {
   kFlagged = 3,   ///< run completed but QoS FLAGGED (results unreliable)
   kAborted = 4,   ///< run ABORTED by the QoS policy
   kIo = 5,  ///< hardware / I/O error (e.g. the wrong FPGA image, a log that could not be written)
+  /// Stopped on request before any cycle was judged (no verdict): 128 + the signal, the code a
+  /// shell reports for a command that signal ended (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
+  kStoppedBySignal = 128,
 };
+
+/// kStoppedBySignal + `signal_number`.
+[[nodiscard]] constexpr ExitCode StoppedBy(int signal_number) noexcept {
+  return static_cast<ExitCode>(static_cast<int>(ExitCode::kStoppedBySignal) + signal_number);
+}
 
 }  // namespace hiltwin::runtime

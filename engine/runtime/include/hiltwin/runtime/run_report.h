@@ -76,8 +76,11 @@ struct RunReport {
   /// Application facts reported verbatim as top-level string keys (e.g. input, integrator).
   std::vector<std::pair<std::string, std::string>> details;
 
-  qos::Verdict verdict = qos::Verdict::kPass;
+  qos::Verdict verdict = qos::Verdict::kPass;  ///< the QoS monitor's; see ConclusionOf
   lifecycle::StopReason stop_reason = lifecycle::StopReason::kNone;
+  /// The signal that asked for a stop_requested stop (SIGINT, SIGTERM, SIGHUP); 0 otherwise
+  /// (also for a stop command).
+  int stop_signal = 0;
   lifecycle::StopReason fault_while_stopping = lifecycle::StopReason::kNone;
   lifecycle::State final_state = lifecycle::State::kInit;
 
@@ -108,7 +111,31 @@ struct RunReport {
   std::optional<LogFigures> timing_log;  ///< `--timing-log`: every cycle's time stamps
   double wall_time_s = 0.0;
   std::optional<kernel_glue::RtSetupRecord> rt_setup;  ///< absent on the virtual clock
+  /// What the command found doubtful about the set-up (e.g. a controller too slow to follow the
+  /// encoders), said at the start and kept here: the summary and the JSON `warnings` list them.
+  std::vector<std::string> warnings;
 };
+
+/// What a run concludes: the one source of the JSON's `verdict`, `complete` and
+/// `verdict_text`, the summary's verdict line and the exit code, so none can say more than
+/// another.
+struct Conclusion {
+  /// The QoS verdict of the judged cycles; none when no cycle was judged (stopped, or its peer
+  /// lost, before the first judged cycle; a fault at start-up).
+  std::optional<qos::Verdict> verdict;
+  /// The verdict covers the run: at least one cycle was judged and no fault ended it. False
+  /// when a fault ended the run (the verdict then judges only the timing of the cycles run).
+  bool complete = false;
+  /// The summary's verdict line without its label, e.g. "PASS", or "PASS for the timing of the
+  /// 2001 cycles run; the run did NOT finish: model fault at cycle 2000", or "NONE (no cycle was
+  /// judged: stopped by SIGTERM before the first judged cycle)".
+  std::string text;
+};
+
+[[nodiscard]] Conclusion ConclusionOf(const RunReport& report);
+
+/// "PASS", "FLAGGED", "ABORTED", or "NONE" when there is no verdict (the JSON's `verdict`).
+[[nodiscard]] const char* VerdictWord(const Conclusion& conclusion) noexcept;
 
 /// The JSON report. Keys of the contract (docs/architecture.md, "Run report") come first and keep
 /// their names.
@@ -120,8 +147,11 @@ struct RunReport {
 /// What went wrong or needs attention, one line each, for stderr (empty when nothing did).
 [[nodiscard]] std::vector<std::string> Problems(const RunReport& report);
 
-/// The process exit code: an I/O fault or an incomplete log (data or timing) 5, a model fault 1,
-/// otherwise the verdict (PASS 0, FLAGGED 3, ABORTED 4).
+/// The process exit code: an I/O fault or an incomplete log (data or timing) 5, a model fault 1;
+/// no verdict (no cycle judged): 128 + the signal when stopped on request (130 SIGINT, 143
+/// SIGTERM or a stop command, 129 SIGHUP: what the shell reports for a command that signal
+/// ended), otherwise 5 (the peer was lost before the first judged cycle); else the verdict
+/// (PASS 0, FLAGGED 3, ABORTED 4).
 [[nodiscard]] ExitCode ExitCodeFor(const RunReport& report) noexcept;
 
 }  // namespace hiltwin::runtime

@@ -60,6 +60,7 @@ struct SessionConfig {
   std::string io;                  ///< backend spec, for the report
   std::string peer_name = "peer";  ///< who is on the other side of the link
   std::vector<std::pair<std::string, std::string>> details;  ///< app facts for the report
+  std::vector<std::string> warnings;  ///< said at the start by the command; in the report
   ClockKind clock = ClockKind::kRealtime;
   double rate_hz = 4000.0;
   scheduler::ExecutiveConfig executive;  ///< max_cycles: the planned releases (0: until stopped)
