@@ -124,7 +124,8 @@ std::vector<NamedFile> TwinRunFiles(const TwinRunFlags& f) {
 
 /// --input-rate, or its documented default.
 double ControllerRateOf(const TwinRunFlags& f) {
-  return f.input_rate_hz == 0.0 ? std::min(1000.0, f.session.rate_hz) : f.input_rate_hz;
+  // Only a missing flag means the default: a given 0 is refused (ValidateTwinRunNumbers).
+  return f.input_rate_hz.value_or(std::min(1000.0, f.session.rate_hz));
 }
 
 }  // namespace

@@ -80,7 +80,8 @@ void ParseSessionTexts(const SessionFlags& f, const SessionRole& role, SessionSe
 struct TwinRunFlags {
   SessionFlags session;
   std::string input = "openloop";
-  double input_rate_hz = 0.0;  ///< --input-rate; 0: min(1000 Hz, --rate), the thesis ECS rate
+  /// --input-rate; not given: min(1000 Hz, --rate), the thesis ECS rate
+  std::optional<double> input_rate_hz;
   std::string plant = "relbot";
   std::string plant_map_path;
   std::string config_path;

@@ -17,6 +17,7 @@
 #include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/relbot/ecs_report.h"
 #include "hiltwin/relbot/ecs_task.h"
+#include "hiltwin/relbot/encoder_reading.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/setpoint_profile.h"
@@ -144,6 +145,10 @@ int RunEcs(const EcsRunOptions& options) {
                         const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, profile, rt);
   };
+  // Whether this rate follows the counts (the twin's rate is not known here: `hil` checks it).
+  config.warnings =
+      EncoderReadingWarnings({o.session.rate_hz, std::nullopt, TopCountsPerSecond(ecs->params)});
+  PrintWarnings("ecs", config.warnings);
   const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
   const EcsFigures figures =
       EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());

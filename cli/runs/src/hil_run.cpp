@@ -22,7 +22,10 @@
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/kernel_glue/process.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/relbot/config_error.h"
+#include "hiltwin/relbot/encoder_reading.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/command.h"
 #include "hiltwin/runs/hil_report.h"
@@ -251,6 +254,19 @@ void ShowOutputOf(const Child& child, const fs::path& dir) {
   while (std::getline(file, line)) std::fprintf(stderr, "  %s| %s\n", child.name, line.c_str());
 }
 
+/// Whether the ECS reads the twin's encoders often enough (relbot/encoder_reading.h): said
+/// before the pair starts and kept in the combined report.
+std::vector<std::string> PairWarnings(const HilRunOptions& o) {
+  RelbotParams params = DefaultRelbotParams();
+  try {
+    if (!o.config_path.empty()) params = LoadRelbotParams(o.config_path);
+  } catch (const ConfigError& e) {
+    ThrowUsage(e.what());
+  }
+  return EncoderReadingWarnings(
+      {o.ecs_rate_hz, o.twin_rate_hz, TopCountsPerSecond(params), "--ecs-rate"});
+}
+
 }  // namespace
 
 std::vector<NamedFile> HilFiles(const HilRunOptions& o) {
@@ -275,6 +291,7 @@ int RunHil(const HilRunOptions& o) {
   // Before anything is created: a stop signal from here on ends the pair cleanly, never
   // leaving a half-made report or work folder (docs/reliability.md, row M13).
   kernel_glue::InstallStopSignalHandlers();
+  const std::vector<std::string> warnings = PairWarnings(o);  // exit 2 before anything exists
   const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
   ReportFile report_file(o.report_path);
   std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s, %s\n",
@@ -282,16 +299,18 @@ int RunHil(const HilRunOptions& o) {
               Num(o.duration_s).c_str(),
               o.clock == "virtual" ? "in lockstep on one virtual clock" : "in real time");
   std::fflush(stdout);
+  PrintWarnings("hil", warnings);
   Child twin = Start("twin", TwinArgv(o, wire, dir->path), dir->path);
   Child ecs = Start("ecs", EcsArgv(o, wire, dir->path), dir->path);
   WaitForBoth(twin, ecs, o.duration_s, !o.no_progress && isatty(STDERR_FILENO) == 1);
   io::WireBus::Unlink(name);  // both are gone: nothing may be left in /dev/shm
   ShowOutputOf(twin, dir->path);
   ShowOutputOf(ecs, dir->path);
-  const HilResult result =
+  HilResult result =
       CombineHil(wire, o.mode,
                  HilSide{"twin", *twin.status, ReadReport(SideFile(dir->path, "twin", kReport))},
                  HilSide{"ecs", *ecs.status, ReadReport(SideFile(dir->path, "ecs", kReport))});
+  result.warnings = warnings;
   std::fputs(FormatHilSummary(result).c_str(), stdout);
   std::fflush(stdout);
   return report_file.WriteAtEnd(ToJson(result).dump(2) + '\n', "hil", result.exit_code);

@@ -206,4 +206,10 @@ int PrintOutcome(const SessionRole& role, const runtime::RunReport& report,
                                 static_cast<int>(runtime::ExitCodeFor(report)));
 }
 
+void PrintWarnings(const char* command, const std::vector<std::string>& warnings) {
+  for (const std::string& line : warnings) {
+    std::fprintf(stderr, "hiltwin %s: warning: %s\n", command, line.c_str());
+  }
+}
+
 }  // namespace hiltwin::app

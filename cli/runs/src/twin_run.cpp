@@ -15,6 +15,7 @@
 #include "hiltwin/kernel_glue/clock.h"
 #include "hiltwin/kernel_glue/rt_setup.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
+#include "hiltwin/relbot/encoder_reading.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/relbot_plant.h"
@@ -75,6 +76,19 @@ io::LinkFaultSchedule LinkFaultsOf(const TwinRunOptions& o) {
   return schedule;
 }
 
+/// Whether the controller behind the board reads the encoders often enough: over a wire its
+/// readers decode the emulated lines (both limits); on a real board only the count's wrap
+/// applies; on the mock board and the Verilator model nothing decodes the counts.
+std::vector<std::string> ControllerWarnings(const TwinRunOptions& o, const Twin& twin) {
+  const io::BackendSpec::Kind kind = o.session.io.kind;
+  if (kind != io::BackendSpec::Kind::kWire && kind != io::BackendSpec::Kind::kSpidev) return {};
+  EncoderReading reading{o.controller_rate_hz, std::nullopt, std::nullopt, "--input-rate"};
+  if (kind == io::BackendSpec::Kind::kWire) reading.twin_rate_hz = o.session.rate_hz;
+  // Only the RELbot's top speed is known; another plant's counts are checked for the history.
+  if (o.plant == kRelbotPlantName) reading.top_counts_per_s = TopCountsPerSecond(twin.params);
+  return EncoderReadingWarnings(reading);
+}
+
 /// The report's line naming the injected link faults, e.g. "drop-answer,at=4000,count=3".
 std::string DescribeAll(const io::LinkFaultSchedule& schedule) {
   std::string text;
@@ -94,7 +108,8 @@ void ValidateTwinRunNumbers(const TwinRunOptions& o) {
   ValidateSessionSettings(o.session);
   if (!std::isfinite(o.controller_rate_hz) || o.controller_rate_hz <= 0.0 ||
       o.controller_rate_hz > o.session.rate_hz) {
-    ThrowUsage("--input-rate: the controller rate must be positive and not above --rate (" +
+    ThrowUsage("--input-rate " + Num(o.controller_rate_hz) +
+               ": the controller rate must be positive and not above --rate (" +
                Num(o.session.rate_hz) + " Hz)");
   }
 }
@@ -125,6 +140,8 @@ TwinRunOutcome RunTwin(const TwinRunOptions& o, const char* command) {
                      input = twin->input_name](const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(command, s, planned, task_name, input, rt);
   };
+  config.warnings = ControllerWarnings(o, *twin);
+  PrintWarnings(command, config.warnings);
   // The emulated board exists: LinkFaultsOf accepted only mock and wire.
   std::optional<runtime::LinkFaultingTask> faulting;
   if (!link_faults.empty()) {

@@ -144,7 +144,12 @@ TEST(SessionFlags, ABadValueFailsAtTheCommandLineNamingItsFlag) {
   EXPECT_THAT(UsageErrorOf({"--deadline-us", "250.1"}), HasSubstr("--deadline-us: "));
   // The numbers are checked before anything derives from them: the rate, not a QoS rule.
   EXPECT_THAT(UsageErrorOf({"--rate", "0"}), HasSubstr("--rate: "));
-  EXPECT_THAT(UsageErrorOf({"--input-rate", "-5"}), HasSubstr("--input-rate: "));
+  EXPECT_THAT(UsageErrorOf({"--input-rate", "-5"}), HasSubstr("--input-rate -5: "));
+  // Issue 34: a given 0 was taken for "not given" and ran at the default rate.
+  EXPECT_THAT(UsageErrorOf({"--input-rate", "0"}),
+              HasSubstr("--input-rate 0: the controller rate must be positive and not above "
+                        "--rate (4000 Hz)"));
+  EXPECT_THAT(UsageErrorOf({"--input-rate", "nan"}), HasSubstr("--input-rate nan: "));
   EXPECT_EQ(UsageErrorOf({"--deadline-us", "250"}), "no error");  // exactly the period
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "hiltwin/io/backend.h"
 #include "hiltwin/io/icoboard.h"
@@ -60,6 +61,10 @@ void InitBoard(io::IcoBoardLink& driver, kernel_glue::TimeNs period_ns);
 [[nodiscard]] int PrintOutcome(const SessionRole& role, const runtime::RunReport& report,
                                const nlohmann::ordered_json& json,
                                const std::string& extra_summary, ReportFile& report_file);
+
+/// Each warning on stderr as "hiltwin <command>: warning: ...", at the start of a run (the
+/// report keeps them: SessionConfig::warnings).
+void PrintWarnings(const char* command, const std::vector<std::string>& warnings);
 
 /// A number as a person writes it (4000, 0.25), for messages.
 [[nodiscard]] std::string Num(double value);
