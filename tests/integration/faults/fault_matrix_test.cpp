@@ -5,8 +5,11 @@
 // ends a row), parseable to its last row and holds exactly the rows the report counts. Then
 // each row asserts what its fault must have done. Virtual-clock rows are exact; wall-clock rows
 // (FaultMatrixRealtime) assert only what holds on a noisy shared machine.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -83,7 +86,50 @@ int ExpectedExitCode(const Json& report) {
   if (stop == "io_fault" || report.contains("log_error")) return 5;
   if (stop == "model_fault") return 1;
   const std::string verdict = report["verdict"];
+  if (verdict == "NONE") {
+    // No cycle judged: stopped on request, the signal's shell code (a command: as SIGTERM);
+    // the peer lost before the first judged cycle, 5.
+    if (stop != "stop_requested") return 5;
+    const Json& signal = report["stop_signal"];
+    return 128 + (signal == "SIGINT" ? SIGINT : signal == "SIGHUP" ? SIGHUP : SIGTERM);
+  }
   return verdict == "PASS" ? 0 : verdict == "FLAGGED" ? 3 : 4;
+}
+
+/// Waits until the file at `path` holds `text`; false after `timeout`.
+bool WaitForText(const std::string& path, const std::string& text,
+                 std::chrono::milliseconds timeout) {
+  const auto end = Clock::now() + timeout;
+  while (ReadFile(path).find(text) == std::string::npos) {
+    if (Clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
+
+/// Runs `argv` to its end with stdout a pipe whose reader has already gone (`| head -1` once
+/// head has its line) and stderr into `err_path`; returns the wait status.
+int RunWithClosedStdout(const std::vector<std::string>& argv, const std::string& err_path) {
+  int fds[2];
+  if (::pipe(fds) != 0) return -1;
+  ::close(fds[0]);  // no reader: every write to the pipe fails (EPIPE, or SIGPIPE's default)
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addclose(&actions, fds[1]);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::vector<char*> args;
+  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = -1;
+  const int spawned = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fds[1]);
+  if (spawned != 0) return -1;
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return status;
 }
 
 /// The verdict the constraints imply: any violated rule flags (or aborts) the run.
@@ -127,6 +173,11 @@ class FaultMatrix : public ::testing::Test {
     } else if (report["verdict"] == "FLAGGED") {
       EXPECT_TRUE(AnyRuleViolated(report));
     }
+    // The verdict's words agree: complete only for a judged run no fault ended, and the text
+    // (the summary's verdict line) starts with the verdict.
+    EXPECT_EQ(report["complete"], report["verdict"] != "NONE" && !report.contains("fault"));
+    const std::string verdict_text = report["verdict_text"];
+    EXPECT_EQ(verdict_text.rfind(report["verdict"].get<std::string>(), 0), 0U) << verdict_text;
     const LogFile log = ReadLog(Path(name + ".csv"));
     EXPECT_EQ(log.problem, "");
     EXPECT_EQ(log.rows.size(), report["log_rows_written"].get<std::size_t>());
@@ -257,11 +308,76 @@ TEST_F(FaultMatrix, M15_AModelProducingNaNIsAModelFaultWithEveryEarlierRowKept) 
   ASSERT_EQ(log.rows.size(), 2000U);
   for (const double value : log.rows.back()) EXPECT_TRUE(std::isfinite(value));
   EXPECT_NE(r.err.find("model fault at cycle 2000"), std::string::npos) << r.err;
-  // The verdict judges timing only; its line says the run did not finish.
-  EXPECT_NE(r.out.find("verdict    PASS for the timing of the 2001 cycles run; the run did NOT "
-                       "finish: model fault at cycle 2000"),
+  // The verdict judges timing only; its line says the run did not finish, and so does the
+  // JSON (issue 34: it said only "PASS").
+  const std::string verdict_text =
+      "PASS for the timing of the 2001 cycles run; the run did NOT finish: model fault at cycle "
+      "2000";
+  EXPECT_NE(r.out.find("verdict    " + verdict_text + "\n"), std::string::npos) << r.out;
+  EXPECT_EQ(report["verdict"], "PASS");
+  EXPECT_EQ(report["complete"], false);
+  EXPECT_EQ(report["verdict_text"], verdict_text);
+}
+
+// --- The command line's own streams --------------------------------------------------------
+
+// `hiltwin run ... | head -1`: once the reader is gone, a write to stdout must neither kill the
+// process (SIGPIPE, exit 141) nor lose the report and log; the verdict's code stands (issue 34).
+TEST_F(FaultMatrix, M25_AClosedStdoutKeepsTheVerdictsExitCodeTheReportAndTheLog) {
+  const int status =
+      RunWithClosedStdout(RunArgs("m25", {"--clock", "virtual", "--duration", "2",
+                                          "--inject-overrun", "at=4000,count=20,extra-us=600"}),
+                          Path("m25.err"));
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 3);
+  const Json report = ExpectCoherent("m25", WEXITSTATUS(status), ReadFile(Path("m25.err")));
+  EXPECT_EQ(report["verdict"], "FLAGGED");
+  EXPECT_EQ(report["cycles_run"], 8000);
+  EXPECT_EQ(report["log_rows_written"], 8000);
+}
+
+// --- The controller's rate against the encoders ---------------------------------------------
+
+// A 10 Hz controller against the 4 kHz twin reads the emulated encoder lines every 400 twin
+// periods; they keep 128, so it decodes no edge at all. Its timing may pass, so it is said at the
+// start and in both reports (issue 34: PASS, 0 edges decoded, 119 mm off, not a word).
+TEST_F(FaultMatrix, M27_AControllerTooSlowForTheEncodersIsWarnedAtTheStartAndInTheReport) {
+  const std::string warning =
+      "the controller at 10 Hz reads the encoders every 400 periods of the twin at 4000 Hz; the "
+      "emulated encoder lines keep 128, so the edges in between are lost and the counts jump "
+      "undecoded (resyncs): raise --ecs-rate to at least 32 Hz";
+  auto r = hiltwin::test::Run({HILTWIN_BINARY, "hil", "--clock", "virtual", "--wire",
+                               scratch_.WireName(), "--ecs-rate", "10", "--duration", "1",
+                               "--no-progress", "--report", Path("m27.json")});
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;  // the timing is fine: lockstep misses nothing
+  EXPECT_NE(r.err.find("hiltwin hil: warning: " + warning + "\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("warning   " + warning + "\n"), std::string::npos) << r.out;
+  const Json hil = Json::parse(ReadFile(Path("m27.json")));
+  EXPECT_EQ(hil["warnings"], Json::array({warning}));
+  EXPECT_EQ(hil["ecs"]["encoder_lines"]["edges"], 0);  // what the warning is about
+  EXPECT_GT(hil["ecs"]["encoder_lines"]["resyncs"].get<int>(), 0);
+  // The twin on a wire knows its controller's rate from --input-rate: the same limit.
+  r = hiltwin::test::Run(
+      RunArgs("m27_twin", {"--io", Wire(), "--input-rate", "10", "--wait-peer", "0.1"}));
+  EXPECT_EQ(r.exit_code, 5) << r.err;  // no controller came: not this row's point
+  EXPECT_NE(r.err.find("hiltwin run: warning: the controller at 10 Hz reads the encoders every "
+                       "400 periods"),
             std::string::npos)
-      << r.out;
+      << r.err;
+  EXPECT_NE(r.err.find("raise --input-rate to at least 32 Hz"), std::string::npos) << r.err;
+  EXPECT_EQ(Json::parse(ReadFile(Path("m27_twin.json")))["warnings"].size(), 1U);
+  // The default pair follows its encoders: no warning.
+  r = hiltwin::test::Run({HILTWIN_BINARY, "hil", "--clock", "virtual", "--wire",
+                          scratch_.WireName(), "--duration", "0.5", "--no-progress", "--report",
+                          Path("m27_default.json")});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_TRUE(Json::parse(ReadFile(Path("m27_default.json")))["warnings"].empty());
+  // A controller rate of 0 is no rate: refused, naming the flag (it ran at the default).
+  r = hiltwin::test::Run(RunArgs("m27_zero", {"--clock", "virtual", "--input-rate", "0"}));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--input-rate 0: the controller rate must be positive"), std::string::npos)
+      << r.err;
 }
 
 // --- Wall clock: the machine, the peer, the signals -----------------------------------------------
@@ -381,6 +497,137 @@ TEST_F(FaultMatrixRealtime, M13_StopSignalsAtRandomMomentsNeverLeaveAHalfWritten
       EXPECT_EQ(report["cycles_run"], 4000);
     }
   }
+}
+
+// A closed terminal or a dropped SSH session: SIGHUP stops a run as SIGTERM does, with its
+// report, its log and its stop's cause (issue 34: exit 129 by the signal, a 0-byte report).
+TEST_F(FaultMatrixRealtime, M23_SighupStopsARunCleanlyAsSigtermDoes) {
+  auto run = hiltwin::test::Spawn(RunArgs("m23", {"--duration", "30"}), Path("m23.out"));
+  ASSERT_TRUE(WaitForText(Path("m23.out"), "hiltwin run: ", std::chrono::seconds(10)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto status = run.Kill(SIGHUP);
+  ASSERT_TRUE(status.exited) << status.Describe();
+  const Json report = ExpectCoherent("m23", status.code, ReadFile(Path("m23.out.err")));
+  EXPECT_EQ(report["stop_reason"], "stop_requested");
+  EXPECT_EQ(report["stop_signal"], "SIGHUP");
+  EXPECT_GT(report["cycles_run"].get<int>(), 0);
+  EXPECT_NE(ReadFile(Path("m23.out")).find("stop: stop_requested by SIGHUP"), std::string::npos);
+}
+
+/// Sets an environment variable for the scope (the processes started meanwhile inherit it).
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      ::setenv(name_, old_->c_str(), 1);
+    } else {
+      ::unsetenv(name_);
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+class FaultMatrixHil : public FaultMatrixWire {
+ protected:
+  /// Starts `hiltwin hil` (behind `prefix`, e.g. setsid) with its work folder in this test's
+  /// folder, and returns once both sides run. In lockstep: an hour of virtual time lasts about
+  /// 45 s here, long enough to be stopped midway, and neither side's start-up can be taken
+  /// for a dead peer on a loaded machine (its heartbeat waits with it).
+  hiltwin::kernel_glue::Process StartHil(const std::string& name,
+                                         std::vector<std::string> prefix = {}) {
+    fs::create_directories(Tmp());
+    const ScopedEnv tmpdir("TMPDIR", Tmp());
+    std::vector<std::string> argv = std::move(prefix);
+    argv.insert(argv.end(),
+                {HILTWIN_BINARY, "hil", "--clock", "virtual", "--wire", scratch_.WireName(),
+                 "--duration", "3600", "--no-progress", "--report", Path(name + ".json")});
+    auto hil = hiltwin::test::Spawn(argv, Path(name + ".out"));
+    const auto end = Clock::now() + std::chrono::seconds(15);
+    while (!BothSidesUp() && Clock::now() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_TRUE(BothSidesUp()) << ReadFile(Path(name + ".out.err"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    return hil;
+  }
+  std::string Tmp() const { return Path("tmp"); }
+  /// hil's work folder holds each side's output: both found their peer.
+  bool BothSidesUp() const {
+    for (const auto& entry : fs::directory_iterator(Tmp())) {
+      const std::string twin = ReadFile((entry.path() / "twin.out").string());
+      const std::string ecs = ReadFile((entry.path() / "ecs.out").string());
+      return twin.find("is up; starting") != std::string::npos &&
+             ecs.find("is up; starting") != std::string::npos;
+    }
+    return false;
+  }
+  /// Both sides stopped cleanly and said so; nothing of hil is left in the temporary folder.
+  void ExpectStoppedCleanly(const std::string& name, const hiltwin::kernel_glue::ExitStatus& s) {
+    ASSERT_TRUE(s.exited) << s.Describe();
+    EXPECT_TRUE(s.code == 0 || s.code == 3) << s.Describe() << ReadFile(Path(name + ".out.err"));
+    const Json hil = Json::parse(ReadFile(Path(name + ".json")));
+    for (const char* side : {"twin", "ecs"}) {
+      SCOPED_TRACE(side);
+      ASSERT_TRUE(hil[side].is_object()) << hil.dump(1);
+      EXPECT_TRUE(hil[side]["stop_reason"] == "stop_requested" ||
+                  hil[side]["stop_reason"] == "peer_stopped")
+          << hil[side]["stop_reason"];
+      EXPECT_EQ(hil[side]["outputs_safe"], true);
+      EXPECT_TRUE(hil[side + std::string("_exit")]["exit_code"] == 0 ||
+                  hil[side + std::string("_exit")]["exit_code"] == 3);
+    }
+    EXPECT_TRUE(fs::is_empty(Tmp())) << "hil's work folder left behind";
+  }
+};
+
+// SIGHUP to `hil` (its terminal closed): it passes the stop on to both sides, which end with
+// their reports, combines them and removes its work folder (issue 34: hil died with exit 129,
+// its folder leaked and both sides ran on). Then a SIGTERM to the whole process group, as
+// `kill -TERM -PGID` sends it: both sides get it directly and must not be killed by hil's
+// forwarding a second SIGTERM (their stop handlers are one-shot).
+TEST_F(FaultMatrixHil, M24_SighupToHilStopsBothSidesAndLeavesNothingBehind) {
+  auto hil = StartHil("m24");
+  const auto status = hil.Kill(SIGHUP);
+  ExpectStoppedCleanly("m24", status);
+  EXPECT_NE(ReadFile(Path("m24.out.err")).find("stopping the twin (hil got SIGHUP)"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(scratch_.SegmentPath()));
+
+  auto group = StartHil("m24_group", {"/usr/bin/setsid"});  // its own process group
+  ASSERT_EQ(::kill(-group.pid(), SIGTERM), 0);
+  const auto group_status = group.WaitFor(std::chrono::seconds(20));
+  ASSERT_TRUE(group_status.has_value()) << "hil did not end";
+  ExpectStoppedCleanly("m24_group", *group_status);
+}
+
+// No judged cycle, no verdict (issue 34: `ecs` given SIGTERM while it waited for its twin said
+// PASS and exit 0 over 0 cycles): NONE, and 143, what the shell reports for SIGTERM.
+TEST_F(FaultMatrixWire, M26_AStopBeforeTheFirstCycleHasNoVerdict) {
+  auto ecs = hiltwin::test::Spawn(
+      {HILTWIN_BINARY, "ecs", "--io", Wire(), "--no-progress", "--report", Path("m26.json")},
+      Path("m26.out"));
+  ASSERT_TRUE(WaitForText(Path("m26.out.err"), "waiting for the twin", std::chrono::seconds(10)));
+  const auto status = ecs.Kill(SIGTERM);
+  ASSERT_TRUE(status.exited) << status.Describe();
+  EXPECT_EQ(status.code, 143);
+  const Json report = Json::parse(ReadFile(Path("m26.json")));
+  EXPECT_EQ(status.code, ExpectedExitCode(report));
+  EXPECT_EQ(report["cycles_run"], 0);
+  EXPECT_EQ(report["verdict"], "NONE");
+  EXPECT_EQ(report["complete"], false);
+  EXPECT_EQ(report["verdict_text"],
+            "NONE (no cycle was judged: stopped by SIGTERM before the first judged cycle)");
+  EXPECT_NE(ReadFile(Path("m26.out")).find("verdict    NONE (no cycle was judged"),
+            std::string::npos);
 }
 
 }  // namespace
