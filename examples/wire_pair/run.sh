@@ -6,8 +6,9 @@
 #   HILTWIN  the hiltwin binary (default: `hiltwin` from PATH)
 #   OUT_DIR  where each side's report, log and output go (default: a new folder under $TMPDIR)
 # Prints both sides' output and exit codes; exits with the worse of the two codes, in the order
-# `hiltwin hil` uses (0 < 3 FLAGGED < 4 ABORTED < 5 I/O < 2 bad input < 1 internal), so any
-# side that did not PASS makes it non-zero.
+# `hiltwin hil` uses (0 < 3 FLAGGED < 4 ABORTED < 128+N stopped by signal N before any cycle
+# was judged < 5 I/O < 2 bad input < 1 internal), so any side that did not PASS makes it
+# non-zero.
 set -euo pipefail
 
 hiltwin=${1:-hiltwin}
@@ -70,10 +71,12 @@ echo "---"
 echo "twin exit $twin_rc"
 echo "controller exit $ecs_rc"
 
-# hil's order of badness: 0 < 3 < 4 < 5 < 2 < 1 < anything else (a signal, a crash).
+# hil's order of badness: 0 < 3 < 4 < 129..159 (no verdict: stopped by a signal first) < 5 < 2
+# < 1 < anything else (a crash).
 rank() {
   case $1 in
-    0) echo 0 ;; 3) echo 1 ;; 4) echo 2 ;; 5) echo 3 ;; 2) echo 4 ;; 1) echo 5 ;; *) echo 6 ;;
+    0) echo 0 ;; 3) echo 1 ;; 4) echo 2 ;; 129 | 1[3-5][0-9]) echo 3 ;; 5) echo 4 ;; 2) echo 5 ;;
+    1) echo 6 ;; *) echo 7 ;;
   esac
 }
 if (($(rank "$twin_rc") >= $(rank "$ecs_rc"))); then worst=$twin_rc; else worst=$ecs_rc; fi
