@@ -1,7 +1,6 @@
 #include "hiltwin/io/wire_bus.h"
 
 #include <fcntl.h>
-#include <signal.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -21,6 +20,7 @@
 
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/wire_segment.h"
+#include "hiltwin/kernel_glue/shared_memory.h"
 #include "wire_guard.h"
 #include "wire_lockstep.h"
 #include "hiltwin/lockfree/seqlock.h"
@@ -366,14 +366,20 @@ std::string OwnerOnlyProblem(const struct stat& info) {
       path + ") and retry; otherwise use another wire name");
 }
 
+/// The segment's open file, and whether this process created it.
+struct SegmentFile {
+  int fd = -1;
+  bool created = false;
+};
+
 /// Creates the segment owner-only, or opens the existing one and checks it is owner-only.
-int OpenOwnerOnly(const std::string& segment_name, const std::string& label) {
+SegmentFile OpenOwnerOnly(const std::string& segment_name, const std::string& label) {
   for (int attempt = 0; attempt < 100; ++attempt) {
     int fd = ::shm_open(segment_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC,
                         kWireSegmentMode);
     if (fd >= 0) {
       ::fchmod(fd, kWireSegmentMode);  // the umask may have taken bits off
-      return fd;
+      return {fd, true};
     }
     if (errno == EEXIST) fd = ::shm_open(segment_name.c_str(), O_RDWR | O_CLOEXEC, 0);
     if (fd < 0 && errno == ENOENT) continue;  // removed between the two calls: create it
@@ -395,7 +401,7 @@ int OpenOwnerOnly(const std::string& segment_name, const std::string& label) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
       problem = ::fstat(fd, &info) != 0 ? std::strerror(errno) : OwnerOnlyProblem(info);
     }
-    if (problem.empty()) return fd;
+    if (problem.empty()) return {fd, false};
     ::close(fd);
     RefuseSegment(segment_name, problem);
   }
@@ -403,25 +409,56 @@ int OpenOwnerOnly(const std::string& segment_name, const std::string& label) {
                            ": it keeps being removed and re-created; retry");
 }
 
-/// Opens (creating if needed) owner-only, sizes and maps the named segment.
-WireSegment* MapSegment(const std::string& segment_name, const std::string& label) {
-  const int fd = OpenOwnerOnly(segment_name, label);
+/// Closes `file` and throws `message`; a segment this process created is removed first (no
+/// other process uses it yet: it is not laid out), so a failed start leaves nothing behind.
+[[noreturn]] void AbandonSegment(const SegmentFile& file, const std::string& segment_name,
+                                 const std::string& message) {
+  ::close(file.fd);
+  if (file.created) ::shm_unlink(segment_name.c_str());
+  throw std::runtime_error(message);
+}
+
+/// Sizes the segment's file and reserves its pages: a tmpfs file that is only sized is sparse,
+/// and a full or too small /dev/shm then kills the first process that writes into a page it
+/// cannot supply with SIGBUS. A segment of the right size is reserved too (idempotent: pages
+/// already there are kept, a hole left by an older version is filled).
+void SizeAndReserve(const SegmentFile& file, const std::string& segment_name) {
+  const std::string path = "/dev/shm" + segment_name;
   struct stat info {};
   const auto size = static_cast<off_t>(sizeof(WireSegment));
-  if (::fstat(fd, &info) != 0 || (info.st_size != 0 && info.st_size != size) ||
-      (info.st_size == 0 && ::ftruncate(fd, size) != 0)) {
-    const int error = errno;
-    ::close(fd);
-    throw std::runtime_error("shared memory /dev/shm" + segment_name + " has the wrong size or " +
-                             "cannot be sized (" + std::strerror(error) + "); it may be from " +
-                             "another hiltwin version: remove /dev/shm" + segment_name +
-                             " and retry");
+  if (::fstat(file.fd, &info) != 0) {
+    AbandonSegment(file, segment_name,
+                   "cannot read the size of shared memory " + path + ": " + std::strerror(errno));
   }
-  void* map = ::mmap(nullptr, sizeof(WireSegment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  ::close(fd);
+  if (info.st_size != 0 && info.st_size != size) {
+    AbandonSegment(file, segment_name,
+                   "shared memory " + path + " has the wrong size (" +
+                       std::to_string(info.st_size) + " bytes, not " + std::to_string(size) +
+                       "); it may be from another hiltwin version: remove " + path +
+                       " and retry");
+  }
+  if (const int error = kernel_glue::ReserveFileBytes(file.fd, sizeof(WireSegment));
+      error != 0) {
+    AbandonSegment(file, segment_name,
+                   "cannot reserve " + std::to_string(size) + " bytes for shared memory " + path +
+                       ": " + std::strerror(error) + "; /dev/shm is full or too small (df " +
+                       "/dev/shm): remove what is stale there (ls /dev/shm) or enlarge it " +
+                       "(mount -o remount,size=64M /dev/shm), then retry");
+  }
+}
+
+/// Opens (creating if needed) owner-only, sizes, reserves and maps the named segment. `fd`
+/// receives the open file, which the caller keeps: it holds the side's presence lock.
+WireSegment* MapSegment(const std::string& segment_name, const std::string& label, int& fd) {
+  const SegmentFile file = OpenOwnerOnly(segment_name, label);
+  SizeAndReserve(file, segment_name);
+  void* map =
+      ::mmap(nullptr, sizeof(WireSegment), PROT_READ | PROT_WRITE, MAP_SHARED, file.fd, 0);
   if (map == MAP_FAILED) {
-    throw std::runtime_error("cannot map /dev/shm" + segment_name + ": " + std::strerror(errno));
+    AbandonSegment(file, segment_name,
+                   "cannot map /dev/shm" + segment_name + ": " + std::strerror(errno));
   }
+  fd = file.fd;
   return static_cast<WireSegment*>(map);
 }
 
@@ -484,17 +521,15 @@ WireBus::WireBus(const std::string& name, Image side, std::optional<Image> board
       board_(board_image.value_or(side), board_clock_),
       pid_(static_cast<std::int32_t>(::getpid())),
       guard_(std::make_unique<WireGuard>(SegmentPath(name))) {
-  segment_ = MapSegment(segment_name_, label_);
+  segment_ = MapSegment(segment_name_, label_, fd_);
   if (!LayOutOrCheck(*segment_)) {
-    ::munmap(segment_, sizeof(WireSegment));
-    segment_ = nullptr;
+    Release();
     throw std::runtime_error("shared memory /dev/shm" + segment_name_ + " is not a hiltwin wire " +
                              "of this version; remove /dev/shm" + segment_name_ + " and retry");
   }
   if (ClockMismatch().result != BusResult::kOk) {
     const std::string why = ClockMismatch().reason;
-    ::munmap(segment_, sizeof(WireSegment));
-    segment_ = nullptr;
+    Release();
     throw std::invalid_argument(why.substr(6));  // without "wire: ": the caller names the wire
   }
   Attach();
@@ -526,37 +561,42 @@ BusStatus WireBus::ClockMismatch() const noexcept {
   const std::uint32_t peer_clock = peer.clock.load(std::memory_order_acquire);
   // The usual case, on every exchange: the clocks agree (no system call for it).
   if (peer_clock == kClockUnset || peer_clock == ClockCode(clock_kind_)) return {};
-  // Only a peer that is there now counts: a stale entry of one that left says nothing.
-  const std::int32_t peer_pid = peer.pid.load(std::memory_order_relaxed);
-  const bool present = peer.attached.load(std::memory_order_acquire) == 1 && peer_pid > 0 &&
-                       ProcessAlive(peer_pid);
-  if (!present) return {};
+  // Only a peer that is there now counts: a stale entry of one that left or died says nothing.
+  if (!PeerAlive()) return {};
   return {BusResult::kPeerMismatch, MismatchMessage(side_ == Image::kIcoboard, clock_kind_)};
 }
 
 void WireBus::Attach() {
-  WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
-  WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
-  const std::int32_t previous_pid = self.pid.load();
-  if (self.attached.load() != 0 && previous_pid > 0 && ProcessAlive(previous_pid)) {
-    ::munmap(segment_, sizeof(WireSegment));
-    segment_ = nullptr;
-    throw std::runtime_error(label_ + " already has a" +
-                             (side_ == Image::kIcoboard ? "n ECS" : " twin") +
-                             " attached (pid " + std::to_string(previous_pid) +
+  const bool ecs_side = side_ == Image::kIcoboard;
+  WireSide& self = ecs_side ? segment_->ecs : segment_->twin;
+  WireSide& peer = ecs_side ? segment_->twin : segment_->ecs;
+  // The side is this process's while it holds the side's lock; a process that died (reaped or
+  // not) holds none, so whatever its entry still says, the side is free.
+  const int error = kernel_glue::TakePresence(fd_, ecs_side ? kEcsPresenceByte : kTwinPresenceByte);
+  if (error != 0) {
+    const std::int32_t holder = self.pid.load();
+    Release();
+    if (error != EAGAIN) {
+      throw std::runtime_error("cannot lock /dev/shm" + segment_name_ + " for " + label_ + ": " +
+                               std::strerror(error));
+    }
+    throw std::runtime_error(label_ + " already has a" + (ecs_side ? "n ECS" : " twin") +
+                             " attached (pid " + std::to_string(holder) +
                              "); stop it first or use another wire name");
   }
-  // A peer that crashed never detached: its flags would make this process report "stopped
+  // A peer that died never detached: its flags would make this process report "stopped
   // updating its heartbeat" (or "detached") although no peer has been there since it started.
+  // The lock alone: a new peer takes it before it writes its entry (its attached flag may
+  // still be the dead one's, or not yet set).
   std::int32_t peer_pid = peer.pid.load();
-  if (peer_pid > 0 && !ProcessAlive(peer_pid) && peer.pid.compare_exchange_strong(peer_pid, 0)) {
+  if (peer_pid > 0 && !PeerProcessLives() && peer.pid.compare_exchange_strong(peer_pid, 0)) {
     peer.attached.store(0);
     peer.sessions.store(0);
     peer.stop_cause.store(0);
     peer.clock.store(kClockUnset);
     peer.lockstep_ns.store(0);
-    // A new peer stores its pid before its flags: if one arrived while these were cleared,
-    // give its presence back.
+    // A new peer takes its lock, then stores its pid before its flags: if one arrived while
+    // these were cleared, give its presence back.
     if (peer.pid.load() != 0) {
       peer.attached.store(1);
       peer.sessions.fetch_add(1);
@@ -567,25 +607,41 @@ void WireBus::Attach() {
   self.step_ns.store(0);
   self.clock.store(ClockCode(clock_kind_));
   self.lockstep_ns.store(0);  // lockstep: its set-up happens at time 0, before its first wait
-  self.last_beat_ns.store(kNoBeatYet);  // up at its first beat (Poll or a transfer)
+  self.last_beat_ns.store(kNoBeatYet);  // up at its first beat, once its set-up is done
   self.attached.store(1);
   self.sessions.fetch_add(1);
   segment_->attach_count.fetch_add(1);
 }
 
+void WireBus::Release() noexcept {
+  ::munmap(segment_, sizeof(WireSegment));
+  segment_ = nullptr;
+  ::close(fd_);
+  fd_ = -1;
+}
+
+bool WireBus::PeerProcessLives() const noexcept {
+  return kernel_glue::PresenceHeld(
+      fd_, side_ == Image::kIcoboard ? kTwinPresenceByte : kEcsPresenceByte);
+}
+
+bool WireBus::PeerAlive() const noexcept {
+  const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
+  return peer.attached.load() == 1 && PeerProcessLives();
+}
+
 WireBus::~WireBus() {
   if (segment_ == nullptr) return;
   WireSide& self = side_ == Image::kIcoboard ? segment_->ecs : segment_->twin;
-  const WireSide& peer = side_ == Image::kIcoboard ? segment_->twin : segment_->ecs;
   if (lockstep_) lockstep_->Leave();  // a peer waiting for this side's turn goes on
   self.attached.store(0);
   segment_->attach_count.fetch_sub(1);
-  // The last one out removes the segment. A peer that crashed never detached, so its pid is
-  // checked too; a running peer keeps its mapping even if the name is removed under it.
-  const std::int32_t peer_pid = peer.pid.load();
-  const bool peer_alive = peer.attached.load() != 0 && peer_pid > 0 && ProcessAlive(peer_pid);
-  if (!peer_alive) ::shm_unlink(segment_name_.c_str());
-  ::munmap(segment_, sizeof(WireSegment));
+  // The last one out removes the segment. A peer that died never detached, but it holds no
+  // presence lock (even while its parent has not reaped it); a running peer keeps its mapping
+  // even if the name is removed under it. Both leaving at once: each clears its attached flag
+  // (seq_cst) before it reads the other's, so at least one sees the other gone.
+  if (!PeerAlive()) ::shm_unlink(segment_name_.c_str());
+  Release();  // drops this side's presence lock
 }
 
 void WireBus::Publish(std::int64_t now_ns) noexcept {
@@ -603,7 +659,7 @@ void WireBus::Publish(std::int64_t now_ns) noexcept {
     }
     seg.twin_pins.store(pins, std::memory_order_release);
   }
-  Beat(now_ns);
+  if (present_) Beat(now_ns);
 }
 
 void WireBus::Beat(std::int64_t now_ns) noexcept {
@@ -616,6 +672,7 @@ void WireBus::Beat(std::int64_t now_ns) noexcept {
 BusStatus WireBus::Poll() noexcept {
   const std::int64_t now_ns = wall_.NowNs();
   CheckSegment(now_ns);
+  present_ = true;  // it waits for its peer: its set-up is done
   Beat(now_ns);
   return Status();
 }
@@ -794,6 +851,10 @@ BusStatus WireBus::RunOnBoard(Transfers&& transfers) noexcept {
     }
   }
   board_.SetDigitalInputs(pins);
+  // INIT runs while the command handles its options, before the session's real-time set-up: a
+  // beat there would make the waiting peer start against a side that then stays silent for the
+  // whole set-up. A transfer to a board that INIT has configured is the loop's: set-up done.
+  if (board_.initialised()) present_ = true;
   // The board samples (and publishes its period) while acting on the request; the fetch's NOOP
   // changes nothing on the wire, so one window around both keeps the ECS's replay bound valid.
   if (twin) {

@@ -1,9 +1,6 @@
 #pragma once
 // The wire's latched verdict on the segment (wire_bus.cpp, wire_lockstep.cpp): private to io.
-#include <signal.h>
-
 #include <array>
-#include <cerrno>
 #include <cstdarg>
 #include <cstdint>
 #include <cstdio>
@@ -11,11 +8,6 @@
 #include <utility>
 
 namespace hiltwin::io {
-
-/// kill(pid, 0) succeeds, or fails only for lack of permission: the process exists.
-inline bool ProcessAlive(std::int32_t pid) noexcept {
-  return ::kill(pid, 0) == 0 || errno == EPERM;
-}
 
 /// The first impossible value this side read from the segment, latched: once set, the side
 /// reads nothing more from the wire and every transfer reports it. The message lives in this

@@ -77,17 +77,18 @@ bool WireBus::LockstepClock::PeerStillTakingTurns() noexcept {
   // its run, it did not crash.
   const BusResult status = bus_.PeerStatus().result;
   if (status == BusResult::kPeerStopped) return false;  // its next exchange says why
-  const std::int32_t pid = peer().pid.load(std::memory_order_relaxed);
-  if (pid > 0 && !ProcessAlive(pid)) {
+  // Its process is gone (killed, crashed): the kernel dropped its presence lock at its death,
+  // whether or not its parent has reaped it yet.
+  if (!bus_.PeerProcessLives()) {
     // It may have announced its stop and exited since the status above: then it ended.
     if (bus_.PeerStatus().result != BusResult::kPeerStopped) broken_ = kPeerGone[column];
     return false;
   }
   const bool same_peer = peer().sessions.load(std::memory_order_relaxed) == peer_sessions_;
   if (status == BusResult::kOk && same_peer) return true;
-  // Still in its set-up (lockstep time 0: its loop has not waited yet). It beat at its INIT,
-  // which made it count as up, and beats again only once it polls for this side or runs: under
-  // load (a sanitizer, a busy machine) its set-up in between may outlast the heartbeat timeout.
+  // Still starting (lockstep time 0: its loop has not waited yet). It counts as up from its
+  // wait for this side, and beats again only once its loop waits or runs: under load (a
+  // sanitizer, a busy machine) the moment in between may outlast the heartbeat timeout.
   // Alive, it is given kLockstepSetUpNs before it counts as hung.
   if (status == BusResult::kPeerLost && same_peer &&
       peer().lockstep_ns.load(std::memory_order_relaxed) == 0) {

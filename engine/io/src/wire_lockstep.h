@@ -30,8 +30,8 @@ class WireBus::LockstepClock final : public kernel_glue::Clock {
   /// Spinning beyond this costs more than the futex sleep it avoids.
   static constexpr kernel_glue::TimeNs kLockstepSpinNs = 20'000;
   static constexpr kernel_glue::TimeNs kLockstepSliceNs = 10'000'000;
-  /// How long a live peer may stay in its set-up (between its INIT and its loop's first wait)
-  /// without a heartbeat before it counts as hung.
+  /// How long a live peer may stay starting (between its last poll for this side and its
+  /// loop's first wait) without a heartbeat before it counts as hung.
   static constexpr kernel_glue::TimeNs kLockstepSetUpNs = 30'000'000'000;
 
   /// Binds to `bus`, whose segment it reaches only once the loop waits (after the bus mapped it).

@@ -22,6 +22,7 @@
 #include "fakes/process.h"
 #include "fakes/test_paths.h"
 #include "fakes/wire_scratch.h"
+#include "hand_started_pair.h"
 
 namespace {
 
@@ -214,6 +215,22 @@ TEST_F(HilCli, AKilledControllerEndsTheTwinWithinASecondAsAnIoFault) {
   EXPECT_NE(ReadFile(Path("twin.out.err")).find("I/O fault"), std::string::npos);
 }
 
+// Issue 34, "zombie": the controller is killed by a parent that reaps it only after the twin
+// has ended (this test), and a zombie still answers kill(pid, 0). The twin ends as above and,
+// the controller being dead, it is the last one out: it removes the segment.
+TEST_F(HilCli, AKilledControllerItsParentHasNotReapedYetLeavesNoSharedMemory) {
+  StartPair();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto killed_at = Clock::now();
+  ASSERT_EQ(::kill(ecs_->pid(), SIGKILL), 0);  // not reaped: ecs_ waits for it at the end
+  const auto [status, after_s] = EndOf(*twin_, killed_at);
+  EXPECT_EQ(status.code, 5) << ReadFile(Path("twin.out.err"));
+  EXPECT_LT(after_s, 1.0);
+  EXPECT_FALSE(fs::exists(scratch_.SegmentPath()))
+      << "the twin left the segment beside its dead, unreaped controller";
+  EXPECT_EQ(ecs_->Wait().signal, SIGKILL);
+}
+
 TEST_F(HilCli, AStoppedTwinEndsTheControllerCleanlyWithinASecond) {
   StartPair();
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -245,6 +262,21 @@ TEST_F(HilCli, EitherSideMayStartFirst) {
   EXPECT_EQ(ReadJson(Path("ecs.json"))["stop_reason"], "finished");
   EXPECT_EQ(ReadJson(Path("ecs.json"))["peer_absent_cycles"], 0);
   EXPECT_EQ(ReadJson(Path("twin.json"))["stop_reason"], "peer_stopped");
+}
+
+// Issue 34, 1: README's pair started by hand, each order a few times. The second side comes
+// up beside a first side that already waits for it; its INIT exchange used to count it as
+// present, so the first started at once and called it dead 250 ms later, while it was still in
+// its real-time set-up (most tries on a loaded machine). The long run beside stress-ng, 20 of
+// each order, is WireStartUnderLoad (wire_start_load_test.cpp).
+TEST_F(HilCli, HandStartedPairsComeUpInEitherOrder) {
+  for (int run = 0; run < 6; ++run) {
+    const hiltwin::test::HandStartedPair pair{run % 2 == 0, 2.0, 0.3};
+    EXPECT_EQ(hiltwin::test::RunHandStartedPair(HILTWIN_BINARY, scratch_,
+                                                "pair" + std::to_string(run), pair),
+              "")
+        << "run " << run;
+  }
 }
 
 TEST_F(HilCli, AQosAbortOnTheTwinEndsThePairWithExitFour) {
@@ -300,6 +332,41 @@ TEST_F(HilCli, BadGainsAndProfilesExitTwoNamingFileAndLine) {
   r = Hiltwin({"ecs", "--mode", "openloop", "--input", Path("missing.csv"), "--no-progress"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("missing.csv"), std::string::npos) << r.err;
+}
+
+// Issue 34, 4: a /dev/shm without room for the segment (a tmpfs of its own in a mount
+// namespace, filled up) used to kill the side with SIGBUS at its first write into
+// the mapping (exit 135, an empty report, the segment left behind). The pages are reserved
+// before the mapping is used: an I/O error, exit 5, naming the segment and what to do, and
+// nothing left behind. LTTng-UST, when built in, keeps two pages of its own in /dev/shm (and
+// itself dies of SIGBUS without them): a first hiltwin process makes them before the filling.
+TEST(WireShm, AFullDevShmIsAnIoErrorNotABusError) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root for a mount namespace with its own /dev/shm";
+  if (!fs::exists("/usr/bin/unshare")) GTEST_SKIP() << "needs unshare (util-linux)";
+  hiltwin::test::WireScratch scratch("shm");
+  const std::string segment = scratch.SegmentPath();
+  const std::string script =
+      "mount -t tmpfs -o size=64k tmpfs /dev/shm || exit 99\n"
+      "\"$0\" --version >/dev/null\n"
+      "cat /dev/zero >/dev/shm/filler 2>/dev/null\n"  // until the file system is full
+      "\"$0\" run --io \"$1\" --wait-peer 1 --no-progress --report \"$2\"\n"
+      "echo \"exit $?\"\n"
+      "if [ -e \"$3\" ]; then echo \"segment left\"; fi\n"
+      "if [ -s \"$2\" ]; then echo \"report written\"; fi\n";
+  const auto r = hiltwin::test::Run({"/usr/bin/unshare", "-m", "sh", "-c", script,
+                                     HILTWIN_BINARY, scratch.Wire(), scratch.Path("r.json"),
+                                     segment},
+                                    60'000);
+  if (r.exit_code == 99) GTEST_SKIP() << "cannot mount a tmpfs here: " << r.err;
+  EXPECT_NE(r.out.find("exit 5\n"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.err.find("--io " + scratch.Wire() + ": cannot reserve"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(segment), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("segment left"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("report written"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(scratch.Path("r.json")))
+      << "an empty report is left where none was written";
 }
 
 }  // namespace

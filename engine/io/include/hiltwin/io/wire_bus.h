@@ -14,9 +14,16 @@
 /// reported as kPeerLost. A peer that ends its run announces why (PeerLink::AnnounceStop) and is
 /// then reported as kPeerStopped, so the other side can stop cleanly rather than as a fault.
 /// While a side waits to start it keeps its heartbeat fresh with PeerLink::Poll. A side counts
-/// as up from its first beat, not from its attach: its set-up may outlast the heartbeat timeout,
-/// and until then its peer sees kPeerAbsent. A peer that crashed is forgotten when a new
-/// process attaches.
+/// as up from its first beat, which comes once its set-up is done: its first Poll, or (a run
+/// that does not wait) its first transfer after INIT. Neither its attach nor its INIT exchange,
+/// which happen while its command handles the options, beats: its real-time set-up follows
+/// them and may outlast the heartbeat timeout, and until it is done its peer sees kPeerAbsent.
+/// Whether a side's process still lives is a lock it holds on the segment's file
+/// (kernel_glue::TakePresence), which the kernel drops at its death, even while its parent has
+/// not reaped it yet; its pid is only its identity. A peer that died is forgotten when a new
+/// process attaches, and the last live side out removes the segment. The segment's pages are
+/// reserved when it is opened, so a full or too small /dev/shm is an error there, not a SIGBUS
+/// at the first write.
 ///
 /// Trust: the segment is created owner-only (0600) and refused when it exists with another
 /// mode or owner, but any process of the same user can still write into it. So everything read
@@ -81,9 +88,10 @@ class WireBus final : public SpiBus, public PeerLink {
   /// Attaches to (or creates) the segment of `name` as the side that owns a board of `side`
   /// (icoboard = ECS, icoboard_inverse = twin). Throws std::invalid_argument for a bad name
   /// and std::runtime_error when the segment cannot be used (not a regular file owned by this
-  /// user with mode 0600, another layout, impossible contents) or that side is already attached
-  /// by a live process. `board_image` (fault injection) is the image this side's emulated
-  /// board carries, the side's own image when empty: the wrong one fails INIT's identity check.
+  /// user with mode 0600, another layout, impossible contents, no room in /dev/shm for its
+  /// pages) or that side is already attached by a live process. `board_image` (fault
+  /// injection) is the image this side's emulated board carries, the side's own image when
+  /// empty: the wrong one fails INIT's identity check.
   /// `clock`: the time base; a peer attached on the other one is refused (ClockMismatch).
   WireBus(const std::string& name, Image side, std::optional<Image> board_image = {},
           WireClock clock = WireClock::kRealtime);
@@ -125,8 +133,16 @@ class WireBus final : public SpiBus, public PeerLink {
   class EncoderWire;
   class LockstepClock;
   /// Registers this side in the segment (refusing a second live process on it) and clears
-  /// the flags of a peer that crashed without detaching.
+  /// the flags of a peer that died without detaching.
   void Attach();
+  /// Unmaps the segment and closes its file (which drops this side's presence lock).
+  void Release() noexcept;
+  /// Whether a process holds the peer's presence lock: one that took the peer's side lives.
+  /// One system call (cold paths only: start-up, a clock mismatch, a lockstep slice, detach).
+  [[nodiscard]] bool PeerProcessLives() const noexcept;
+  /// Whether the peer is there now: attached, and its process lives.
+  [[nodiscard]] bool PeerAlive() const noexcept;
+  /// Puts this side's outputs on the wire and, once it is present, beats.
   void Publish(std::int64_t now_ns) noexcept;
   /// Checks the header and both sides' identity fields at `now_ns`; false (and the guard
   /// latched) when the segment holds what no hiltwin process writes.
@@ -154,7 +170,11 @@ class WireBus final : public SpiBus, public PeerLink {
   const kernel_glue::Clock* board_clock_;
   EmulatedFpga board_;
   WireSegment* segment_ = nullptr;
+  int fd_ = -1;  ///< the segment's file, open while attached: it holds the presence lock
   std::int32_t pid_ = 0;
+  /// Whether this side's set-up is done (its first Poll, or a transfer after INIT): its
+  /// transfers beat only from then on. Only the thread that polls or transfers touches it.
+  bool present_ = false;
   std::unique_ptr<WireGuard> guard_;
   std::unique_ptr<PwmWire> pwm_wire_;
   std::unique_ptr<EncoderWire> encoder_wire_;

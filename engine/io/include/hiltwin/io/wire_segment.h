@@ -17,16 +17,25 @@ namespace hiltwin::io {
 namespace wire {
 constexpr std::uint64_t kMagic = 0x6869'6C74'7769'7265ULL;  // "hiltwire"
 // 2: encoder periods in a ring; 3: stop causes; 4: seqlock slots of 64-bit words (no fences);
-// 5: each side's clock and the lockstep's turn words
-constexpr std::uint32_t kLayoutVersion = 5;
+// 5: each side's clock and the lockstep's turn words; 6: a side's process is present while it
+// holds its presence lock (kEcsPresenceByte): a version-5 side holds none and would look dead
+constexpr std::uint32_t kLayoutVersion = 6;
 constexpr std::uint32_t kFresh = 0;
 constexpr std::uint32_t kInitialising = 1;
 constexpr std::uint32_t kReady = 2;
-/// last_beat_ns from Attach until the side's first beat: attached, still setting up (real-time
-/// set-up, pre-faulting, under a sanitizer easily longer than the heartbeat timeout). Its peer
-/// waits for the first beat: an attach-time beat would count a side that is not yet polling as
-/// up, and then as lost once its set-up outlasts the timeout. No CLOCK_MONOTONIC reading is 0.
+/// last_beat_ns from Attach until the side's first beat: attached, still setting up (INIT while
+/// its command handles the options, then the real-time set-up, pre-faulting, under load or a
+/// sanitizer easily longer than the heartbeat timeout). A side first beats once that is done:
+/// at its first Poll (it waits for its peer) or, when it does not wait, at its first transfer
+/// after INIT. Its peer waits for that beat: an earlier one would count a side that is not yet
+/// polling as up, and then as lost once its set-up outlasts the timeout. No CLOCK_MONOTONIC
+/// reading is 0.
 constexpr std::int64_t kNoBeatYet = 0;
+/// The byte of the segment's file on which each side holds its presence lock while attached
+/// (kernel_glue::TakePresence): the kernel drops it at the holder's death, reaped or not, so
+/// whether a side's process is there is asked of the lock, never of its pid.
+constexpr std::int64_t kEcsPresenceByte = 0;
+constexpr std::int64_t kTwinPresenceByte = 1;
 /// twin_sampling_ns when the twin is not inside a transfer.
 constexpr std::int64_t kNotSampling = std::numeric_limits<std::int64_t>::max();
 /// Words of one encoder period: start_ns, subticks << 32 | divider, start_counts (4 × 16),
@@ -41,7 +50,8 @@ constexpr std::int64_t kLockstepRunning = -1;  ///< it holds the turn: the time 
 constexpr std::int64_t kLockstepLeft = std::numeric_limits<std::int64_t>::max();  ///< it stopped
 }  // namespace wire
 
-/// One process's presence on the wire.
+/// One process's presence on the wire. `attached` and `pid` say who attached; whether that
+/// process still lives is the presence lock's to say (wire::kEcsPresenceByte).
 struct WireSide {
   std::atomic<std::uint64_t> heartbeat;
   std::atomic<std::int64_t> last_beat_ns;
