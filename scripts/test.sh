@@ -215,16 +215,11 @@ asan_stage() {
 tsan_stage() {
   build_stage "$root/build-tsan" "${tsan_options[@]}"
   test_stage "TSan (concurrency)" "$root/build-tsan" -j "$jobs" -L concurrency -LE "^(long|rt)$"
-  # Left out here (it runs in the quick tier and under ASan): HilCli.EitherSideMayStartFirst
-  # fails under TSan, the ECS calling the twin's heartbeat stale about 240 ms after both
-  # started. The cause is a wire start-up defect, not the test: the twin's INIT exchange beats
-  # before its real-time set-up, which TSan slows past the 250 ms heartbeat (docs/testing.md,
-  # Flakiness); to be fixed with its own test, then run here again.
-  # (The open-loop comparison with the reference, left out here too while it ran in real time,
-  # runs in lockstep now, HilLockstep.OpenLoopTwinMatches...: exact, so it is back.)
-  local left_out='^HilCli[.]EitherSideMayStartFirst$'
+  # HilCli.EitherSideMayStartFirst, once left out here, runs again: its failures under TSan were
+  # the wire's start-up race, fixed in issue 34 (docs/testing.md, Flakiness). The open-loop
+  # comparison with the reference runs in lockstep now (HilLockstep.OpenLoopTwinMatches...).
   test_stage "TSan (concurrency, rt, serial)" "$root/build-tsan" -j 1 -L concurrency -L "^rt$" \
-    -LE long -E "$left_out"
+    -LE long
 }
 
 # arm64, cross-built with Debian's toolchain and run under qemu-aarch64 (binfmt_misc runs the
