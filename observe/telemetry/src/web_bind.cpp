@@ -4,6 +4,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <system_error>
 
@@ -81,6 +82,29 @@ std::string BindFailureMessage(const WebEndpoint& endpoint, int probe_error) {
       return flag + "could not bind port " + port + " (" +
              std::system_category().message(probe_error) + "); pick another with --web ADDR:PORT";
   }
+}
+
+std::optional<WebEndpoint> BoundEndpoint(int fd) {
+  sockaddr_storage addr{};
+  socklen_t length = sizeof(addr);
+  if (getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length) != 0) return std::nullopt;
+  std::array<char, NI_MAXHOST> host{};
+  std::array<char, NI_MAXSERV> port{};
+  if (getnameinfo(reinterpret_cast<const sockaddr*>(&addr), length, host.data(), host.size(),
+                  port.data(), port.size(), NI_NUMERICHOST | NI_NUMERICSERV) != 0) {
+    return std::nullopt;
+  }
+  return WebEndpoint{host.data(), static_cast<std::uint16_t>(std::stoi(port.data()))};
+}
+
+std::string UrlOf(const WebEndpoint& endpoint) {
+  const bool v6 = endpoint.address.find(':') != std::string::npos;
+  const std::string host = v6 ? "[" + endpoint.address + "]" : endpoint.address;
+  return "http://" + host + ":" + std::to_string(endpoint.port) + "/";
+}
+
+bool IsEveryInterface(const std::string& address) {
+  return address == "0.0.0.0" || address == "::";
 }
 
 }  // namespace hiltwin::telemetry::web

@@ -4,6 +4,8 @@
 // its own worker, so a slow one delays nobody but itself.
 
 #include <httplib.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <sys/socket.h>
 
 #include <atomic>
@@ -30,13 +32,26 @@ namespace {
 constexpr std::chrono::milliseconds kKeepAlive{2000};
 // How long an EventSource waits before it reconnects (e.g. to the next run on the same port).
 constexpr const char* kRetryHint = "retry: 1000\n\n";
-// Each /events stream holds a worker for its whole life: six pages may watch and two workers
-// stay free for the page itself and /record.
-constexpr std::size_t kWorkers = 8;
+// Each /events stream holds a worker for its whole life: six pages may watch, and eight more
+// workers are always left for the page itself, /record and connections that never send a
+// request (each of those costs a worker about 10 ms, see Configure).
 constexpr int kMaxStreams = 6;
-// How long one idle or stuck connection may hold a worker, and so the longest the destructor
-// waits for a worker that is not inside a stream (streams end at once on Stop).
+constexpr std::size_t kRequestWorkers = 8;
+constexpr std::size_t kWorkers = kMaxStreams + kRequestWorkers;
+// Connections held at once, queued or being served; beyond it the accept loop waits and new
+// connections wait in the kernel's listen queue (web_workers.h).
+constexpr std::size_t kMaxConnections = 128;
+// How long the kernel keeps a connection that has sent nothing before handing it over anyway
+// (TCP_DEFER_ACCEPT, see Configure).
+constexpr int kDeferAcceptS = 1;
+// How long one stuck connection (a request that stops halfway, a stream whose browser does not
+// read) may hold a worker per read or write, and so the longest the destructor waits for a
+// worker that is not inside a stream (streams end at once on Stop).
 constexpr time_t kSocketTimeoutS = 1;
+// What a page beyond kMaxStreams gets instead of a stream: an EventSource treats every status
+// but 200 as the end for good (the page would say "connecting" forever), so a page is served
+// one `busy` event that says why, and `retry:` makes the browser try again on its own.
+constexpr int kBusyRetryS = 5;
 // How long the destructor lets open streams send their last record (a stream whose client
 // does not read is cut off after this).
 constexpr std::chrono::milliseconds kDrainTimeout{300};
@@ -58,6 +73,29 @@ bool Write(httplib::DataSink& sink, const std::string& text) {
   return sink.write(text.data(), text.size());
 }
 
+// httplib's server, with the socket it listens on (httplib keeps it protected): the sink names
+// the address the socket really has.
+class Server final : public httplib::Server {
+ public:
+  [[nodiscard]] socket_t ListeningSocket() const noexcept { return svr_sock_; }
+};
+
+// The one event a page beyond kMaxStreams gets (docs/telemetry.md, "The web page").
+std::string BusyEvent() {
+  const nlohmann::json busy = {
+      {"message", std::to_string(kMaxStreams) +
+                      " pages already watch this run (the most it serves): close one of them; "
+                      "this page tries again every " +
+                      std::to_string(kBusyRetryS) + " s"},
+      {"retry_s", kBusyRetryS}};
+  return "retry: " + std::to_string(kBusyRetryS * 1000) + "\nevent: busy\ndata: " + busy.dump() +
+         "\n\n";
+}
+
+bool WantsEventStream(const httplib::Request& req) {
+  return req.get_header_value("Accept").find("text/event-stream") != std::string::npos;
+}
+
 class WebSink final : public runtime::TelemetrySink {
  public:
   explicit WebSink(const WebEndpoint& endpoint);
@@ -74,13 +112,13 @@ class WebSink final : public runtime::TelemetrySink {
   void Bind();
   void StartServing();
   void ServeRecord(httplib::Response& res) const;
-  void ServeEvents(httplib::Response& res);
+  void ServeEvents(const httplib::Request& req, httplib::Response& res);
   bool StreamStep(Stream& stream, httplib::DataSink& sink);
 
   WebEndpoint endpoint_;
   web::LatestRecord latest_;
   std::atomic<int> open_streams_{0};
-  httplib::Server server_;
+  Server server_;
   std::atomic<bool> listen_returned_{false};
   kernel_glue::NamedThread listener_;
 };
@@ -123,14 +161,27 @@ void WebSink::Configure() {
   server_.set_socket_options([](socket_t sock) {
     const int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+    // The kernel hands a connection over only once its request has arrived (or, one that
+    // sends nothing, after this time): a connection that sends nothing never takes a worker
+    // or a descriptor meanwhile, and one the accept loop takes has its request there already,
+    // however late a loaded browser wrote it after connecting.
+    const int defer_s = kDeferAcceptS;
+    setsockopt(sock, IPPROTO_TCP, TCP_DEFER_ACCEPT, &defer_s, sizeof(defer_s));
   });
   // One request per connection: an idle keep-alive connection would hold a worker, and
   // httplib does not look at stop() while it waits for the next request.
   server_.set_keep_alive_max_count(1);
-  server_.set_keep_alive_timeout(kSocketTimeoutS);
+  // How long a taken-up connection may stay silent before its request starts: 0 s is httplib's
+  // shortest, one 10 ms poll. The kernel hands over connections whose request is there
+  // (TCP_DEFER_ACCEPT above); one that still sends nothing after kDeferAcceptS (a port scanner,
+  // a browser's spare socket) held a worker a whole second before, and 500 of them kept
+  // /record waiting over 40 s.
+  server_.set_keep_alive_timeout(0);
   server_.set_read_timeout(kSocketTimeoutS, 0);
   server_.set_write_timeout(kSocketTimeoutS, 0);
-  server_.new_task_queue = [] { return new web::Workers(kWorkers, "hiltwin-web"); };
+  server_.new_task_queue = [] {
+    return new web::Workers(kWorkers, kMaxConnections, "hiltwin-web");
+  };
 
   server_.Get("/", [](const httplib::Request&, httplib::Response& res) {
     const std::string_view page = web::PageHtml();
@@ -139,8 +190,9 @@ void WebSink::Configure() {
   });
   server_.Get("/record",
               [this](const httplib::Request&, httplib::Response& res) { ServeRecord(res); });
-  server_.Get("/events",
-              [this](const httplib::Request&, httplib::Response& res) { ServeEvents(res); });
+  server_.Get("/events", [this](const httplib::Request& req, httplib::Response& res) {
+    ServeEvents(req, res);
+  });
 }
 
 void WebSink::Bind() {
@@ -155,6 +207,13 @@ void WebSink::Bind() {
   if (!bound) {
     throw std::invalid_argument(web::BindFailureMessage(endpoint_, web::ProbeBind(endpoint_)));
   }
+  // httplib listens with a backlog of 5. Connections wait in the kernel while their request is
+  // deferred, and when kMaxConnections are held: beyond the backlog the kernel would fall back
+  // to SYN cookies, which hand a connection over without waiting for its request.
+  listen(server_.ListeningSocket(), static_cast<int>(kMaxConnections));
+  // What the socket really has ("0" is 0.0.0.0, "localhost" one of its addresses), for the
+  // start-up line.
+  if (const auto real = web::BoundEndpoint(server_.ListeningSocket())) endpoint_ = *real;
 }
 
 void WebSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) {
@@ -186,9 +245,15 @@ void WebSink::ServeRecord(httplib::Response& res) const {
   res.set_content(*latest.json, "application/json");
 }
 
-void WebSink::ServeEvents(httplib::Response& res) {
+void WebSink::ServeEvents(const httplib::Request& req, httplib::Response& res) {
   if (open_streams_.fetch_add(1) >= kMaxStreams) {
     open_streams_.fetch_sub(1);
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("Retry-After", std::to_string(kBusyRetryS));
+    if (WantsEventStream(req)) {  // a page: see kBusyRetryS
+      res.set_content(BusyEvent(), "text/event-stream");
+      return;
+    }
     res.status = 503;
     res.set_content(
         "too many open pages (at most " + std::to_string(kMaxStreams) + "): close one and reload",
@@ -233,7 +298,9 @@ void WebSink::Publish(const runtime::TelemetryRecord& record) noexcept {
 }
 
 std::string WebSink::Describe() const {
-  return "web page http://" + endpoint_.address + ":" + std::to_string(endpoint_.port) + "/";
+  std::string url = "web page " + web::UrlOf(endpoint_);
+  if (!web::IsEveryInterface(endpoint_.address)) return url;
+  return url + " (every interface: open it at this machine's name or address)";
 }
 
 }  // namespace

@@ -4,11 +4,14 @@
 
 namespace hiltwin::telemetry::web {
 
-Workers::Workers(std::size_t count, const std::string& name) {
+Workers::Workers(std::size_t count, std::size_t capacity, const std::string& name)
+    : capacity_(capacity) {
   threads_.reserve(count);
   try {
-    for (std::size_t i = 0; i < count; ++i)
-      threads_.emplace_back(kernel_glue::ThreadSpec{name, kernel_glue::AllowedCpus()}, [this] { Work(); });
+    for (std::size_t i = 0; i < count; ++i) {
+      threads_.emplace_back(kernel_glue::ThreadSpec{name, kernel_glue::AllowedCpus()},
+                            [this] { Work(); });
+    }
   } catch (...) {
     shutdown();  // the started ones wait on queued_: release them before unwinding
     throw;
@@ -19,8 +22,10 @@ Workers::~Workers() { shutdown(); }
 
 void Workers::enqueue(std::function<void()> fn) {
   {
-    const std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
+    room_.wait(lock, [this] { return shutting_down_ || held_ < capacity_; });
     jobs_.push_back(std::move(fn));
+    ++held_;
   }
   queued_.notify_one();
 }
@@ -31,6 +36,7 @@ void Workers::shutdown() {
     shutting_down_ = true;
   }
   queued_.notify_all();
+  room_.notify_all();
   for (kernel_glue::NamedThread& thread : threads_) thread.Join();
 }
 
@@ -45,6 +51,11 @@ void Workers::Work() {
       jobs_.pop_front();
     }
     job();
+    {
+      const std::lock_guard lock(mutex_);
+      --held_;
+    }
+    room_.notify_one();
   }
 }
 

@@ -17,6 +17,7 @@
 // with every record the page received. test::Run's timeout guards a hang.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <httplib.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -27,9 +28,11 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <regex>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -139,12 +142,37 @@ std::string Digits(const std::string& text) {
   return digits;
 }
 
-std::vector<std::string> ChromiumDumpDom(const fs::path& profile, int port) {
+/// An open /events stream held by the test, as a watching page would hold it.
+class HeldStream {
+ public:
+  explicit HeldStream(int port) : fd_(socket(AF_INET, SOCK_STREAM, 0)) {
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const std::string request = "GET /events HTTP/1.1\r\nHost: x\r\n\r\n";
+    char buffer[64];
+    if (fd_ < 0 || connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0 ||
+        write(fd_, request.data(), request.size()) != static_cast<ssize_t>(request.size()) ||
+        read(fd_, buffer, sizeof(buffer)) <= 0) {  // served: the stream holds its place
+      throw std::runtime_error("no stream");
+    }
+  }
+  ~HeldStream() { close(fd_); }
+  HeldStream(const HeldStream&) = delete;
+  HeldStream& operator=(const HeldStream&) = delete;
+
+ private:
+  int fd_;
+};
+
+std::vector<std::string> ChromiumDumpDom(const fs::path& profile, int port,
+                                         int virtual_budget_ms = 1000) {
   return {kChromium, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
           "--no-first-run", "--disable-background-networking", "--disable-component-update",
           "--disable-sync", "--user-data-dir=" + profile.string(),
           // Dumps once the stream has ended (see the top of this file).
-          "--virtual-time-budget=1000", "--dump-dom",
+          "--virtual-time-budget=" + std::to_string(virtual_budget_ms), "--dump-dom",
           "http://127.0.0.1:" + std::to_string(port) + "/"};
 }
 
@@ -193,7 +221,9 @@ TEST(TelemetryWeb, ChromiumDrawsTheRobotFromTheStream) {
   ASSERT_TRUE(last["final"].get<bool>());
   const std::string& dom = chromium.out;
 
-  EXPECT_GE(std::stoi(Attribute(Tag(dom, "arena"), "data-samples")), 5) << dom;
+  const std::string samples = Attribute(Tag(dom, "arena"), "data-samples");
+  ASSERT_FALSE(samples.empty()) << "no page in the dump: " << chromium.err << dom;
+  EXPECT_GE(std::stoi(samples), 5) << dom;
   ExpectRobotDrawnAt(dom, last["pose"]);
   const std::string points = Attribute(Tag(dom, "trail"), "points");
   EXPECT_GE(std::count(points.begin(), points.end(), ','), 3) << points;
@@ -209,6 +239,49 @@ TEST(TelemetryWeb, ChromiumDrawsTheRobotFromTheStream) {
     EXPECT_EQ(std::stod(Attribute(m[0].str(), "data-m")), wheel["m"].get<double>()) << name;
   }
   fs::remove_all(dir);
+}
+
+// Six pages watch (the most a run serves); a seventh used to show "connecting" forever: an
+// EventSource given HTTP 503 gives up for good and says nothing. It must say why and retry.
+// Its stream ends at once, so virtual time runs: 12 s of it cover the first connection and the
+// retries 5 s and 10 s later.
+TEST(TelemetryWeb, ChromiumAsSeventhPageSaysWhyItCannotConnectAndRetries) {
+  if (!fs::exists(kChromium)) {
+    GTEST_SKIP() << kChromium << " is missing (apt-get install chromium; scripts/setup.sh)";
+  }
+  const fs::path dir = TempDir("seventh");
+  const int port = FreePort();
+  auto twin = test::Spawn({HILTWIN_BINARY, "run", "--rate", "200", "--duration", "60", "--web",
+                           "127.0.0.1:" + std::to_string(port), "--no-progress"},
+                          (dir / "out.txt").string());
+  ASSERT_TRUE(WaitUntilServing(port, std::chrono::seconds(20)));
+  std::vector<std::unique_ptr<HeldStream>> watching;
+  for (int i = 0; i < 6; ++i) watching.push_back(std::make_unique<HeldStream>(port));
+  const test::RunResult chromium =
+      test::Run(ChromiumDumpDom(dir / "profile", port, 12'000), 60'000);
+  watching.clear();
+  static_cast<void>(twin.Kill(SIGTERM));
+  ASSERT_EQ(chromium.exit_code, 0) << chromium.status.Describe() << chromium.err;
+  const std::string& dom = chromium.out;
+  const std::string link = Tag(dom, "link");
+  EXPECT_EQ(Attribute(link, "class"), "busy") << link;
+  EXPECT_NE(Text(dom, "link").find("6 pages already watch this run"), std::string::npos) << link;
+  EXPECT_NE(Text(dom, "link").find("tries again every 5 s"), std::string::npos) << link;
+  EXPECT_GE(std::stoi("0" + Attribute(link, "data-attempts")), 2) << "no retry: " << link;
+  EXPECT_EQ(Attribute(Tag(dom, "arena"), "data-samples"), "0") << "no record was shown";
+  fs::remove_all(dir);
+}
+
+// "0" is 0.0.0.0 to the resolver: the start-up line names the address really bound, and says
+// that it means every interface.
+TEST(TelemetryWeb, TheStartUpLineNamesTheAddressReallyBound) {
+  const std::string port = std::to_string(FreePort());
+  const test::RunResult r = test::Run({HILTWIN_BINARY, "run", "--duration", "0.2", "--web",
+                                       "0:" + port, "--no-progress"});
+  EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;  // 3: a loaded machine
+  EXPECT_NE(r.out.find("web page http://0.0.0.0:" + port + "/ (every interface"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(TelemetryWeb, APortInUseIsExitTwoNamingThePort) {

@@ -1,18 +1,27 @@
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <atomic>
 #include <chrono>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "hiltwin/telemetry/record_json.h"
 #include "hiltwin/telemetry/sinks.h"
@@ -90,6 +99,107 @@ std::string FirstEvent(httplib::Client& client, std::string* content_type = null
         return false;  // one event is enough: close the stream
       });
   return event;
+}
+
+/// Polls `done` every 20 ms until it holds or 5 s pass.
+bool WaitFor(const std::function<bool()>& done) {
+  const auto give_up = steady_clock::now() + std::chrono::seconds(5);
+  while (!done()) {
+    if (steady_clock::now() >= give_up) return false;
+    std::this_thread::sleep_for(milliseconds(20));
+  }
+  return true;
+}
+
+/// A raw TCP connection to 127.0.0.1:`port` (closed with the object). Non-blocking ones return
+/// at once: a flood of them must not wait for a server that stops accepting.
+class RawConnection {
+ public:
+  RawConnection(int port, bool nonblocking) : fd_(socket(AF_INET, SOCK_STREAM, 0)) {
+    if (fd_ < 0) throw std::runtime_error("no socket");
+    if (nonblocking) fcntl(fd_, F_SETFL, fcntl(fd_, F_GETFL) | O_NONBLOCK);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0 &&
+        !(nonblocking && errno == EINPROGRESS)) {
+      close(fd_);
+      throw std::runtime_error("connect failed");
+    }
+  }
+  ~RawConnection() {
+    if (fd_ >= 0) close(fd_);
+  }
+  RawConnection(RawConnection&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+  RawConnection& operator=(RawConnection&&) = delete;
+  RawConnection(const RawConnection&) = delete;
+  RawConnection& operator=(const RawConnection&) = delete;
+  [[nodiscard]] int fd() const noexcept { return fd_; }
+
+ private:
+  int fd_;
+};
+
+/// `count` open /events streams, each served (its first bytes read) before this returns.
+std::vector<RawConnection> OpenStreams(int port, int count) {
+  std::vector<RawConnection> streams;
+  for (int i = 0; i < count; ++i) {
+    RawConnection c(port, false);
+    const std::string request = "GET /events HTTP/1.1\r\nHost: x\r\n\r\n";
+    if (write(c.fd(), request.data(), request.size()) != static_cast<ssize_t>(request.size())) {
+      throw std::runtime_error("write failed");
+    }
+    char buffer[64];
+    if (read(c.fd(), buffer, sizeof(buffer)) <= 0) throw std::runtime_error("stream not served");
+    streams.push_back(std::move(c));
+  }
+  return streams;
+}
+
+/// Connections that never send a request: nothing at all (a port scanner, a browser's spare
+/// sockets), or only `first_bytes` of one. Opened five at a time, each five given up to 20 ms
+/// to connect: a burst of SYNs beyond the listen backlog would be retried only a second later.
+std::vector<RawConnection> OpenSilent(int port, int count, const std::string& first_bytes = "") {
+  constexpr int kBatch = 5;
+  std::vector<RawConnection> silent;
+  silent.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; i += kBatch) {
+    std::vector<pollfd> batch;
+    for (int j = i; j < std::min(count, i + kBatch); ++j) {
+      silent.emplace_back(port, true);
+      batch.push_back({silent.back().fd(), POLLOUT, 0});
+    }
+    const auto give_up = steady_clock::now() + milliseconds(20);
+    while (steady_clock::now() < give_up) {
+      const bool all_in = std::all_of(batch.begin(), batch.end(),
+                                      [](const pollfd& p) { return p.revents != 0; });
+      if (all_in || poll(batch.data(), batch.size(), 1) < 0) break;
+    }
+    for (const pollfd& p : batch) {
+      if ((p.revents & POLLOUT) != 0 && !first_bytes.empty()) {
+        static_cast<void>(write(p.fd, first_bytes.data(), first_bytes.size()));
+      }
+    }
+  }
+  return silent;
+}
+
+/// How many sockets this process holds besides `clients` (the test's own ends): the server's
+/// listening socket and every connection it has taken in.
+int ServerSockets(const std::vector<RawConnection>& clients) {
+  std::set<int> theirs;
+  for (const RawConnection& c : clients) theirs.insert(c.fd());
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code error;
+    const std::string target = std::filesystem::read_symlink(entry.path(), error).string();
+    if (!error && target.starts_with("socket:") &&
+        !theirs.contains(std::stoi(entry.path().filename().string()))) {
+      ++count;
+    }
+  }
+  return count;
 }
 
 TEST(WebSink, PageIsSelfContainedHtml) {
@@ -312,20 +422,7 @@ TEST(WebSinkTiming, PublishDoesNotWaitForAClientThatDoesNotRead) {
 TEST(WebSink, StreamsBeyondTheLimitAreTurnedAway) {
   Served served;
   served.sink->Publish(MakeRecord(0.0));
-  std::vector<int> streams;
-  for (int i = 0; i < 6; ++i) {  // the limit: six pages at once
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons(static_cast<std::uint16_t>(served.port));
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
-    const std::string request = "GET /events HTTP/1.1\r\nHost: x\r\n\r\n";
-    ASSERT_GT(write(fd, request.data(), request.size()), 0);
-    char buffer[64];
-    ASSERT_GT(read(fd, buffer, sizeof(buffer)), 0);  // served: its worker holds the stream
-    streams.push_back(fd);
-  }
+  const std::vector<RawConnection> streams = OpenStreams(served.port, 6);  // the limit
   const httplib::Result seventh = served.client.Get("/events");
   ASSERT_TRUE(seventh);
   EXPECT_EQ(seventh->status, 503);
@@ -333,7 +430,88 @@ TEST(WebSink, StreamsBeyondTheLimitAreTurnedAway) {
   const httplib::Result record = served.client.Get("/record");  // workers left for the rest
   ASSERT_TRUE(record);
   EXPECT_EQ(record->status, 200);
-  for (const int fd : streams) close(fd);
+}
+
+// An EventSource treats any status but 200 as the end, for good: the page would show
+// "connecting" forever. A page (Accept: text/event-stream) is told why, and when to retry.
+TEST(WebSink, ASeventhPageIsToldWhyAndRetriesUntilASlotIsFree) {
+  Served served;
+  served.sink->Publish(MakeRecord(0.0));
+  std::vector<RawConnection> streams = OpenStreams(served.port, 6);
+  const httplib::Headers page{{"Accept", "text/event-stream"}};
+  const httplib::Result seventh = served.client.Get("/events", page);
+  ASSERT_TRUE(seventh) << httplib::to_string(seventh.error());
+  EXPECT_EQ(seventh->status, 200);
+  EXPECT_EQ(seventh->get_header_value("Content-Type"), "text/event-stream");
+  EXPECT_NE(seventh->body.find("retry: 5000\n"), std::string::npos) << seventh->body;
+  EXPECT_NE(seventh->body.find("event: busy\ndata: "), std::string::npos) << seventh->body;
+  EXPECT_NE(seventh->body.find("6 pages already watch this run"), std::string::npos)
+      << seventh->body;
+  EXPECT_EQ(seventh->body.find("\ndata: {\"timestamp\""), std::string::npos) << "no record";
+
+  streams.pop_back();  // one page closes: the next retry is served
+  std::string received;
+  httplib::Client retry("127.0.0.1", served.port);
+  retry.set_read_timeout(5, 0);
+  ASSERT_TRUE(WaitFor([&] {
+    served.sink->Publish(MakeRecord(0.0));  // a write shows the closed page's stream is gone
+    received.clear();
+    retry.Get("/events", page, [&](const char* data, std::size_t length) {
+      received.append(data, length);
+      return received.find("\n\n", received.find("data: ")) == std::string::npos;
+    });
+    return received.find("data: " + ToJson(MakeRecord(0.0)).dump()) != std::string::npos;
+  })) << received;
+  EXPECT_EQ(received.find("event: busy"), std::string::npos) << received;
+}
+
+TEST(WebSink, DescribeNamesTheAddressItReallyBinds) {
+  // "0" is 0.0.0.0 to the resolver: every interface, which the line must say.
+  const auto any = MakeWebSink({"0", 0});
+  const std::regex every(R"(web page http://0\.0\.0\.0:\d+/ \(every interface.*)");
+  EXPECT_TRUE(std::regex_match(any->Describe(), every)) << any->Describe();
+  const auto loopback = MakeWebSink({"127.1", 0});
+  EXPECT_TRUE(std::regex_match(loopback->Describe(),
+                               std::regex(R"(web page http://127\.0\.0\.1:\d+/)")))
+      << loopback->Describe();
+}
+
+// 500 connections that never send a byte made /record wait over 40 s: each held one of the
+// few workers for a whole keep-alive timeout, in turn. Now the kernel keeps them until their
+// request arrives (TCP_DEFER_ACCEPT), one still silent after a second is dropped within about
+// 10 ms, and six open pages leave eight workers to everything else.
+TEST(WebSinkTiming, RecordAnswersWithinSecondsWhile500IdleConnectionsAreOpen) {
+  Served served;
+  served.sink->Publish(MakeRecord(0.5));
+  const std::vector<RawConnection> streams = OpenStreams(served.port, 6);
+  const std::vector<RawConnection> idle = OpenSilent(served.port, 500);
+  httplib::Client client("127.0.0.1", served.port);
+  client.set_connection_timeout(15, 0);
+  client.set_read_timeout(15, 0);
+  const auto start = steady_clock::now();
+  const httplib::Result res = client.Get("/record");
+  const auto took = steady_clock::now() - start;
+  ASSERT_TRUE(res) << httplib::to_string(res.error());
+  EXPECT_EQ(res->status, 200);
+  EXPECT_LT(took, std::chrono::seconds(5))
+      << std::chrono::duration_cast<milliseconds>(took).count() << " ms";
+}
+
+// Connections that start a request and stall are handed over at once, and each holds a worker
+// up to the read timeout: they pile up in the queue, never beyond the cap. Before the cap
+// every one of them held a descriptor (a process out of descriptors cannot write its report).
+TEST(WebSinkTiming, AtMost128ConnectionsAreTakenInAtOnce) {
+  Served served;
+  const int before = ServerSockets({});
+  const std::vector<RawConnection> stalled = OpenSilent(served.port, 500, "GET /rec");
+  int most = 0;
+  const auto until = steady_clock::now() + milliseconds(500);
+  while (steady_clock::now() < until) {
+    most = std::max(most, ServerSockets(stalled) - before);
+    std::this_thread::sleep_for(milliseconds(5));
+  }
+  EXPECT_GT(most, 100) << "the flood was not taken in up to the cap";
+  EXPECT_LE(most, 128 + 1);  // and the one the accept loop has taken and waits to queue
 }
 
 }  // namespace
