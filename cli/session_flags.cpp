@@ -207,6 +207,10 @@ void AddTelemetryFlags(CLI::App& app, telemetry::TelemetryOptions& t) {
       ->default_str("127.0.0.1:8080");
   app.add_option("--telemetry-rate", t.rate_hz, "telemetry records per second (0 < HZ <= 1000)")
       ->capture_default_str();
+  app.add_flag("--accept-commands", t.accept_commands,
+               "with --telemetry dds: take commands (stop, pause, start, ...) on rt/NS/command "
+               "from any participant on the DDS domain; without it they are refused, and the "
+               "task and the sender say so");
 }
 
 std::vector<NamedFile> SessionOutputFiles(const SessionFlags& f) {

@@ -62,6 +62,7 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
     static_cast<void>(telemetry::ParseDdsSpecs(t.specs));
     static_cast<void>(telemetry::ParseUdpSpecs(t.specs));
     if (!t.web.empty()) static_cast<void>(telemetry::ParseWebSpec(t.web));
+    telemetry::CheckAcceptCommands(t);
     telemetry::CheckNamespace(t.ns + "/controller");
   } catch (const std::invalid_argument& e) {
     ThrowUsage(e.what());

@@ -82,11 +82,13 @@ std::unique_ptr<WorkDir> MakeWorkDir(const HilRunOptions& o) {
   return dir;
 }
 
-/// One side's telemetry flags: its own namespace under --namespace; the page on the twin only.
+/// One side's telemetry flags: its own namespace under --namespace; the page on the twin only;
+/// --accept-commands to both sides, this pair's own processes, when hil was given it.
 void AddTelemetry(std::vector<std::string>& argv, const telemetry::TelemetryOptions& t,
                   const char* side, bool serves_web) {
   if (t.specs.empty() && (t.web.empty() || !serves_web)) return;
   for (const std::string& spec : t.specs) argv.insert(argv.end(), {"--telemetry", spec});
+  if (t.accept_commands) argv.emplace_back("--accept-commands");
   argv.insert(argv.end(), {"--namespace", t.ns + "/" + side, "--telemetry-rate", Num(t.rate_hz)});
   if (serves_web && !t.web.empty()) argv.insert(argv.end(), {"--web", t.web});
 }

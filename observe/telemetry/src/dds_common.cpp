@@ -54,4 +54,27 @@ dds_entity_t CreateTopic(dds_entity_t participant, const dds_topic_descriptor_t*
 
 std::string TopicName(const std::string& ns, const char* leaf) { return "rt/" + ns + "/" + leaf; }
 
+dds_entity_t CreatePublicationReader(dds_entity_t participant) {
+  // The macro is Cyclone's pseudo-handle, defined with a C cast in its header.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wold-style-cast"
+  const dds_entity_t builtin = DDS_BUILTIN_TOPIC_DCPSPUBLICATION;
+#pragma GCC diagnostic pop
+  return Check(dds_create_reader(participant, builtin, nullptr, nullptr),
+               "DDS reader of the built-in publication topic");
+}
+
+void SetUserData(dds_qos_t* qos, std::string_view text) {
+  dds_qset_userdata(qos, text.data(), text.size());
+}
+
+std::string UserDataOf(const dds_qos_t* qos) {
+  void* value = nullptr;
+  std::size_t size = 0;
+  if (qos == nullptr || !dds_qget_userdata(qos, &value, &size) || value == nullptr) return {};
+  std::string text(static_cast<const char*>(value), size);
+  dds_free(value);  // dds_qget_userdata hands over a copy
+  return text;
+}
+
 }  // namespace hiltwin::telemetry::dds

@@ -5,9 +5,12 @@
 
 #include <dds/dds.h>
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace hiltwin::telemetry::dds {
@@ -75,5 +78,39 @@ dds_entity_t CreateTopic(dds_entity_t participant, const dds_topic_descriptor_t*
 
 /// The ROS 2 type name of hiltwin's timing topic (module hiltwin::msg::dds_, struct Timing_).
 inline constexpr const char* kTimingTypeName = "hiltwin::msg::dds_::Timing_";
+
+/// The user data of a task's command reader: whether it takes commands (--accept-commands).
+/// Discovery carries it to every writer that matches, so a sender learns of a refusal before
+/// the task's stderr, on another machine, says so.
+inline constexpr std::string_view kCommandsAccepted = "hiltwin commands=accepted";
+inline constexpr std::string_view kCommandsRefused = "hiltwin commands=refused";
+
+/// Takes every sample `reader` holds, calling `fn(sample, info)` for each that has data.
+template <typename Sample, typename Fn>
+void TakeAll(dds_entity_t reader, Fn&& fn) {
+  constexpr std::size_t kBatch = 16;
+  for (;;) {
+    std::array<void*, kBatch> samples{};  // null: Cyclone lends its own buffers
+    std::array<dds_sample_info_t, kBatch> infos{};
+    const dds_return_t n = dds_take(reader, samples.data(), infos.data(), kBatch, kBatch);
+    if (n <= 0) return;
+    const auto taken = static_cast<std::size_t>(n);
+    for (std::size_t i = 0; i < taken; ++i) {
+      if (infos[i].valid_data) fn(*static_cast<const Sample*>(samples[i]), infos[i]);
+    }
+    static_cast<void>(dds_return_loan(reader, samples.data(), n));
+    if (taken < kBatch) return;
+  }
+}
+
+/// A reader of the built-in DCPSPublication topic: every writer on the domain, with its topic,
+/// type, participant and QoS (how `ros2 topic list` finds topics).
+[[nodiscard]] dds_entity_t CreatePublicationReader(dds_entity_t participant);
+
+/// Sets `text` as the user data of `qos`.
+void SetUserData(dds_qos_t* qos, std::string_view text);
+
+/// The user data of a discovered endpoint's QoS ("" when it has none).
+[[nodiscard]] std::string UserDataOf(const dds_qos_t* qos);
 
 }  // namespace hiltwin::telemetry::dds

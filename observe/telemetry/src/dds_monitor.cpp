@@ -5,6 +5,7 @@
 // (transient-local, so the task's last record arrives at once).
 #include "hiltwin/telemetry/dds_monitor.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <map>
@@ -50,22 +51,20 @@ MonitorEntry EntryOf(const std::string& ns, const hiltwin_msg_dds__Timing_& t) {
   return e;
 }
 
-// Takes every sample `reader` holds, calling `fn(sample, info)` for those with data.
-template <typename Sample, typename Fn>
-void TakeAll(dds_entity_t reader, Fn&& fn) {
-  constexpr std::size_t kBatch = 16;
-  for (;;) {
-    std::array<void*, kBatch> samples{};  // null: Cyclone lends its own buffers
-    std::array<dds_sample_info_t, kBatch> infos{};
-    const dds_return_t n = dds_take(reader, samples.data(), infos.data(), kBatch, kBatch);
-    if (n <= 0) return;
-    const auto taken = static_cast<std::size_t>(n);
-    for (std::size_t i = 0; i < taken; ++i) {
-      if (infos[i].valid_data) fn(*static_cast<const Sample*>(samples[i]));
-    }
-    static_cast<void>(dds_return_loan(reader, samples.data(), n));
-    if (taken < kBatch) return;
+// Whether any reader `writer` matched takes commands: a hiltwin task's command reader says so
+// in its user data (dds_common.h); a reader that does not say (another program's) may.
+bool AnyReaderTakesCommands(dds_entity_t writer) {
+  std::array<dds_instance_handle_t, 16> handles{};
+  const dds_return_t n = dds_get_matched_subscriptions(writer, handles.data(), handles.size());
+  const std::size_t matched = n > 0 ? std::min(static_cast<std::size_t>(n), handles.size()) : 0;
+  bool takes = matched == 0;  // none left to ask: the acknowledgement decides
+  for (std::size_t i = 0; i < matched && !takes; ++i) {
+    dds_builtintopic_endpoint_t* reader = dds_get_matched_subscription_data(writer, handles[i]);
+    if (reader == nullptr) continue;
+    takes = dds::UserDataOf(reader->qos) != dds::kCommandsRefused;
+    dds_builtintopic_free_endpoint(reader);
   }
+  return takes;
 }
 
 }  // namespace
@@ -87,7 +86,7 @@ struct DdsMonitor::State {
 };
 
 void DdsMonitor::State::Discover() {
-  TakeAll<dds_builtintopic_endpoint_t>(publications, [this](const dds_builtintopic_endpoint_t& ep) {
+  dds::TakeAll<dds_builtintopic_endpoint_t>(publications, [this](const auto& ep, const auto&) {
     if (ep.topic_name == nullptr || ep.type_name == nullptr) return;
     if (std::string_view(ep.type_name) != dds::kTimingTypeName) return;
     const std::string ns = NamespaceOfTimingTopic(ep.topic_name);
@@ -108,14 +107,7 @@ DdsMonitor::DdsMonitor(std::uint32_t domain) : state_(new State) {
   try {
     state_->domain = domain;
     state_->participant = dds::CreateParticipant(domain, "DDS domain " + std::to_string(domain));
-    // The macro is Cyclone's pseudo-handle, defined with a C cast in its header.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-    const dds_entity_t builtin = DDS_BUILTIN_TOPIC_DCPSPUBLICATION;
-#pragma GCC diagnostic pop
-    state_->publications =
-        dds::Check(dds_create_reader(state_->participant.get(), builtin, nullptr, nullptr),
-                   "DDS reader of the built-in publication topic");
+    state_->publications = dds::CreatePublicationReader(state_->participant.get());
   } catch (...) {
     delete state_;
     throw;
@@ -131,7 +123,7 @@ std::vector<MonitorEntry> DdsMonitor::Poll() {
   for (auto& item : state_->tasks) {
     const std::string& ns = item.first;
     State::Task& task = item.second;
-    TakeAll<hiltwin_msg_dds__Timing_>(task.reader, [&](const hiltwin_msg_dds__Timing_& t) {
+    dds::TakeAll<hiltwin_msg_dds__Timing_>(task.reader, [&](const auto& t, const auto&) {
       task.latest = EntryOf(ns, t);
       task.arrived = now;
     });
@@ -169,6 +161,8 @@ std::string DdsMonitor::SendCommand(const std::string& ns, runtime::RemoteComman
     }
     std::this_thread::sleep_for(kPollPeriod);
   }
+  // Sent even when refused: the task then says on its stderr that someone tried.
+  const bool refused = !AnyReaderTakesCommands(writer.get());
   const std_msgs_msg_dds__Int32_ sample{static_cast<std::int32_t>(command)};
   const dds_return_t rc = dds_write(writer.get(), &sample);
   if (rc < 0) return "writing " + name + " failed: " + dds_strretcode(rc);
@@ -178,6 +172,12 @@ std::string DdsMonitor::SendCommand(const std::string& ns, runtime::RemoteComman
   if (acked < 0) {
     return std::string("the reader on ") + name + " did not acknowledge " +
            runtime::ToString(command) + " within 2 s (" + dds_strretcode(acked) + ")";
+  }
+  if (refused) {
+    return std::string("the task refused ") + runtime::ToString(command) +
+           ": it was started without --accept-commands, so it takes no commands from the DDS "
+           "domain (it says so on its stderr); start it with --accept-commands to command it "
+           "(docs/telemetry.md, \"Who may command a task\")";
   }
   return {};
 }

@@ -1,14 +1,21 @@
 // `--telemetry dds[:DOMAIN]`: one task's telemetry as ROS 2 topics (sinks.h). Every call after
 // Open comes from the telemetry thread, so the sink needs no lock; Publish and PollCommands
 // never throw and never wait on the network.
+// The trust boundary (docs/telemetry.md, "Who may command a task"): any participant on the
+// domain can write rt/<ns>/command, so commands reach the session only with --accept-commands,
+// and a task warns when another task publishes under its namespace.
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dds_common.h"
@@ -33,11 +40,30 @@ builtin_interfaces_msg_dds__Time_ StampOf(double time_s) noexcept {
   return {static_cast<std::int32_t>(whole_s), static_cast<std::uint32_t>(ns)};
 }
 
+// "hiltwin task pid=P host=H": the timing writer's user data, so a task that finds another one
+// under its namespace can say which.
+std::string TaskUserData() {
+  std::array<char, 256> host{};
+  if (gethostname(host.data(), host.size() - 1) != 0) host[0] = '\0';
+  return "hiltwin task pid=" + std::to_string(getpid()) + " host=" + host.data();
+}
+
+// "pid P on H" from TaskUserData's text, "" from any other.
+std::string WhoOf(const std::string& user_data) {
+  constexpr std::string_view kPrefix = "hiltwin task pid=";
+  const std::size_t host = user_data.find(" host=");
+  if (!user_data.starts_with(kPrefix) || host == std::string::npos) return {};
+  return "pid " + user_data.substr(kPrefix.size(), host - kPrefix.size()) + " on " +
+         user_data.substr(host + 6);
+}
+
 class DdsSink final : public runtime::TelemetrySink {
  public:
-  explicit DdsSink(std::uint32_t domain)
-      : domain_(domain),
-        participant_(dds::CreateParticipant(domain, "--telemetry dds:" + std::to_string(domain))) {}
+  explicit DdsSink(const DdsEndpoint& endpoint)
+      : domain_(endpoint.domain),
+        accept_commands_(endpoint.accept_commands),
+        participant_(dds::CreateParticipant(
+            endpoint.domain, "--telemetry dds:" + std::to_string(endpoint.domain))) {}
 
   void Open(const runtime::TelemetryShape& shape, const std::string& ns) override;
   void Publish(const runtime::TelemetryRecord& record) noexcept override;
@@ -49,11 +75,15 @@ class DdsSink final : public runtime::TelemetrySink {
   void PublishTiming(const runtime::TelemetryRecord& record) noexcept;
   void Write(dds_entity_t writer, const void* sample, const char* leaf) noexcept;
   void Handle(std::int32_t code, const runtime::CommandPort& port) const noexcept;
+  void Refuse(std::int32_t code) noexcept;
+  void WatchNamespace() noexcept;
 
   std::uint32_t domain_;
+  bool accept_commands_;
   dds::Entity participant_;  // owns every topic, writer and reader below
   bool has_pose_ = false;
   std::string ns_;
+  std::string timing_topic_;
   std::string command_topic_;
   dds_entity_t pose_writer_ = 0;
   dds_entity_t joints_writer_ = 0;
@@ -62,6 +92,11 @@ class DdsSink final : public runtime::TelemetrySink {
   std::vector<std::string> joint_names_;
   std::vector<char*> joint_name_ptrs_;  // JointState_::name points here (Cyclone's char**)
   std::uint64_t write_failures_ = 0;    // the first is reported, the rest only counted
+  std::uint64_t commands_refused_ = 0;  // without --accept-commands: the first is reported
+  // Every writer on the domain, watched for another task's timing writer under our namespace
+  // until one is found (then deleted: the warning is given once).
+  dds_entity_t publications_ = 0;
+  dds_guid_t own_guid_{};
 };
 
 void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) {
@@ -75,7 +110,10 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
   const dds::QosPtr stream = dds::MakeQos(10, dds::Durability::kVolatile);
   // Depth 1 and transient-local: a monitor that joins late sees every task at once.
   const dds::QosPtr latest = dds::MakeQos(1, dds::Durability::kTransientLocal);
+  dds::SetUserData(latest.get(), TaskUserData());
   const dds::QosPtr commands = dds::MakeQos(32, dds::Durability::kVolatile);
+  dds::SetUserData(commands.get(),
+                   accept_commands_ ? dds::kCommandsAccepted : dds::kCommandsRefused);
   has_pose_ = shape.has_pose;
   if (has_pose_) {
     const std::string name = dds::TopicName(ns, "pose");
@@ -89,7 +127,8 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
       dds_create_writer(pp, dds::CreateTopic(pp, &sensor_msgs_msg_dds__JointState__desc, joints),
                         stream.get(), nullptr),
       "DDS writer " + joints);
-  const std::string timing = dds::TopicName(ns, "timing");
+  timing_topic_ = dds::TopicName(ns, "timing");
+  const std::string& timing = timing_topic_;
   timing_writer_ =
       dds::Check(dds_create_writer(pp, dds::CreateTopic(pp, &hiltwin_msg_dds__Timing__desc, timing),
                                    latest.get(), nullptr),
@@ -102,6 +141,10 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
   joint_names_ = shape.joint_names;
   joint_name_ptrs_.clear();
   for (std::string& name : joint_names_) joint_name_ptrs_.push_back(name.data());
+  // Discovery takes time, so the namespace is watched from the telemetry thread (WatchNamespace,
+  // every record) rather than waited for here: the run starts at once.
+  publications_ = dds::CreatePublicationReader(pp);
+  dds::Check(dds_get_guid(pp, &own_guid_), "DDS participant GUID");
   ns_ = ns;
 }
 
@@ -162,21 +205,58 @@ void DdsSink::Write(dds_entity_t writer, const void* sample, const char* leaf) n
 }
 
 void DdsSink::PollCommands(const runtime::CommandPort& port) noexcept {
+  WatchNamespace();
   if (command_reader_ <= 0) return;
-  constexpr std::size_t kBatch = 16;
-  for (;;) {
-    std::array<void*, kBatch> samples{};  // null: Cyclone lends its own buffers
-    std::array<dds_sample_info_t, kBatch> infos{};
-    const dds_return_t n = dds_take(command_reader_, samples.data(), infos.data(), kBatch, kBatch);
-    if (n <= 0) return;
-    const auto taken = static_cast<std::size_t>(n);
-    for (std::size_t i = 0; i < taken; ++i) {
-      if (infos[i].valid_data)
-        Handle(static_cast<const std_msgs_msg_dds__Int32_*>(samples[i])->data, port);
+  dds::TakeAll<std_msgs_msg_dds__Int32_>(command_reader_, [&](const auto& sample, const auto&) {
+    if (accept_commands_) {
+      Handle(sample.data, port);
+    } else {
+      Refuse(sample.data);
     }
-    static_cast<void>(dds_return_loan(command_reader_, samples.data(), n));
-    if (taken < kBatch) return;
+  });
+}
+
+// Once per run: a sender that repeats must not flood stderr, and one line says all there is.
+void DdsSink::Refuse(std::int32_t code) noexcept {
+  if (commands_refused_++ > 0) return;
+  const std::optional<RemoteCommand> command = runtime::RemoteCommandOf(code);
+  std::array<char, 32> what{};  // no allocation: this function is noexcept
+  if (command) {
+    std::snprintf(what.data(), what.size(), "%s", runtime::ToString(*command));
+  } else {
+    std::snprintf(what.data(), what.size(), "command code %d", static_cast<int>(code));
   }
+  std::fprintf(stderr,
+               "hiltwin: ignored %s on %s: this task was started without --accept-commands, so "
+               "it takes no commands from DDS domain %u, where any participant could send "
+               "them (docs/telemetry.md, \"Who may command a task\"); further ones are ignored "
+               "without a word\n",
+               what.data(), command_topic_.c_str(), static_cast<unsigned>(domain_));
+}
+
+// Another task's timing writer under our namespace: its topics and ours mix, and a command to
+// the namespace reaches both. Taking the new discovery samples costs one call per record.
+void DdsSink::WatchNamespace() noexcept {
+  if (publications_ <= 0) return;
+  try {
+    std::optional<std::string> other;  // its user data
+    dds::TakeAll<dds_builtintopic_endpoint_t>(publications_, [&](const auto& ep, const auto&) {
+      if (other || ep.topic_name == nullptr || timing_topic_ != ep.topic_name) return;
+      if (std::memcmp(&ep.participant_key, &own_guid_, sizeof(own_guid_)) == 0) return;  // ours
+      other = dds::UserDataOf(ep.qos);
+    });
+    if (!other) return;
+    const std::string who = WhoOf(*other);
+    const std::string by = who.empty() ? "" : " (" + who + ")";
+    std::fprintf(stderr,
+                 "hiltwin: warning: another task already publishes %s on DDS domain %u%s: the "
+                 "two tasks' topics mix and a command to %s reaches both; give each task its own "
+                 "--namespace\n",
+                 timing_topic_.c_str(), static_cast<unsigned>(domain_), by.c_str(), ns_.c_str());
+  } catch (...) {  // out of memory: no warning, and the watch ends (below)
+  }
+  static_cast<void>(dds_delete(publications_));
+  publications_ = 0;
 }
 
 // One stderr line per command, accepted or not: this runs on the telemetry thread, where
@@ -220,7 +300,7 @@ std::string DdsSink::Describe() const {
 }  // namespace
 
 std::shared_ptr<runtime::TelemetrySink> MakeDdsSink(const DdsEndpoint& endpoint) {
-  return std::make_shared<DdsSink>(endpoint.domain);
+  return std::make_shared<DdsSink>(endpoint);
 }
 
 }  // namespace hiltwin::telemetry

@@ -106,6 +106,13 @@ WebEndpoint ParseWebSpec(const std::string& spec) {
   return endpoint;
 }
 
+void CheckAcceptCommands(const TelemetryOptions& options) {
+  if (options.accept_commands && ParseDdsSpecs(options.specs).empty()) {
+    Bad("--accept-commands: commands come over DDS only; add --telemetry dds[:DOMAIN], or drop "
+        "--accept-commands");
+  }
+}
+
 void CheckNamespace(const std::string& ns) {
   if (ns.empty()) Bad("--namespace: empty; give a name such as bench1 or lab/bench1");
   if (ns.size() > kMaxNamespaceChars) {
@@ -131,7 +138,9 @@ void CheckNamespace(const std::string& ns) {
 
 runtime::TelemetryConfig MakeTelemetryConfig(const TelemetryOptions& options) {
   runtime::TelemetryConfig config;
-  const std::vector<DdsEndpoint> dds = ParseDdsSpecs(options.specs);
+  CheckAcceptCommands(options);
+  std::vector<DdsEndpoint> dds = ParseDdsSpecs(options.specs);
+  for (DdsEndpoint& endpoint : dds) endpoint.accept_commands = options.accept_commands;
   const std::vector<UdpEndpoint> udp = ParseUdpSpecs(options.specs);
   std::optional<WebEndpoint> web;
   if (!options.web.empty()) web = ParseWebSpec(options.web);

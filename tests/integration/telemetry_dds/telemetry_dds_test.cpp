@@ -9,9 +9,11 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -50,11 +52,13 @@ class TelemetryDds : public ::testing::Test {
     return "t" + std::to_string(getpid()) + "/" + leaf;
   }
 
-  // `hiltwin run` publishing on `domain` under `ns`, with its log and report in the test dir.
+  // `hiltwin run` publishing on `domain` under `ns`, with its log and report in the test dir
+  // (named after the namespace's last part, or `tag`).
   [[nodiscard]] std::vector<std::string> Twin(std::uint32_t domain, const std::string& ns,
                                               const std::string& duration_s,
-                                              const std::string& input = "openloop") const {
-    const std::string tag = ns.substr(ns.find('/') + 1);
+                                              const std::string& input = "openloop",
+                                              std::string tag = "") const {
+    if (tag.empty()) tag = ns.substr(ns.find('/') + 1);
     return {HILTWIN_BINARY,
             "run",
             "--no-progress",
@@ -243,7 +247,9 @@ TEST_F(TelemetryDds, TwoTwinsOnOneDomainDoNotMixAndTheMonitorListsBoth) {
 TEST_F(TelemetryDds, MonitorCommandStopStopsATwinAsSigtermWould) {
   constexpr std::uint32_t kDomain = 222;
   const std::string ns = Ns("twin");
-  Process twin = hiltwin::test::Spawn(Twin(kDomain, ns, "60"), Path("twin.out"));
+  std::vector<std::string> argv = Twin(kDomain, ns, "60");
+  argv.emplace_back("--accept-commands");
+  Process twin = hiltwin::test::Spawn(argv, Path("twin.out"));
   const std::string domain = std::to_string(kDomain);
 
   // A wrong namespace is a usage error that names the namespaces that are there.
@@ -273,6 +279,104 @@ TEST_F(TelemetryDds, MonitorCommandStopStopsATwinAsSigtermWould) {
   EXPECT_NE(ReadText(Path("twin.out.err")).find("STOP received on rt/" + ns + "/command"),
             std::string::npos)
       << ReadText(Path("twin.out.err"));
+}
+
+// Any participant on the domain could stop a task: now a task takes commands only when started
+// with --accept-commands. Without it the STOP is refused where it was sent (exit 2 naming the
+// flag) and where it arrived (one line on the task's stderr), and the run goes on to its end.
+TEST_F(TelemetryDds, WithoutAcceptCommandsAStopIsRefusedAndTheRunGoesOn) {
+  constexpr std::uint32_t kDomain = 223;
+  const std::string ns = Ns("twin");
+  Process twin = hiltwin::test::Spawn(Twin(kDomain, ns, "3"), Path("twin.out"));
+  const auto stop = hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--domain",
+                                        std::to_string(kDomain), "--command", ns, "stop", "--wait",
+                                        "10"});
+  EXPECT_EQ(stop.exit_code, 2) << stop.out << stop.err;
+  EXPECT_NE(stop.err.find("the task refused STOP"), std::string::npos) << stop.err;
+  EXPECT_NE(stop.err.find("--accept-commands"), std::string::npos) << stop.err;
+  EXPECT_EQ(stop.out.find("delivered"), std::string::npos) << stop.out;
+
+  ExpectCleanExit(twin, "twin");
+  const Json report = Json::parse(ReadText(Path("twin.json")));
+  EXPECT_NE(report["stop_reason"], "stop_requested");
+  EXPECT_EQ(report["cycles_run"], report["cycles_planned"]) << "the run went on to its end";
+  const std::string err = ReadText(Path("twin.out.err"));
+  EXPECT_NE(err.find("hiltwin: ignored STOP on rt/" + ns + "/command"), std::string::npos) << err;
+  EXPECT_EQ(err.find("STOP received"), std::string::npos) << err;
+}
+
+// Two tasks under one namespace mix their topics, and a command to it reaches both: the task
+// that starts beside another one with its namespace says so at start, and so does the other.
+TEST_F(TelemetryDds, ATaskStartedOnANamespaceInUseIsWarnedAtStart) {
+  constexpr std::uint32_t kDomain = 224;
+  const std::string ns = Ns("twin");
+  Process first = hiltwin::test::Spawn(Twin(kDomain, ns, "3", "openloop", "first"),
+                                       Path("first.out"));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (ReadText(Path("first.out")).find("telemetry: ") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {  // its sink is open
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  Process second = hiltwin::test::Spawn(Twin(kDomain, ns, "1", "openloop", "second"),
+                                        Path("second.out"));
+  ExpectCleanExit(second, "second");
+  ExpectCleanExit(first, "first");
+  const std::string warning = "warning: another task already publishes rt/" + ns +
+                              "/timing on DDS domain " + std::to_string(kDomain);
+  for (const std::string name : {"second", "first"}) {
+    const std::string err = ReadText(Path(name + ".out.err"));
+    EXPECT_NE(err.find(warning), std::string::npos) << name << ": " << err;
+    EXPECT_NE(err.find("give each task its own --namespace"), std::string::npos) << err;
+  }
+}
+
+// The command lines of `parent`'s children, arguments joined by spaces (from /proc).
+std::vector<std::string> ChildCommandLines(pid_t parent) {
+  std::vector<std::string> lines;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string pid = entry.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat_file(entry.path() / "stat");
+    std::string stat;
+    std::getline(stat_file, stat);
+    const std::size_t after_name = stat.rfind(')');  // the name may hold spaces and ')'
+    if (after_name == std::string::npos) continue;
+    std::istringstream fields(stat.substr(after_name + 1));
+    std::string state;
+    pid_t ppid = 0;
+    if (!(fields >> state >> ppid) || ppid != parent) continue;
+    std::ifstream cmdline(entry.path() / "cmdline");
+    std::string line{std::istreambuf_iterator<char>(cmdline), std::istreambuf_iterator<char>()};
+    std::replace(line.begin(), line.end(), '\0', ' ');
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+// `hil --accept-commands` passes the flag to its own two processes, and only when asked. (What
+// the flag then does is the run tests' above; a pair's wire is not what is tested here.)
+TEST_F(TelemetryDds, HilPassesAcceptCommandsToItsPairOnlyWhenAsked) {
+  const std::string domain = "dds:225";
+  for (const bool asked : {true, false}) {
+    SCOPED_TRACE(asked ? "asked" : "not asked");
+    std::vector<std::string> argv = {HILTWIN_BINARY, "hil",         "--duration", "30",
+                                     "--telemetry",  domain,        "--namespace", Ns("hil")};
+    if (asked) argv.emplace_back("--accept-commands");
+    Process hil = hiltwin::test::Spawn(argv, Path("hil.out"));
+    std::vector<std::string> children;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (children.size() < 2 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      children = ChildCommandLines(hil.pid());
+    }
+    static_cast<void>(hil.Kill(SIGTERM));  // hil stops both sides
+    ASSERT_EQ(children.size(), 2u) << ReadText(Path("hil.out"));
+    for (const std::string& line : children) {
+      EXPECT_TRUE(line.find(" run ") != std::string::npos ||
+                  line.find(" ecs ") != std::string::npos) << line;
+      EXPECT_EQ(line.find(" --accept-commands") != std::string::npos, asked) << line;
+    }
+  }
 }
 
 }  // namespace

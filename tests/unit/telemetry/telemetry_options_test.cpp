@@ -90,6 +90,21 @@ TEST(TelemetryOptions, NoFlagMeansNoSinksAndNothingChecked) {
   EXPECT_EQ(config.ns, "twin");
 }
 
+TEST(TelemetryOptions, AcceptCommandsNeedsADdsSpec) {
+  TelemetryOptions options;
+  options.ns = "twin";
+  options.accept_commands = true;
+  options.specs = {"udp"};
+  const std::string why = Refusal([&] { CheckAcceptCommands(options); });
+  EXPECT_NE(why.find("--accept-commands"), std::string::npos) << why;
+  EXPECT_NE(why.find("--telemetry dds"), std::string::npos) << why;
+  EXPECT_NE(Refusal([&] { static_cast<void>(MakeTelemetryConfig(options)); })
+                .find("--accept-commands"),
+            std::string::npos);
+  options.specs = {"udp", "dds:3"};
+  EXPECT_NO_THROW(CheckAcceptCommands(options));
+}
+
 TEST(RecordJson, HasEveryDocumentedKeyAndNullForADistanceThatCannotFail) {
   runtime::TelemetryRecord r;
   r.ns = "twin";

@@ -97,7 +97,7 @@ TEST_F(DdsMonitorTest, ListsEveryTaskWithItsLatestRecord) {
 TEST_F(DdsMonitorTest, SendsACommandToOneTask) {
   constexpr std::uint32_t kDomain = 208;
   const std::string ns = test::UniqueNamespace("twin");
-  const auto sink = MakeDdsSink({kDomain});
+  const auto sink = MakeDdsSink({kDomain, true});  // --accept-commands
   sink->Open(runtime::TelemetryShape{}, ns);
   DdsMonitor monitor(kDomain);
   ::testing::internal::CaptureStderr();
@@ -112,6 +112,25 @@ TEST_F(DdsMonitorTest, SendsACommandToOneTask) {
   }));
   ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(seen, std::vector<RemoteCommand>{RemoteCommand::kStop});
+}
+
+// The task's command reader says in its user data whether it takes commands, so the sender
+// learns of a refusal at once, not from the task's stderr on another machine.
+TEST_F(DdsMonitorTest, ACommandToATaskWithoutAcceptCommandsIsReportedRefused) {
+  constexpr std::uint32_t kDomain = 212;
+  const std::string ns = test::UniqueNamespace("twin");
+  const auto sink = MakeDdsSink({kDomain});  // as started without --accept-commands
+  sink->Open(runtime::TelemetryShape{}, ns);
+  DdsMonitor monitor(kDomain);
+  ::testing::internal::CaptureStderr();
+  const std::string why = monitor.SendCommand(ns, RemoteCommand::kStop, 10.0);
+  bool offered = false;
+  sink->PollCommands([&](RemoteCommand, std::string&) { return offered = true; });
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(why.find("the task refused STOP"), std::string::npos) << why;
+  EXPECT_NE(why.find("--accept-commands"), std::string::npos) << why;
+  EXPECT_FALSE(offered);
+  EXPECT_NE(err.find("ignored STOP"), std::string::npos) << "the task says so too: " << err;
 }
 
 TEST_F(DdsMonitorTest, ACommandToNobodyTimesOutWithAReason) {

@@ -2,6 +2,7 @@
 // the test's own, and what it does with commands written on rt/<ns>/command.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -161,12 +162,14 @@ TEST_F(DdsSinkTest, TimingCarriesDistanceVerdictAndFinalToALateReader) {
   EXPECT_TRUE(timing.final);
 }
 
-// Writes `codes` on rt/<ns>/command and polls the sink until the port was offered `offers`
-// commands or 5 s passed; returns what the port took.
+// Writes `codes` on rt/<ns>/command to a sink that takes commands when `accept`
+// (--accept-commands), waits until its reader has them all, and polls the sink until the port
+// was offered `offers` commands or 5 s passed; returns what the port took.
 std::vector<RemoteCommand> SendAndPoll(std::uint32_t domain, const std::vector<int>& codes,
-                                       std::size_t offers, const runtime::CommandPort& refuse) {
+                                       std::size_t offers, const runtime::CommandPort& refuse,
+                                       bool accept = true) {
   const std::string ns = test::UniqueNamespace("cmd");
-  const auto sink = MakeDdsSink({domain});
+  const auto sink = MakeDdsSink({domain, accept});
   sink->Open(TwinShape(), ns);
   test::Peer peer(domain);
   const dds_entity_t writer = peer.Writer(&std_msgs_msg_dds__Int32__desc, "rt/" + ns + "/command");
@@ -175,6 +178,7 @@ std::vector<RemoteCommand> SendAndPoll(std::uint32_t domain, const std::vector<i
     const std_msgs_msg_dds__Int32_ sample{code};
     EXPECT_EQ(dds_write(writer, &sample), DDS_RETCODE_OK);
   }
+  EXPECT_EQ(dds_wait_for_acks(writer, DDS_SECS(5)), DDS_RETCODE_OK);
   std::vector<RemoteCommand> seen;
   std::size_t offered = 0;
   const runtime::CommandPort port = [&](RemoteCommand c, std::string& why) {
@@ -189,6 +193,56 @@ std::vector<RemoteCommand> SendAndPoll(std::uint32_t domain, const std::vector<i
   });
   sink->PollCommands(port);  // nothing more may arrive
   return seen;
+}
+
+// Any participant on the domain could stop or pause a task. Without --accept-commands the
+// task takes none, known codes or not, and says so once on stderr: whoever watches it learns
+// that someone tried, and how to allow it.
+TEST_F(DdsSinkTest, WithoutAcceptCommandsNothingReachesThePortAndTheTaskSaysSoOnce) {
+  ::testing::internal::CaptureStderr();
+  const auto seen = SendAndPoll(210, {3, 5, 42}, 0, {}, false);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_TRUE(seen.empty());
+  EXPECT_NE(err.find("hiltwin: ignored STOP on rt/"), std::string::npos) << err;
+  EXPECT_NE(err.find("started without --accept-commands"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << "once: " << err;
+}
+
+TEST_F(DdsSinkTest, TwoTasksWithOneNamespaceAreEachWarnedOnce) {
+  constexpr std::uint32_t kDomain = 211;
+  const std::string shared = test::UniqueNamespace("shared");
+  const std::string alone = test::UniqueNamespace("alone");
+  const test::StderrFile err;
+  const auto first = MakeDdsSink({kDomain});
+  first->Open(TwinShape(), shared);
+  const auto other = MakeDdsSink({kDomain});
+  other->Open(TwinShape(), alone);
+  const auto second = MakeDdsSink({kDomain});
+  second->Open(TwinShape(), shared);
+  const auto warnings = [&] {
+    const std::string text = err.Text();
+    std::size_t count = 0;
+    for (std::size_t at = text.find("warning: another task"); at != std::string::npos;
+         at = text.find("warning: another task", at + 1)) {
+      ++count;
+    }
+    return count;
+  };
+  const auto poll_all = [&] {  // as each task's telemetry thread does, once per record
+    for (const auto& sink : {first, other, second}) {
+      sink->PollCommands([](RemoteCommand, std::string&) { return true; });
+    }
+  };
+  EXPECT_TRUE(WaitFor([&] {
+    poll_all();
+    return warnings() >= 2;
+  })) << err.Text();
+  for (int i = 0; i < 20; ++i) poll_all();
+  const std::string text = err.Text();
+  EXPECT_EQ(warnings(), 2u) << "each of the two, once: " << text;
+  EXPECT_NE(text.find("rt/" + shared + "/timing on DDS domain 211"), std::string::npos) << text;
+  EXPECT_NE(text.find("give each task its own --namespace"), std::string::npos) << text;
+  EXPECT_EQ(text.find(alone), std::string::npos) << text;
 }
 
 TEST_F(DdsSinkTest, CommandsReachThePortInOrder) {

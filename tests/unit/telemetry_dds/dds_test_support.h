@@ -7,7 +7,11 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
+#include <fstream>
 #include <functional>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -90,6 +94,38 @@ bool TakeOne(dds_entity_t reader, Copy&& copy) {
   dds_return_loan(reader, &sample, n);
   return valid;
 }
+
+/// Sends this process's stderr to a file for the object's life; unlike gtest's CaptureStderr,
+/// what was written so far can be read at any time (to wait for a line).
+class StderrFile {
+ public:
+  StderrFile() : path_("/tmp/hiltwin-stderr-XXXXXX"), saved_(::dup(STDERR_FILENO)) {
+    std::fflush(stderr);
+    const int fd = ::mkstemp(path_.data());
+    if (fd < 0 || saved_ < 0 || ::dup2(fd, STDERR_FILENO) < 0) {
+      throw std::runtime_error("cannot send stderr to a file");
+    }
+    ::close(fd);
+  }
+  ~StderrFile() {
+    std::fflush(stderr);
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+    ::unlink(path_.c_str());
+  }
+  StderrFile(const StderrFile&) = delete;
+  StderrFile& operator=(const StderrFile&) = delete;
+
+  [[nodiscard]] std::string Text() const {
+    std::fflush(stderr);
+    std::ifstream in(path_);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+ private:
+  std::string path_;
+  int saved_;
+};
 
 /// True once `writer` has a matched reader.
 inline bool Matched(dds_entity_t writer) {

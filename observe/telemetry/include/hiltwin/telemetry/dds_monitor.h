@@ -47,7 +47,9 @@ class DdsMonitor {
 
   /// Sends `command` to rt/<ns>/command once a reader there is matched, waiting up to
   /// `timeout_s`, then waits up to 2 s for the reader's acknowledgement. Returns "" when
-  /// delivered, else why not (for the message; exit 2).
+  /// delivered to a task that takes commands, else why not (for the message; exit 2): no
+  /// reader, no acknowledgement, or a task started without --accept-commands (its reader's
+  /// user data says so; the command is still sent, so the task reports the attempt).
   [[nodiscard]] std::string SendCommand(const std::string& ns, runtime::RemoteCommand command,
                                         double timeout_s);
 

@@ -17,8 +17,12 @@ namespace hiltwin::telemetry {
 /// `--telemetry dds[:DOMAIN]`: publishes rt/<ns>/pose (geometry_msgs::msg::dds_::Pose2D_),
 /// rt/<ns>/joint_states (sensor_msgs::msg::dds_::JointState_), rt/<ns>/timing
 /// (hiltwin::msg::dds_::Timing_) and reads rt/<ns>/command (std_msgs::msg::dds_::Int32_).
+/// Warns once on stderr when another task publishes under the same namespace.
 struct DdsEndpoint {
   std::uint32_t domain = 0;  ///< DDS domain id (0..232, as ROS_DOMAIN_ID)
+  /// --accept-commands: commands on rt/<ns>/command reach the session. Off, the sink refuses
+  /// them (it says so once on stderr, and the sender sees it in the reader's user data).
+  bool accept_commands = false;
 };
 /// Throws std::invalid_argument (bad domain) or std::runtime_error (Cyclone refused).
 [[nodiscard]] std::shared_ptr<runtime::TelemetrySink> MakeDdsSink(const DdsEndpoint& endpoint);
@@ -46,12 +50,16 @@ struct TelemetryOptions {
   std::string web;                 ///< --web ADDR:PORT, "" for none (the flag's bare form
                                    ///< gives "127.0.0.1:8080")
   double rate_hz = 50.0;           ///< --telemetry-rate
+  bool accept_commands = false;    ///< --accept-commands (DDS only)
 };
 
 /// Parses the specs without opening anything; throws std::invalid_argument naming the flag.
 [[nodiscard]] std::vector<DdsEndpoint> ParseDdsSpecs(const std::vector<std::string>& specs);
 [[nodiscard]] std::vector<UdpEndpoint> ParseUdpSpecs(const std::vector<std::string>& specs);
 [[nodiscard]] WebEndpoint ParseWebSpec(const std::string& spec);
+/// --accept-commands applies to DDS only: throws std::invalid_argument naming the flag when it
+/// is given without a `dds` spec.
+void CheckAcceptCommands(const TelemetryOptions& options);
 /// A ROS 2 namespace without its leading slash: [A-Za-z_][A-Za-z0-9_]* tokens joined by '/'.
 /// Throws std::invalid_argument naming --namespace and the offending character.
 void CheckNamespace(const std::string& ns);
