@@ -6,9 +6,10 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <system_error>
+#include <utility>
+
+#include "hiltwin/tracing/line_reader.h"
 
 namespace hiltwin::analysis {
 namespace {
@@ -29,11 +30,12 @@ struct Field {
 };
 
 // Splits one line; a field in double quotes may hold the separator and "" for a quote
-// (20-sim quotes its header names, e.g. "model\position").
+// (20-sim quotes its header names, e.g. "model\position"). Stops after kMaxCsvCells + 1 fields:
+// one more than the cap is enough to refuse the row.
 std::vector<Field> SplitLine(std::string_view line, char separator) {
   std::vector<Field> fields;
   std::size_t i = 0;
-  while (true) {
+  while (fields.size() <= kMaxCsvCells) {
     Field field;
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t') && line[i] != separator) ++i;
     if (i < line.size() && line[i] == '"') {
@@ -201,6 +203,61 @@ void CheckRowCount(const CsvTable& table, std::string_view purpose) {
   }
 }
 
+// Where a line is refused for its length: its text is not kept, so only the line is named.
+[[noreturn]] void ThrowLineTooLong(const std::string& path, std::size_t line_no) {
+  throw InputError(path + ":" + std::to_string(line_no) + ": the line is longer than " +
+                   std::to_string(kMaxCsvLineBytes) +
+                   " bytes, the most hiltwin reads as one CSV row; a row holds a time and its "
+                   "values: check that the file is a CSV file with one row per line");
+}
+
+tracing::LineReader OpenLines(const std::string& path) {
+  try {
+    return {path, kMaxCsvLineBytes};
+  } catch (const std::system_error& error) {
+    throw InputError(path + ": cannot open for reading (" + error.code().message() +
+                     "); check the path and permissions");
+  }
+}
+
+// Takes a file's lines one at a time, so a file need not be held whole.
+class CsvBuilder {
+ public:
+  CsvBuilder(const std::string& path, const CsvRules& rules) : rules_(rules) {
+    table_.path = path;
+  }
+
+  // One line without its line break; `line_no` is 1-based.
+  void Add(std::string_view line, std::size_t line_no) {
+    // Excel and Windows editors save "CSV UTF-8" with a byte order mark, which would otherwise
+    // become part of the first header name (or make the first time cell "not a number").
+    constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+    if (line_no == 1 && line.starts_with(kUtf8Bom)) line.remove_prefix(kUtf8Bom.size());
+    line = Trim(line);
+    if (line.empty() || line.front() == '#') return;
+    if (table_.columns.empty()) separator_ = DetectSeparator(line);
+    const std::vector<Field> fields = SplitLine(line, separator_);
+    if (fields.size() > kMaxCsvCells) {
+      throw InputError(CsvLocation(table_.path, line_no, kMaxCsvCells + 1) +
+                       ": the row has more than " + std::to_string(kMaxCsvCells) +
+                       " cells, the most hiltwin reads in one CSV row; keep the time column "
+                       "and the columns you need");
+    }
+    if (table_.columns.empty() && ReadLayout(table_, fields, line_no, rules_)) return;
+    ReadRow(table_, fields, line_no, rules_.time_order);
+  }
+
+  CsvTable Finish() {
+    CheckRowCount(table_, rules_.purpose);
+    return std::move(table_);
+  }
+
+ private:
+  const CsvRules& rules_;
+  CsvTable table_;
+  char separator_ = ',';
+};
+
 }  // namespace
 
 std::string CsvLocation(std::string_view path, std::size_t line, std::size_t column) {
@@ -224,40 +281,39 @@ std::string CsvTable::ColumnLabel(std::size_t column) const {
 }
 
 CsvTable ParseCsv(std::string_view text, const std::string& path, const CsvRules& rules) {
-  // Excel and Windows editors save "CSV UTF-8" with a byte order mark, which would otherwise
-  // become part of the first header name (or make the first time cell "not a number").
-  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
-  if (text.starts_with(kUtf8Bom)) text.remove_prefix(kUtf8Bom.size());
-  CsvTable table;
-  table.path = path;
-  char separator = ',';
+  CsvBuilder builder(path, rules);
   std::size_t line_no = 0;
   for (std::size_t pos = 0; pos <= text.size();) {
     std::size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
-    const std::string_view line = Trim(text.substr(pos, end - pos));
+    std::string_view line = text.substr(pos, end - pos);
     pos = end + 1;
     ++line_no;
-    if (line.empty() || line.front() == '#') continue;
-    if (table.columns.empty()) {
-      separator = DetectSeparator(line);
-      if (ReadLayout(table, SplitLine(line, separator), line_no, rules)) continue;
-    }
-    ReadRow(table, SplitLine(line, separator), line_no, rules.time_order);
+    if (line.ends_with('\r')) line.remove_suffix(1);
+    if (line.size() > kMaxCsvLineBytes) ThrowLineTooLong(path, line_no);
+    builder.Add(line, line_no);
   }
-  CheckRowCount(table, rules.purpose);
-  return table;
+  return builder.Finish();
 }
 
 CsvTable ReadCsv(const std::string& path, const CsvRules& rules) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    throw InputError(path + ": cannot open for reading (" + std::strerror(errno) +
-                     "); check the path and permissions");
+  tracing::LineReader lines = OpenLines(path);
+  CsvBuilder builder(path, rules);
+  std::string_view line;
+  try {
+    for (;;) {
+      const tracing::LineReader::Status status = lines.Next(line);
+      if (status == tracing::LineReader::Status::kEnd) break;
+      if (status == tracing::LineReader::Status::kTooLong) {
+        ThrowLineTooLong(path, lines.line_number());
+      }
+      builder.Add(line, lines.line_number());
+    }
+  } catch (const std::system_error& error) {
+    throw InputError(path + ":" + std::to_string(lines.line_number() + 1) + ": cannot read (" +
+                     error.code().message() + "); check that it is a readable file");
   }
-  std::ostringstream buffer;
-  buffer << file.rdbuf();
-  return ParseCsv(buffer.str(), path, rules);
+  return builder.Finish();
 }
 
 std::size_t ResolveColumn(const CsvTable& table, const std::string& selector,

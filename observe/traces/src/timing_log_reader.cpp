@@ -1,28 +1,26 @@
 // ReadTimingLog: the timing log `hiltwin run --timing-log FILE` writes
 // (tracing/timing_log_format.h). A dedicated line parser rather than ReadCsv: a 20 kHz minute is
-// 1.2 M rows, read here in one linear pass (large chunks, std::from_chars, no per-row
-// allocation) straight into the TimingTrace, where ReadCsv would hold every cell as a double.
+// 1.2 M rows, read here in one linear pass (the shared line reader's large chunks,
+// std::from_chars, no per-row allocation) straight into the TimingTrace, where ReadCsv would
+// hold every cell as a double.
 //
 // Messages start "FILE:LINE" and, for a cell, "FILE:LINE:COL" with COL counting CSV fields
 // from 1, as csv.h does.
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
-#include "hiltwin/kernel_glue/os_calls.h"
 #include "hiltwin/traces/trace_readers.h"
 #include "hiltwin/tracing/csv.h"
+#include "hiltwin/tracing/line_reader.h"
 #include "hiltwin/tracing/timing_log_format.h"
 #include "trace_reading.h"
 
@@ -44,7 +42,6 @@ enum Column : std::size_t {
   kJudged
 };
 static_assert(kJudged == kFieldCount, "one Column per timing-log field");
-constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
 /// Rows reserved up front at most, whatever planned_cycles says (a hand-edited file may lie).
 constexpr std::uint64_t kMaxReservedRows = std::uint64_t{1} << 24;
 
@@ -58,84 +55,52 @@ const char* ColumnName(std::size_t column) {
   return column == kTimeS ? "time_s" : tracing::kTimingLogFields[column - kK];
 }
 
-/// A file read line by line through one large buffer.
+/// The file's lines through the shared bounded reader (tracing/line_reader.h): a line longer
+/// than the CSV reader's cap is refused there, so a file without line breaks is not read whole.
 class TimingLogLines {
  public:
-  explicit TimingLogLines(const std::string& path) : path_(path), buffer_(kChunkBytes) {
-    file_.reset(std::fopen(path.c_str(), "rbe"));
-    if (!file_) {
-      const int error = errno;
-      throw TraceReadError("cannot open the timing log " + path + ": " +
-                           kernel_glue::ErrnoText(error));
-    }
-  }
+  explicit TimingLogLines(const std::string& path) : path_(path), lines_(Open(path)) {}
 
   /// The next line, without its '\n' (nor a '\r' before it); false at the end of the file.
   /// `terminated` is false for a last line the file ends inside of.
   bool Next(std::string_view& line, bool& terminated) {
-    for (;;) {
-      const char* first = buffer_.data() + begin_;
-      const void* newline = std::memchr(first, '\n', end_ - begin_);
-      if (newline != nullptr) {
-        line = std::string_view(
-            first, static_cast<std::size_t>(static_cast<const char*>(newline) - first));
-        begin_ += line.size() + 1;
-        terminated = true;
-        break;
-      }
-      if (!Fill()) {
-        if (begin_ == end_) return false;
-        line = std::string_view(buffer_.data() + begin_, end_ - begin_);
-        begin_ = end_;
-        terminated = false;
-        break;
-      }
+    const tracing::LineReader::Status status =
+        Guard([&] { return lines_.Next(line, terminated); });
+    if (status == tracing::LineReader::Status::kTooLong) {
+      throw TraceReadError(path_ + ":" + std::to_string(lines_.line_number()) +
+                           ": the line is longer than " + std::to_string(kMaxCsvLineBytes) +
+                           " bytes, the most hiltwin reads as one CSV row; a timing log's rows "
+                           "are under 200 bytes: this is not a timing log `hiltwin run "
+                           "--timing-log FILE` wrote");
     }
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    ++line_number_;
-    return true;
+    return status == tracing::LineReader::Status::kLine;
   }
 
   /// Whether nothing follows the last line returned.
-  bool AtEnd() { return begin_ == end_ && !Fill(); }
+  bool AtEnd() { return Guard([&] { return lines_.AtEnd(); }); }
 
-  [[nodiscard]] std::size_t line_number() const noexcept { return line_number_; }
+  [[nodiscard]] std::size_t line_number() const noexcept { return lines_.line_number(); }
 
  private:
-  /// Reads more after what is left of the buffer; false at the end of the file.
-  bool Fill() {
-    if (eof_) return false;
-    if (begin_ > 0) {
-      std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
-      end_ -= begin_;
-      begin_ = 0;
+  static tracing::LineReader Open(const std::string& path) {
+    try {
+      return {path, kMaxCsvLineBytes};
+    } catch (const std::system_error& error) {
+      throw TraceReadError("cannot open the timing log " + path + ": " + error.code().message());
     }
-    if (end_ == buffer_.size()) buffer_.resize(buffer_.size() * 2);  // one very long line
-    const std::size_t got =
-        std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_.get());
-    if (got == 0) {
-      if (std::ferror(file_.get()) != 0) {
-        const int error = errno;
-        throw TraceReadError(path_ + ":" + std::to_string(line_number_ + 1) +
-                             ": cannot read: " + kernel_glue::ErrnoText(error));
-      }
-      eof_ = true;
-      return false;
+  }
+  template <typename Read>
+  std::invoke_result_t<Read> Guard(Read read) {
+    try {
+      return read();
+    } catch (const std::system_error& error) {
+      throw TraceReadError(path_ + ":" + std::to_string(lines_.line_number() + 1) +
+                           ": cannot read: " + error.code().message());
     }
-    end_ += got;
-    return true;
   }
 
-  struct FileClose {
-    void operator()(std::FILE* file) const noexcept { std::fclose(file); }
-  };
   const std::string& path_;
-  std::unique_ptr<std::FILE, FileClose> file_;
-  std::vector<char> buffer_;
-  std::size_t begin_ = 0;
-  std::size_t end_ = 0;
-  bool eof_ = false;
-  std::size_t line_number_ = 0;
+  tracing::LineReader lines_;
 };
 
 /// Reads one timing log into a TimingTrace; every method throws TraceReadError with the place.

@@ -2,7 +2,10 @@
 #include "hiltwin/tracing/csv.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace hiltwin::analysis {
@@ -146,6 +149,71 @@ TEST(Csv, UnknownOrTimeColumnIsRefusedWithTheChoices) {
   EXPECT_THROW((void)ResolveColumn(t, "time", "--sim"), InputError);
   EXPECT_THROW((void)ResolveColumn(t, "4", "--sim"), InputError);
   EXPECT_THROW((void)ResolveColumn(t, "0", "--sim"), InputError);
+}
+
+// A file of the test's own, removed at the end.
+class CsvFile : public ::testing::Test {
+ protected:
+  void TearDown() override { std::filesystem::remove(path_); }
+  [[nodiscard]] const std::string& Write(const std::string& text) {
+    std::ofstream(path_, std::ios::binary) << text;
+    return path_;
+  }
+  std::string path_ = (std::filesystem::temp_directory_path() /
+                       ("hiltwin_csv_test_" + std::to_string(::getpid()) + ".csv"))
+                          .string();
+};
+
+std::string ReadError(const std::string& path) {
+  try {
+    (void)ReadCsv(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// A line one byte over the cap (a file without line breaks, say) is refused at that line as
+// soon as the cap is passed, from a file and from text alike; a line of exactly the cap is read.
+TEST_F(CsvFile, ALineLongerThanTheCapIsRefusedAtOnceWithItsLine) {
+  const std::size_t cap = kMaxCsvLineBytes;
+  std::string over = "time,a\n0,1\n1,";
+  over += std::string(cap + 1 - 2, '0');  // line 3: "1," and then zeros, cap + 1 bytes
+  over += "\n2,3\n";
+  const std::string expected = ":3: the line is longer than 65536 bytes, the most hiltwin "
+                               "reads as one CSV row";
+  const std::string from_file = ReadError(Write(over));
+  EXPECT_EQ(from_file.rfind(path_ + expected, 0), 0U) << from_file;
+  ExpectError(over, {"in.csv" + expected, "one row per line"});
+  std::string at_cap = "time,a\n0,1\n1,";
+  at_cap += std::string(cap - 2, '0') + "\n";
+  const CsvTable table = ReadCsv(Write(at_cap));
+  EXPECT_EQ(table.rows(), 2U);
+}
+
+// An endless file without a line break (/dev/zero) is refused once the cap is passed: the
+// reader holds one line at most, never the whole file.
+TEST(Csv, AnEndlessLineIsRefusedAfterTheCap) {
+  try {
+    (void)ReadCsv("/dev/zero");
+    ADD_FAILURE() << "/dev/zero read as a CSV";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/dev/zero:1: the line is longer than", 0), 0U)
+        << e.what();
+  }
+}
+
+// More cells in one row than the cap: refused with the line and the cell past the cap.
+TEST(Csv, MoreCellsThanTheCapAreRefused) {
+  std::string header = "time";
+  for (std::size_t c = 1; c < kMaxCsvCells; ++c) header += ",c" + std::to_string(c);
+  std::string zeros = "0";
+  for (std::size_t c = 1; c < kMaxCsvCells; ++c) zeros += ",0";
+  const CsvTable at_cap =
+      ParseCsv(header + "\n" + zeros + "\n1" + zeros.substr(1) + "\n", "w.csv");
+  EXPECT_EQ(at_cap.columns.size(), kMaxCsvCells);
+  ExpectError(header + ",one_more\n" + zeros + ",0\n",
+              {"in.csv:1:1025: the row has more than 1024 cells", "keep the time column"});
 }
 
 TEST(Csv, MissingFileSaysSo) {

@@ -268,5 +268,17 @@ TEST(LoadInputProfile, BuiltInNameFileOrAClearError) {
   EXPECT_THROW((void)LoadCsvProfile("/nonexistent/p.csv"), ProfileError);
 }
 
+// `run --input` on a file without line breaks (here /dev/zero, which never ends) fails at its
+// first line once the CSV reader's line cap is passed, as a profile error naming the file.
+TEST(LoadInputProfile, AFileWithoutLineBreaksIsRefusedAtItsFirstLine) {
+  try {
+    (void)LoadCsvProfile("/dev/zero");
+    FAIL();
+  } catch (const ProfileError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind("/dev/zero:1: the line is longer than 65536 bytes", 0), 0U) << message;
+  }
+}
+
 }  // namespace
 }  // namespace hiltwin::app

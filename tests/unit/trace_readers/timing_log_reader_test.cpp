@@ -210,6 +210,14 @@ TEST_F(TimingLogReaderTest, AFileWithoutTheMagicLineIsNotATimingLog) {
   EXPECT_THAT(ErrorOf(empty), HasSubstr("not a hiltwin timing log: " + empty + " is empty"));
 }
 
+// A file without line breaks (/dev/zero never ends) is refused at its first line once the CSV
+// line cap is passed, not read whole.
+TEST_F(TimingLogReaderTest, AFileWithoutLineBreaksIsRefusedAtTheLineCap) {
+  EXPECT_THAT(ErrorOf("/dev/zero"),
+              StartsWith("/dev/zero:1: the line is longer than 65536 bytes, the most hiltwin "
+                         "reads as one CSV row"));
+}
+
 TEST_F(TimingLogReaderTest, PreambleMistakesNameTheirLine) {
   std::string text = kPreamble;
   text.insert(text.find("# deadline_ns"), "# rate_hz=1000\n");

@@ -14,6 +14,13 @@
 
 namespace hiltwin::analysis {
 
+/// The longest line, in bytes without its line break, and the most cells of one row that the
+/// reader takes: far beyond any profile, 20-sim export or hiltwin log (a log row of the RELbot
+/// is about 200 bytes and 20 cells), and small enough that a file without line breaks is refused
+/// after 64 KiB instead of being read whole. docs/credibility.md ("Input") documents both.
+constexpr std::size_t kMaxCsvLineBytes = 65536;
+constexpr std::size_t kMaxCsvCells = 1024;
+
 /// A bad input file, column or option. what() says what was wrong, where (file:line:column or
 /// the option) and what to do; the command line maps it to exit code 2.
 class InputError : public std::runtime_error {
@@ -58,8 +65,9 @@ struct CsvRules {
 /// Reads and checks `path`: every cell a finite number, every row as wide as the header, time
 /// ordered as `rules` asks, at least two rows. Separator ',', ';' or tab (taken from the header
 /// line), quoted header names, a UTF-8 byte order mark, '#' comment lines and blank lines are
-/// accepted; the header is optional unless rules.check_layout asks for one. Throws InputError
-/// naming file, line and column.
+/// accepted; the header is optional unless rules.check_layout asks for one. A line longer than
+/// kMaxCsvLineBytes or a row of more than kMaxCsvCells cells is refused as soon as it is met:
+/// the file is read line by line, never whole. Throws InputError naming file, line and column.
 [[nodiscard]] CsvTable ReadCsv(const std::string& path, const CsvRules& rules = {});
 
 /// As ReadCsv, on text already in memory; `path` only names the source in messages.
