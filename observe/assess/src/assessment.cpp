@@ -158,16 +158,44 @@ Overlap AlignOnOverlap(const Curve& sim, const Curve& exp, Assessment& a) {
   return {first, last};
 }
 
-// A constant experiment makes eps_t zero, and then no time-domain score exists.
+// "FILE:LINE:COL" of sample `i` of `c` (column 0-based; 0 = time).
+std::string Cell(const Curve& c, std::size_t i, std::size_t column) {
+  return i < c.lines.size() ? CsvLocation(c.path, c.lines[i], column + 1) : c.path;
+}
+
+// Times and values beyond kMaxAssessedMagnitude would overflow the squares the scores sum.
+void CheckMagnitudes(const Curve& c, AssessOption option, const char* role) {
+  const auto beyond = [](double v) { return !(std::abs(v) <= kMaxAssessedMagnitude); };
+  for (std::size_t i = 0; i < c.y.size(); ++i) {
+    const bool time = i < c.t_s.size() && beyond(c.t_s[i]);
+    if (!time && !beyond(c.y[i])) continue;
+    throw OptionError(option, Cell(c, i, time ? 0 : c.column) + ": the " + role + " curve (" +
+                                  c.label + ") holds " + (time ? "the time " : "") +
+                                  Num(time ? c.t_s[i] : c.y[i]) + ", beyond +-" +
+                                  Num(kMaxAssessedMagnitude) +
+                                  ", the largest magnitude assess scores (its square leaves "
+                                  "double precision); rescale the column (another unit)");
+  }
+}
+
+// A constant experiment makes eps_t zero, and then no time-domain score exists; one that moves
+// less than kMinAssessedRange squares every error to 0 and would score any simulation 1.
 void RequireMovingExperiment(const Curve& exp, const Overlap& overlap, const Assessment& a) {
   const auto [lo_it, hi_it] = std::minmax_element(a.y_exp.begin(), a.y_exp.end());
+  const std::string where = Lines(exp, overlap.first, overlap.last - 1, exp.column) +
+                            ": the experiment curve (" + exp.label + ") ";
   if (!(*hi_it > *lo_it)) {
     throw OptionError(AssessOption::kExp,
-                      Lines(exp, overlap.first, overlap.last - 1, exp.column) +
-                          ": the experiment curve (" + exp.label + ") is constant (" +
-                          Num(*lo_it) +
+                      where + "is constant (" + Num(*lo_it) +
                           ") over the compared range, so the error threshold eps_t = "
                           "Kp*(max - min) is 0 and no score exists; pick the column that moves");
+  }
+  if (*hi_it - *lo_it < kMinAssessedRange) {
+    throw OptionError(AssessOption::kExp,
+                      where + "moves by only " + Num(*hi_it - *lo_it) +
+                          " over the compared range, less than " + Num(kMinAssessedRange) +
+                          ", the smallest range assess scores (its errors would square to 0); "
+                          "rescale the column (another unit)");
   }
 }
 
@@ -178,10 +206,28 @@ struct GridCurves {
   std::vector<double> exp;
 };
 
-GridCurves OnUniformGrid(const Curve& sim, const Curve& exp, Assessment& a) {
+// The grid a time base that is not uniform is resampled onto must stay within
+// kMaxGridPointsPerSample points per compared sample.
+void CheckGridSize(const Curve& exp, const Overlap& overlap, const Assessment& a) {
+  const double points = std::floor((a.overlap_t1_s - a.overlap_t0_s) / a.grid_step_s) + 1.0;
+  const double most = static_cast<double>(kMaxGridPointsPerSample * a.samples);
+  if (points <= most) return;
+  throw OptionError(AssessOption::kExp,
+                    Lines(exp, overlap.first, overlap.last - 1, 0) +
+                        ": the time base is uneven: a uniform grid at its median step of " +
+                        Num(a.grid_step_s) + " s over [" + Num(a.overlap_t0_s) + ", " +
+                        Num(a.overlap_t1_s) + "] s would hold " + Num(points) +
+                        " samples, more than " + std::to_string(kMaxGridPointsPerSample) +
+                        " per compared sample (" + std::to_string(a.samples) +
+                        "); resample the files onto one step, or remove the rows around the gap");
+}
+
+GridCurves OnUniformGrid(const Curve& sim, const Curve& exp, const Overlap& overlap,
+                         Assessment& a) {
   a.grid_step_s = MedianStep(a.t_s);
   a.uniform_time_base = IsUniform(a.t_s);
   if (a.uniform_time_base) return {a.t_s, a.y_sim, a.y_exp};
+  CheckGridSize(exp, overlap, a);
   GridCurves grid;
   grid.t_s = UniformGrid(a.overlap_t0_s, a.overlap_t1_s, a.grid_step_s);
   grid.sim = InterpolateAt(sim.t_s, sim.y, grid.t_s);
@@ -264,10 +310,11 @@ void ScorePerformanceDomain(const AssessOptions& options, Assessment& a) {
   }
 }
 
-// A constant input excites no frequency. The message names the input samples the
-// interpolation used: from the last one at or before the range's start to the first one at
-// or after its end.
-[[noreturn]] void ThrowConstantInput(const Curve& input, std::span<const double> g, double u) {
+// A constant input excites no frequency, and one that moves less than kMinAssessedRange
+// squares its spectra to 0. The message names the input samples the interpolation used: from
+// the last one at or before the range's start to the first one at or after its end.
+[[noreturn]] void ThrowConstantInput(const Curve& input, std::span<const double> g, double lo,
+                                     double hi) {
   const auto& ut = input.t_s;
   const auto after_start = std::upper_bound(ut.begin(), ut.end(), g.front()) - ut.begin();
   const auto at_end = std::lower_bound(ut.begin(), ut.end(), g.back()) - ut.begin();
@@ -275,10 +322,14 @@ void ScorePerformanceDomain(const AssessOptions& options, Assessment& a) {
   const auto u_last = std::min(static_cast<std::size_t>(at_end), ut.size() - 1);
   throw OptionError(AssessOption::kInput,
                     Lines(input, u_first, u_last, input.column) + ": the input curve (" +
-                        input.label + ") is constant (" + Num(u) +
-                        ") over the compared range [" + Num(g.front()) + ", " +
-                        Num(g.back()) + "] s, so it excites no frequency; give the column "
-                        "that drove both systems");
+                        input.label + ") " +
+                        (hi > lo ? "moves by only " + Num(hi - lo) + ", less than " +
+                                       Num(kMinAssessedRange) + ","
+                                 : "is constant (" + Num(lo) + ")") +
+                        " over the compared range [" + Num(g.front()) + ", " +
+                        Num(g.back()) + "] s, so it excites no frequency" +
+                        (hi > lo ? " assess can score; rescale the column (another unit)"
+                                 : "; give the column that drove both systems"));
 }
 
 // The frequency domain needs the input the two systems were given.
@@ -302,7 +353,7 @@ void ScoreFrequencyDomain(const Curve* input, const GridCurves& grid,
   const std::span<const double> g(grid.t_s.data() + g_first, g_last - g_first);
   const std::vector<double> u = InterpolateAt(input->t_s, input->y, g);
   const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
-  if (!(*uhi > *ulo)) ThrowConstantInput(*input, g, *ulo);
+  if (!(*uhi - *ulo >= kMinAssessedRange)) ThrowConstantInput(*input, g, *ulo, *uhi);
   const std::size_t segment =
       options.welch_segment > 0 ? options.welch_segment : DefaultWelchSegment(g.size());
   if (segment < 8 || segment > g.size()) {
@@ -459,6 +510,9 @@ nlohmann::json CrossChecksJson(const Assessment& a) {
 Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
                   const AssessOptions& options) {
   CheckOptions(options);
+  CheckMagnitudes(sim, AssessOption::kSim, "simulation");
+  CheckMagnitudes(exp, AssessOption::kExp, "experiment");
+  if (input != nullptr) CheckMagnitudes(*input, AssessOption::kInput, "input");
   Assessment a;
   a.options = options;
   a.sim_label = sim.label;
@@ -469,7 +523,7 @@ Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
   const Overlap overlap = AlignOnOverlap(sim, exp, a);
   RequireMovingExperiment(exp, overlap, a);
   a.time = ScoreTimeDomain(a.y_sim, a.y_exp, options.params);
-  const GridCurves grid = OnUniformGrid(sim, exp, a);
+  const GridCurves grid = OnUniformGrid(sim, exp, overlap, a);
   EstimateGridDelay(grid, options, a);
   ScoreCompensated(sim, exp, overlap, options, a);
   ScorePerformanceDomain(options, a);

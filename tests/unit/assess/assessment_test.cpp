@@ -177,6 +177,68 @@ TEST(Assess, ConstantExperimentNamesFileLinesAndColumn) {
   EXPECT_NE(m.find("constant"), std::string::npos) << m;
 }
 
+// Values whose squares leave double precision are refused naming the curve, file, line and
+// column (they gave an internal error, exit 1): a curve value, a time, an input value.
+TEST(Assess, ValuesBeyondTheScoredMagnitudeNameTheirCell) {
+  const Curve sim = MakeCurve("sim", 0.0, 1e-2, 100, 0.0);
+  Curve exp = MakeCurve("exp", 0.0, 1e-2, 100, 0.0);
+  exp.y[40] = -1e308;  // line 42
+  OptionFailure f = OptionErrorOf(sim, exp, AssessOptions{});
+  EXPECT_EQ(f.option, AssessOption::kExp);
+  EXPECT_EQ(f.message.rfind("exp.csv:42:2: the experiment curve (exp) holds -1e+308, beyond "
+                            "+-1e+100, the largest magnitude assess scores",
+                            0),
+            0U)
+      << f.message;
+  EXPECT_NE(f.message.find("rescale the column"), std::string::npos) << f.message;
+  Curve late = MakeCurve("sim", 0.0, 1e-2, 100, 0.0);
+  late.t_s.back() = 1e300;  // a time far beyond the others, line 101
+  f = OptionErrorOf(late, MakeCurve("exp", 0.0, 1e-2, 100, 0.0), AssessOptions{});
+  EXPECT_EQ(f.option, AssessOption::kSim);
+  EXPECT_EQ(f.message.rfind("sim.csv:101:1: the simulation curve (sim) holds the time 1e+300", 0),
+            0U)
+      << f.message;
+  Curve u = MakeCurve("u", 0.0, 1e-2, 100, 0.0);
+  u.y[0] = 1e200;
+  f = OptionErrorOf(sim, MakeCurve("exp", 0.0, 1e-2, 100, 0.0, 0.1), AssessOptions{}, &u);
+  EXPECT_EQ(f.option, AssessOption::kInput);
+  EXPECT_EQ(f.message.rfind("u.csv:2:2: the input curve (u) holds 1e+200", 0), 0U) << f.message;
+}
+
+// An experiment that moves less than the scored range would square its errors to 0 and score
+// any simulation 1 (a zero simulation against one at 1e-170 passed): refused like a constant.
+TEST(Assess, AnExperimentMovingBelowTheScoredRangeIsRefused) {
+  Curve sim = MakeCurve("sim", 0.0, 1e-2, 100, 0.0);
+  sim.y.assign(sim.y.size(), 0.0);
+  Curve exp = MakeCurve("exp", 0.0, 1e-2, 100, 0.0);
+  for (double& y : exp.y) y *= 1e-170;
+  const OptionFailure f = OptionErrorOf(sim, exp, AssessOptions{});
+  EXPECT_EQ(f.option, AssessOption::kExp);
+  EXPECT_EQ(f.message.rfind("exp.csv:2-101:2: the experiment curve (exp) moves by only", 0), 0U)
+      << f.message;
+  EXPECT_NE(f.message.find("less than 1e-100, the smallest range assess scores"),
+            std::string::npos)
+      << f.message;
+}
+
+// A time base whose median step is far finer than its range (a few nanosecond samples, then one
+// a million seconds later) would resample onto 1e15 points (std::bad_alloc, "internal error"):
+// refused naming the experiment's time column, the grid it would need and the cap.
+TEST(Assess, AnUnevenTimeBaseNeedingAHugeGridIsRefused) {
+  Curve sim = MakeCurve("sim", 0.0, 1e-9, 40, 0.0);
+  Curve exp = MakeCurve("exp", 0.0, 1e-9, 40, 0.0, 0.001);
+  for (Curve* c : {&sim, &exp}) {
+    for (double& y : c->y) y = (&y - c->y.data()) % 2 == 0 ? 1.0 : 0.0;
+    c->t_s.back() = 1e6;
+  }
+  const OptionFailure f = OptionErrorOf(sim, exp, AssessOptions{});
+  EXPECT_EQ(f.option, AssessOption::kExp);
+  EXPECT_EQ(f.message.rfind("exp.csv:2-41:1: the time base is uneven", 0), 0U) << f.message;
+  EXPECT_NE(f.message.find("would hold 1e+15 samples, more than 16 per compared sample (40)"),
+            std::string::npos)
+      << f.message;
+}
+
 TEST(Assess, WeightedDomainThatCannotBeComputedIsAnInputError) {
   const Curve sim = MakeCurve("sim", 0.0, 1e-2, 500, 0.0);
   AssessOptions freq;

@@ -16,7 +16,7 @@ namespace hiltwin::analysis {
 
 /// The longest line, in bytes without its line break, and the most cells of one row that the
 /// reader takes: far beyond any profile, 20-sim export or hiltwin log (a log row of the RELbot
-/// is about 200 bytes and 20 cells), and small enough that a file without line breaks is refused
+/// is under 300 bytes and 15 cells), and small enough that a file without line breaks is refused
 /// after 64 KiB instead of being read whole. docs/credibility.md ("Input") documents both.
 constexpr std::size_t kMaxCsvLineBytes = 65536;
 constexpr std::size_t kMaxCsvCells = 1024;

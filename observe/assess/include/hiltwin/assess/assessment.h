@@ -21,6 +21,21 @@
 
 namespace hiltwin::analysis {
 
+/// The scale of the numbers Assess scores. Every time and value of the curves stays within
+/// +-kMaxAssessedMagnitude and the experiment (and the input) move by at least
+/// kMinAssessedRange over the compared range: inside both, every difference, square and sum of
+/// squares the domains form is a normal double (no overflow to Inf, no underflow to 0, which
+/// would score any simulation 1), and no quantity in SI units comes near either end. Outside,
+/// Assess throws an OptionError naming the file, line and column (docs/credibility.md).
+constexpr double kMaxAssessedMagnitude = 1e100;
+constexpr double kMinAssessedRange = 1e-100;
+/// A time base that is not uniform is resampled onto a uniform grid at its median step (for
+/// the delay, the spectra and ISO 18571); that grid may hold at most this many points per
+/// compared sample. A few gaps cost a few points; a file whose median step is far finer than
+/// its range (nanosecond samples, then one a day later) is refused instead of being resampled
+/// onto 1e15 points.
+constexpr std::size_t kMaxGridPointsPerSample = 16;
+
 /// One curve taken from a CSV column, with where it came from for messages.
 struct Curve {
   std::string path;
@@ -84,8 +99,9 @@ struct Assessment {
 };
 
 /// Runs the whole assessment. `input` (may be null) enables the frequency domain. Throws
-/// OptionError for a bad option or a curve that cannot serve (constant experiment, a domain
-/// with weight > 0 that cannot be computed, ...) and InputError for data that do not fit
+/// OptionError for a bad option or a curve that cannot serve (constant experiment, a value
+/// beyond kMaxAssessedMagnitude, a grid beyond kMaxGridPointsPerSample, a domain with
+/// weight > 0 that cannot be computed, ...) and InputError for data that do not fit
 /// together (no overlap), naming file, line and column; messages never name command-line
 /// flags (see OptionError::option and AssessOptions::name_option).
 [[nodiscard]] Assessment Assess(const Curve& sim, const Curve& exp, const Curve* input,
