@@ -45,7 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto path = hiltwin::fuzz::WriteScratch("input.fmu", data, size);
   std::filesystem::path unpacked_dir;
   try {
-    const hiltwin::fmi::UnpackedFmu fmu(path);
+    const hiltwin::fmi::UnpackedFmu fmu(path, hiltwin::fmi::FmuUnpackLimits{});
     unpacked_dir = fmu.dir();
     CheckInside(unpacked_dir);
   } catch (const hiltwin::plant::PlantError&) {

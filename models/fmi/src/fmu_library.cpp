@@ -15,18 +15,6 @@ namespace {
 
 using plant::PlantError;
 
-// The platforms the archive does have binaries for, to say why this machine's one matters.
-std::string PlatformsPresent(const std::filesystem::path& unpacked) {
-  std::string platforms;
-  std::error_code error;
-  for (const auto& entry : std::filesystem::directory_iterator(unpacked / "binaries", error)) {
-    if (entry.is_directory(error)) {
-      platforms += (platforms.empty() ? "" : ", ") + entry.path().filename().string();
-    }
-  }
-  return platforms.empty() ? "none" : platforms;
-}
-
 template <typename Function>
 void LookUp(void* handle, const char* symbol, Function*& out, const std::string& where) {
   // dlerror's state is per thread in glibc, which is all the lookup needs.
@@ -43,15 +31,15 @@ void LookUp(void* handle, const char* symbol, Function*& out, const std::string&
 
 }  // namespace
 
-FmuLibrary::FmuLibrary(const std::filesystem::path& unpacked, std::string_view model_identifier,
+FmuLibrary::FmuLibrary(const UnpackedFmu& unpacked, std::string_view model_identifier,
                        std::string_view fmu_name)
     : entry_("binaries/" + std::string(kFmuPlatform) + "/" + std::string(model_identifier) +
              ".so") {
-  const std::filesystem::path file = unpacked / entry_;
+  const std::filesystem::path file = unpacked.dir() / entry_;
   std::error_code error;
   if (!std::filesystem::is_regular_file(file, error)) {
     throw PlantError(std::string(fmu_name) + ": no " + entry_ + " in the archive (binaries " +
-                     "for: " + PlatformsPresent(unpacked) + "); hiltwin needs the " +
+                     "for: " + unpacked.binary_platforms() + "); hiltwin needs the " +
                      std::string(kFmuPlatformName) + " binary named after <CoSimulation " +
                      "modelIdentifier>: export the FMU with " + std::string(kFmuPlatform) +
                      " binaries");

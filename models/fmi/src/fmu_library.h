@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 
+#include "fmu_archive.h"
 #include "hiltwin/fmi/fmi2_abi.h"
 
 namespace hiltwin::fmi {
@@ -30,8 +31,9 @@ class FmuLibrary {
   /// dlopens `<unpacked>/binaries/<kFmuPlatform>/<model_identifier>.so` (RTLD_NOW | RTLD_LOCAL:
   /// every undefined symbol is found now, before the run, and two FMUs never see each other's
   /// symbols), looks up every function and checks fmi2GetVersion is "2.0". Throws
-  /// plant::PlantError naming the file and the symbol.
-  FmuLibrary(const std::filesystem::path& unpacked, std::string_view model_identifier,
+  /// plant::PlantError naming the file and the symbol (and, without the binary, the platforms
+  /// the archive has binaries for).
+  FmuLibrary(const UnpackedFmu& unpacked, std::string_view model_identifier,
              std::string_view fmu_name);
   ~FmuLibrary();
   FmuLibrary(const FmuLibrary&) = delete;

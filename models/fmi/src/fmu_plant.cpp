@@ -62,9 +62,9 @@ std::string FileUri(const std::filesystem::path& dir) {
 
 FmuPlantImpl::FmuPlantImpl(const std::filesystem::path& fmu_path, FmuOptions options)
     : fmu_name_(fmu_path.string()),
-      unpacked_(fmu_path),
+      unpacked_(fmu_path, options.unpack_limits),
       md_(ReadModelDescription(unpacked_.dir() / "modelDescription.xml", fmu_name_)),
-      library_(unpacked_.dir(), md_.model_identifier, fmu_name_),
+      library_(unpacked_, md_.model_identifier, fmu_name_),
       fn_(library_.functions()),
       debug_logging_(options.debug_logging),
       log_(md_.model_identifier, options.log_capacity_messages, std::move(options.log_sink)),

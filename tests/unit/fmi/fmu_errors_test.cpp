@@ -5,8 +5,12 @@
 #include <unistd.h>
 #include <zip.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,16 +60,25 @@ class FmuRefused : public ::testing::Test {
   [[nodiscard]] bool NothingLeftBehind() const {
     return std::filesystem::is_empty(tmp_ / "unpack");
   }
-  // A zip with the given entries (name, content), made with libzip as a hostile tool would.
+  // A zip with the given entries (name, content), made with libzip as a hostile tool would;
+  // with `base`, a copy of that FMU with the entries added; `store`: not compressed.
   [[nodiscard]] std::filesystem::path MakeZip(
-      const std::string& name, const std::vector<std::pair<std::string, std::string>>& entries) {
+      const std::string& name, const std::vector<std::pair<std::string, std::string>>& entries,
+      const std::filesystem::path& base = {}, bool store = false) {
     std::filesystem::path path = tmp_ / name;
+    if (!base.empty()) std::filesystem::copy_file(base, path);
     int error = 0;
-    zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+    zip_t* archive = zip_open(path.c_str(), base.empty() ? ZIP_CREATE | ZIP_TRUNCATE : 0, &error);
     EXPECT_NE(archive, nullptr);
     for (const auto& [entry, content] : entries) {
       zip_source_t* source = zip_source_buffer(archive, content.data(), content.size(), 0);
-      EXPECT_GE(zip_file_add(archive, entry.c_str(), source, ZIP_FL_ENC_UTF_8), 0) << entry;
+      const zip_int64_t index = zip_file_add(archive, entry.c_str(), source, ZIP_FL_ENC_UTF_8);
+      EXPECT_GE(index, 0) << entry;
+      if (store) {
+        EXPECT_EQ(zip_set_file_compression(archive, static_cast<zip_uint64_t>(index),
+                                           ZIP_CM_STORE, 0),
+                  0);
+      }
     }
     EXPECT_EQ(zip_close(archive), 0);
     return path;
@@ -124,6 +137,15 @@ TEST_F(FmuRefused, NoLinuxBinary) {
   EXPECT_TRUE(NothingLeftBehind());
 }
 
+// Other platforms' binaries are not unpacked, but the message still lists them.
+TEST_F(FmuRefused, NoBinaryForThisPlatformListsTheOnesInTheArchive) {
+  const std::filesystem::path fmu = MakeZip(
+      "win.fmu", {{"binaries/win64/bad_no_binary.dll", "MZ"}, {"binaries/darwin64/x.dylib", ""}},
+      TestFmu("bad_no_binary"));
+  EXPECT_THAT(OpenError(fmu), HasSubstr("(binaries for: darwin64, win64)"));
+  EXPECT_TRUE(NothingLeftBehind());
+}
+
 TEST_F(FmuRefused, MissingFunction) {
   EXPECT_THAT(OpenError(TestFmu("bad_no_dostep")),
               HasSubstr("bad_no_dostep.fmu: binaries/" HILTWIN_FMU_PLATFORM
@@ -139,6 +161,99 @@ TEST_F(FmuRefused, EntriesThatWouldUnpackOutsideTheFolder) {
   EXPECT_FALSE(std::filesystem::exists(tmp_ / "escape.txt"));
   const std::filesystem::path absolute = MakeZip("absolute.fmu", {{"/tmp/escape.txt", "x"}});
   EXPECT_THAT(OpenError(absolute), HasSubstr("entry \"/tmp/escape.txt\" has an absolute path"));
+  EXPECT_TRUE(NothingLeftBehind());
+}
+
+// Only what running the FMU needs is unpacked: modelDescription.xml, this platform's binaries
+// and resources/; documentation, sources, other platforms' binaries and the icon stay in the
+// archive (a 1 MB FMU unpacked a 1 GiB entry of any name into $TMPDIR).
+TEST_F(FmuRefused, OnlyTheDescriptionThisPlatformsBinariesAndResourcesAreUnpacked) {
+  const std::filesystem::path fmu =
+      MakeZip("extras.fmu",
+              {{"documentation/index.html", "<html/>"},
+               {"sources/lag_model.c", "int x;"},
+               {"binaries/win64/lag.dll", "MZ"},
+               {"model.png", "PNG"},
+               {"resources/table.txt", "1 2 3"}},
+              TestFmu("lag"));
+  const std::unique_ptr<FmuPlant> plant = OpenFmu(fmu);
+  const std::filesystem::path dir = plant->unpack_dir();
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file()) files.push_back(entry.path().lexically_relative(dir).string());
+  }
+  EXPECT_THAT(files, ::testing::UnorderedElementsAre(
+                         "modelDescription.xml", "binaries/" HILTWIN_FMU_PLATFORM "/lag.so",
+                         "resources/table.txt"));
+}
+
+// An archive of more entries than the cap is refused before anything is unpacked, naming the
+// count and the cap.
+TEST_F(FmuRefused, MoreEntriesThanTheCap) {
+  std::vector<std::pair<std::string, std::string>> many;
+  for (std::uint64_t i = 0; i < kMaxFmuEntries; ++i) {
+    many.emplace_back("documentation/" + std::to_string(i) + ".txt", "");
+  }
+  const std::filesystem::path fmu = MakeZip("many.fmu", many, TestFmu("lag"));
+  EXPECT_THAT(OpenError(fmu), HasSubstr("many.fmu: the archive has 10002 entries, more than the "
+                                        "10000 hiltwin opens in an FMU"));
+  EXPECT_TRUE(NothingLeftBehind());
+}
+
+// What is unpacked is capped in bytes: an entry past the cap is refused before it is written,
+// naming the entry, its size and the cap (here a cap of 1 MiB and 2 MiB of zeros, which
+// compress to 2 KiB; the default cap is 256 MiB).
+TEST_F(FmuRefused, UnpackedBytesPastTheCap) {
+  EXPECT_EQ(FmuUnpackLimits{}.max_bytes, std::uint64_t{256} << 20);
+  EXPECT_EQ(FmuUnpackLimits{}.max_entries, 10000U);
+  const std::string zeros(std::size_t{2} << 20, '\0');
+  const std::filesystem::path fmu =
+      MakeZip("big.fmu", {{"resources/zeros.bin", zeros}}, TestFmu("lag"));
+  EXPECT_LT(std::filesystem::file_size(fmu), std::uintmax_t{1} << 20);
+  std::string error;
+  try {
+    FmuOptions options;
+    options.unpack_limits.max_bytes = std::uint64_t{1} << 20;
+    (void)OpenFmu(fmu, std::move(options));
+  } catch (const plant::PlantError& e) {
+    error = e.what();
+  }
+  EXPECT_THAT(error, AllOf(HasSubstr("big.fmu: entry \"resources/zeros.bin\" (2097152 bytes) "
+                                     "would unpack more than 1048576 bytes"),
+                           HasSubstr("the most hiltwin unpacks from an FMU")));
+  EXPECT_TRUE(NothingLeftBehind());
+}
+
+// A damaged entry names libzip's reason (a CRC error), not "damaged entry or disk full".
+TEST_F(FmuRefused, ACorruptEntrySaysWhyLibzipRefusedIt) {
+  const std::string text(4096, 'r');
+  const std::filesystem::path fmu =
+      MakeZip("crc.fmu", {{"resources/data.txt", text}}, TestFmu("lag"), true);
+  // The entry is stored as it is; flip a byte in the middle of its data.
+  zip_t* archive = zip_open(fmu.c_str(), ZIP_RDONLY, nullptr);
+  ASSERT_NE(archive, nullptr);
+  zip_stat_t st;
+  zip_stat_init(&st);
+  ASSERT_EQ(zip_stat(archive, "resources/data.txt", 0, &st), 0);
+  zip_discard(archive);
+  std::string bytes;
+  {
+    std::ifstream in(fmu, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // The local header: 30 bytes, the name, the extra field, then the data.
+  const std::size_t header = bytes.find("resources/data.txt") - 30;
+  ASSERT_EQ(bytes.compare(header, 4, "PK\x03\x04"), 0);
+  const auto u16 = [&bytes](std::size_t at) {
+    return static_cast<std::size_t>(static_cast<unsigned char>(bytes[at])) |
+           static_cast<std::size_t>(static_cast<unsigned char>(bytes[at + 1])) << 8U;
+  };
+  const std::size_t middle = header + 30 + u16(header + 26) + u16(header + 28) + st.comp_size / 2;
+  bytes[middle] = static_cast<char>(bytes[middle] ^ 0x55);
+  std::ofstream(fmu, std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_THAT(OpenError(fmu), AllOf(HasSubstr("crc.fmu: entry \"resources/data.txt\""),
+                                    HasSubstr("(libzip says: CRC error)"),
+                                    HasSubstr("export it again")));
   EXPECT_TRUE(NothingLeftBehind());
 }
 

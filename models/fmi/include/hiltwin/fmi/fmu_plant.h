@@ -19,6 +19,20 @@
 
 namespace hiltwin::fmi {
 
+/// What opening an FMU may unpack at most (docs/fmi.md, "The unpack folder"): far beyond what
+/// modelling tools export (a few hundred entries, tens of MiB), far below what fills a $TMPDIR.
+/// Entries in the archive, of any kind: libzip reads the central directory whole.
+inline constexpr std::uint64_t kMaxFmuEntries = 10'000;
+/// Bytes written into the unpack folder: modelDescription.xml, binaries/<platform>/ and
+/// resources/ (the only parts unpacked), as declared by each entry and as actually written.
+inline constexpr std::uint64_t kMaxFmuUnpackedBytes = std::uint64_t{256} << 20;  // 256 MiB
+
+/// The caps of one opening; the defaults are the constants above.
+struct FmuUnpackLimits {
+  std::uint64_t max_entries = kMaxFmuEntries;
+  std::uint64_t max_bytes = kMaxFmuUnpackedBytes;
+};
+
 /// How to open an FMU beyond what the command line gives (tests, benchmarks, embedders).
 struct FmuOptions {
   /// loggingOn for fmi2Instantiate: asks the FMU for its debug messages too.
@@ -27,6 +41,8 @@ struct FmuOptions {
   std::size_t log_capacity_messages = 1024;
   /// Where drained log lines go (one line, no newline); empty = stderr.
   std::function<void(std::string_view line)> log_sink;
+  /// What unpacking may take at most.
+  FmuUnpackLimits unpack_limits;
 };
 
 /// The FMU's own functions on the plant's instance, for measuring the adapter against them
@@ -56,8 +72,9 @@ class FmuPlant : public plant::Plant {
 };
 
 /// Opens an FMU. Throws plant::PlantError saying which file, entry, attribute or symbol is
-/// wrong and what to do: not a zip, no or malformed modelDescription.xml, fmiVersion other
-/// than 2.0, Model Exchange only, no binary for this platform (fmu_platform.h), a missing function.
+/// wrong and what to do: not a zip, more entries or bytes than options.unpack_limits, a damaged
+/// entry, no or malformed modelDescription.xml, fmiVersion other than 2.0, Model Exchange
+/// only, no binary for this platform (fmu_platform.h), a missing function.
 [[nodiscard]] std::unique_ptr<FmuPlant> OpenFmu(const std::filesystem::path& fmu_path,
                                                 FmuOptions options = {});
 
