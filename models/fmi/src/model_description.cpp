@@ -6,10 +6,13 @@
 #include <libxml/tree.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <system_error>
 #include <utility>
 
 #include "hiltwin/plant/plant.h"
@@ -26,6 +29,8 @@ struct CtxtFreer {
   void operator()(xmlParserCtxt* ctxt) const noexcept { xmlFreeParserCtxt(ctxt); }
 };
 using DocPtr = std::unique_ptr<xmlDoc, DocFreer>;
+
+constexpr const char* kFixIt = "fix the file or export the FMU again";
 
 // Where a message points: "lag.fmu: modelDescription.xml:12".
 struct Where {
@@ -249,6 +254,71 @@ void ReadVariables(const xmlNode* root, const Where& where, ModelDescription& md
   }
 }
 
+// A 1-based index into ModelVariables (FMI 2.0 §2.2.8: ModelStructure and a Real's derivative
+// name variables so). `what` says where it stands, for messages.
+std::size_t VariableIndex(std::string_view text, const std::string& what, const xmlNode* node,
+                          const Where& where, const ModelDescription& md) {
+  const std::string count = std::to_string(md.variables.size());
+  std::size_t index = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), index);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+    throw PlantError(where.At(node) + ": " + what + ": \"" + std::string(text) +
+                     "\" is not a variable's index (1 to " + count + "): " + kFixIt);
+  }
+  if (index == 0 || index > md.variables.size()) {
+    throw PlantError(where.At(node) + ": " + what + " refers to variable " +
+                     std::to_string(index) + ", but <ModelVariables> declares " + count +
+                     " (indices count from 1): " + kFixIt);
+  }
+  return index - 1;
+}
+
+// Every <Unknown> of one ModelStructure list: index and dependencies within ModelVariables,
+// and for <Outputs> a variable whose causality is "output".
+void CheckUnknowns(const xmlNode* list, const Where& where, const ModelDescription& md) {
+  const std::string list_name = reinterpret_cast<const char*>(list->name);
+  for (const xmlNode* node = list->children; node != nullptr; node = node->next) {
+    if (!Named(node, "Unknown")) continue;
+    const std::string index_text = RequiredAttribute(node, "index", where);
+    const std::string label = "<" + list_name + "> <Unknown index=\"" + index_text + "\">";
+    const std::size_t index = VariableIndex(index_text, label, node, where, md);
+    const ScalarVariable& variable = md.variables[index];
+    if (list_name == "Outputs" && variable.causality != "output") {
+      throw PlantError(where.At(node) + ": " + label + " refers to variable " +
+                       std::to_string(index + 1) + " \"" + variable.name +
+                       "\", whose causality is \"" + variable.causality +
+                       "\", not \"output\": " + kFixIt);
+    }
+    const std::string dependencies = Attribute(node, "dependencies").value_or("");
+    const std::string dependencies_label = label + " dependencies=\"" + dependencies + "\"";
+    std::istringstream tokens(dependencies);
+    for (std::string token; tokens >> token;) {
+      static_cast<void>(VariableIndex(token, dependencies_label, node, where, md));
+    }
+  }
+}
+
+// References by index must name a declared variable: a file with dangling ones does not
+// describe the binary it came with.
+void CheckIndexReferences(const xmlNode* root, const Where& where, const ModelDescription& md) {
+  if (const xmlNode* structure = FirstChild(root, "ModelStructure")) {
+    for (const char* list : {"Outputs", "Derivatives", "InitialUnknowns"}) {
+      if (const xmlNode* unknowns = FirstChild(structure, list)) CheckUnknowns(unknowns, where, md);
+    }
+  }
+  const xmlNode* variables = FirstChild(root, "ModelVariables");
+  for (const xmlNode* node = variables != nullptr ? variables->children : nullptr;
+       node != nullptr; node = node->next) {
+    const xmlNode* real = Named(node, "ScalarVariable") ? FirstChild(node, "Real") : nullptr;
+    const std::optional<std::string> derivative =
+        real != nullptr ? Attribute(real, "derivative") : std::nullopt;
+    if (derivative) {
+      static_cast<void>(VariableIndex(*derivative, "<Real derivative=\"" + *derivative + "\">",
+                                      real, where, md));
+    }
+  }
+}
+
 }  // namespace
 
 const ScalarVariable* ModelDescription::Find(std::string_view name) const noexcept {
@@ -270,6 +340,7 @@ ModelDescription ReadModelDescription(const std::filesystem::path& xml_file,
   ReadCoSimulation(root, where, md);
   ReadDefaultExperiment(root, where, md);
   ReadVariables(root, where, md);
+  CheckIndexReferences(root, where, md);
   return md;
 }
 

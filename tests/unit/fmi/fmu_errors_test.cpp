@@ -72,7 +72,8 @@ class FmuRefused : public ::testing::Test {
     EXPECT_NE(archive, nullptr);
     for (const auto& [entry, content] : entries) {
       zip_source_t* source = zip_source_buffer(archive, content.data(), content.size(), 0);
-      const zip_int64_t index = zip_file_add(archive, entry.c_str(), source, ZIP_FL_ENC_UTF_8);
+      const zip_int64_t index =
+          zip_file_add(archive, entry.c_str(), source, ZIP_FL_ENC_UTF_8 | ZIP_FL_OVERWRITE);
       EXPECT_GE(index, 0) << entry;
       if (store) {
         EXPECT_EQ(zip_set_file_compression(archive, static_cast<zip_uint64_t>(index),
@@ -254,6 +255,46 @@ TEST_F(FmuRefused, ACorruptEntrySaysWhyLibzipRefusedIt) {
   EXPECT_THAT(OpenError(fmu), AllOf(HasSubstr("crc.fmu: entry \"resources/data.txt\""),
                                     HasSubstr("(libzip says: CRC error)"),
                                     HasSubstr("export it again")));
+  EXPECT_TRUE(NothingLeftBehind());
+}
+
+// lag.fmu's modelDescription.xml with `from` replaced by `to`.
+std::string LagDescriptionWith(const std::string& from, const std::string& to) {
+  std::ifstream in(std::filesystem::path(HILTWIN_TEST_FMU_DIR) / "stage/lag/modelDescription.xml");
+  std::string xml(std::istreambuf_iterator<char>(in), {});
+  const std::size_t at = xml.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? xml : xml.replace(at, from.size(), to);
+}
+
+// ModelStructure refers to variables by their 1-based index in ModelVariables: an index past
+// the last variable (or not a number, or a dependency past it, or an output that is not one)
+// is refused with its line, as a file that does not describe the binary (it ran before).
+TEST_F(FmuRefused, DanglingModelStructureIndicesAreRefusedWithTheirLine) {
+  const auto error_with = [this](const std::string& name, const std::string& to) {
+    const std::string xml = LagDescriptionWith("<Unknown index=\"2\"/>", to);
+    return OpenError(MakeZip(name, {{"modelDescription.xml", xml}}, TestFmu("lag")));
+  };
+  EXPECT_THAT(error_with("past.fmu", "<Unknown index=\"7\"/>"),
+              AllOf(HasSubstr("past.fmu: modelDescription.xml:28: <Outputs> <Unknown index=\"7\">"
+                              " refers to variable 7, but <ModelVariables> declares 5"),
+                    HasSubstr("export the FMU again")));
+  EXPECT_THAT(error_with("zero.fmu", "<Unknown index=\"0\"/>"),
+              HasSubstr("<Unknown index=\"0\"> refers to variable 0, but <ModelVariables>"));
+  EXPECT_THAT(error_with("text.fmu", "<Unknown index=\"two\"/>"),
+              HasSubstr("<Unknown index=\"two\">: \"two\" is not a variable's index (1 to 5)"));
+  EXPECT_THAT(error_with("deps.fmu", "<Unknown index=\"2\" dependencies=\"1 9\"/>"),
+              HasSubstr("<Outputs> <Unknown index=\"2\"> dependencies=\"1 9\" refers to "
+                        "variable 9, but <ModelVariables> declares 5"));
+  EXPECT_THAT(error_with("input.fmu", "<Unknown index=\"1\"/>"),
+              HasSubstr("<Outputs> <Unknown index=\"1\"> refers to variable 1 \"u\", whose "
+                        "causality is \"input\", not \"output\""));
+  const std::string derivative =
+      LagDescriptionWith("<Real start=\"0\" unit=\"rad\"/>",
+                         "<Real start=\"0\" unit=\"rad\" derivative=\"6\"/>");
+  EXPECT_THAT(OpenError(MakeZip("der.fmu", {{"modelDescription.xml", derivative}}, TestFmu("lag"))),
+              HasSubstr("<Real derivative=\"6\"> refers to variable 6, but <ModelVariables> "
+                        "declares 5"));
   EXPECT_TRUE(NothingLeftBehind());
 }
 
