@@ -47,8 +47,8 @@ RelbotPlant::RelbotPlant(const RelbotParams& params, Integrator integrator)
 void RelbotPlant::Start(double step_s, std::span<double> y0) {
   try {
     model_.emplace(params_, integrator_, step_s);
-  } catch (const ConfigError& e) {
-    throw plant::PlantError(e.what());
+  } catch (const ConfigError& e) {  // the step is out of range or not stable
+    throw plant::PlantStepError(e.what());
   }
   WriteOutputs(model_->Outputs(), y0);
 }
@@ -71,8 +71,8 @@ plant::PlantMap RelbotDefaultMap(const RelbotParams& params) {
   plant::PlantMap map;
   map.source = "the built-in map of relbot";
   // Appendix G: u[0] = channel2 // Left, u[1] = channel1 // Right; enc1 = right, enc2 = left.
-  map.pwm = {{static_cast<int>(kLeftChannel) + 1, "duty_left", 1.0, false, 0},
-             {static_cast<int>(kRightChannel) + 1, "duty_right", 1.0, false, 0}};
+  map.pwm = {{static_cast<int>(kLeftChannel) + 1, "duty_left", 1.0, false, 0, 0},
+             {static_cast<int>(kRightChannel) + 1, "duty_right", 1.0, false, 0, 0}};
   map.encoders = {
       WheelEncoder(kLeftChannel, "wheel_left_m", "enc_left", "wheel_left_joint", params),
       WheelEncoder(kRightChannel, "wheel_right_m", "enc_right", "wheel_right_joint", params)};

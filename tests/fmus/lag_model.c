@@ -17,11 +17,21 @@ void ModelSetStartValues(FmuInstance* instance) {
 }
 
 fmi2Status ModelExitInitialization(FmuInstance* instance) {
+#ifdef HILTWIN_FMU_FAIL_INIT
+  FmuLog(instance, fmi2Error, "logStatusError", "this FMU never initialises (test variant %g)",
+         1.0);
+  return fmi2Error;
+#endif
   if (!(instance->r[kTau] > 0.0)) {
     FmuLog(instance, fmi2Error, "logStatusError", "tau = %g s must be positive",
            instance->r[kTau]);
     return fmi2Error;
   }
+#ifdef HILTWIN_FMU_STEADY_START
+  /* Initialised in equilibrium with the input it was given, as a model with a steady-state
+   * initialisation is: y = K u, so the output holds while u does. */
+  instance->r[kY] = instance->r[kK] * instance->r[kU];
+#endif
   return fmi2OK;
 }
 

@@ -91,11 +91,14 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
   const double step_s = static_cast<double>(period_ns) * 1e-9;
   std::vector<double> y0(twin->plant->Info().outputs.size(), 0.0);
   try {
+    twin->plant->SetInitialInputs(made.bound.initial_inputs);  // the map's [inputs] from t = 0
     twin->plant->Start(step_s, y0);
-  } catch (const plant::PlantError& e) {
+  } catch (const plant::PlantStepError& e) {
     // A plant that names the flag itself (a 20-sim step mismatch) is quoted as it is.
     const std::string why = e.what();
     ThrowUsage(why.starts_with("--rate") ? why : "--rate " + Num(o.session.rate_hz) + ": " + why);
+  } catch (const plant::PlantError& e) {  // not the step's fault: an FMU that fails to start
+    ThrowUsage("--plant " + o.plant + ": " + e.what());
   }
   twin->backend = OpenBoard(o.session, io::Image::kIcoboardInverse);
   twin->pwm_source =

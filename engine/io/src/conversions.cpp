@@ -51,9 +51,8 @@ std::int64_t MetresToCounts(double metres, const WheelGeometry& geometry) noexce
 std::int64_t ValueToCounts(double value, double counts_per_unit) noexcept {
   const double counts = value * counts_per_unit;
   if (!std::isfinite(counts)) return 0;
-  constexpr double kLimit = 4.611686018427387904e18;  // 2^62
-  if (counts >= kLimit) return static_cast<std::int64_t>(kLimit);
-  if (counts <= -kLimit) return -static_cast<std::int64_t>(kLimit);
+  if (counts >= kMaxAbsCounts) return static_cast<std::int64_t>(kMaxAbsCounts);
+  if (counts <= -kMaxAbsCounts) return -static_cast<std::int64_t>(kMaxAbsCounts);
   return static_cast<std::int64_t>(std::floor(counts));
 }
 

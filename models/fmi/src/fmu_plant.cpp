@@ -58,6 +58,22 @@ std::string FileUri(const std::filesystem::path& dir) {
   return uri;
 }
 
+// "an Integer", "a parameter": the article a word takes (by its first letter).
+std::string WithArticle(std::string_view word) {
+  const bool vowel = !word.empty() && std::string_view("aeiouAEIOU").find(word.front()) !=
+                                          std::string_view::npos;
+  return (vowel ? "an " : "a ") + std::string(word);
+}
+
+// What a variable of a causality FMI 2.0 names (§2.2.7) is, as a noun for messages.
+std::string CausalityNoun(const std::string& causality) {
+  if (causality == "parameter") return "a parameter";
+  if (causality == "calculatedParameter") return "a calculated parameter";
+  if (causality == "local") return "a local variable";
+  if (causality == "independent") return "the independent variable";
+  return WithArticle(causality) + " variable";
+}
+
 }  // namespace
 
 FmuPlantImpl::FmuPlantImpl(const std::filesystem::path& fmu_path, FmuOptions options)
@@ -97,7 +113,16 @@ void FmuPlantImpl::BuildPorts() {
       output_refs_.push_back(variable.value_reference);
     }
   }
-  zero_inputs_.assign(input_refs_.size(), 0.0);
+  initial_inputs_.assign(input_refs_.size(), 0.0);
+}
+
+void FmuPlantImpl::SetInitialInputs(std::span<const double> u0) {
+  if (u0.size() != initial_inputs_.size()) {
+    throw PlantError("SetInitialInputs of " + info_.name + " was given " +
+                     std::to_string(u0.size()) + " values for its " +
+                     std::to_string(initial_inputs_.size()) + " inputs (a bug in the caller)");
+  }
+  initial_inputs_.assign(u0.begin(), u0.end());
 }
 
 void FmuPlantImpl::Check(fmi2Status status, const char* call) {
@@ -139,9 +164,11 @@ void FmuPlantImpl::Initialise(std::span<double> y0) {
   Check(fn_.setup_experiment(component_, fmi2False, 0.0, 0.0, fmi2False, 0.0),
         "fmi2SetupExperiment");
   Check(fn_.enter_initialization_mode(component_), "fmi2EnterInitializationMode");
-  // Inputs start at 0: the twin writes the real values before every step.
+  // The inputs held until the first step (the map's constants, 0 for the PWM-driven ones), so
+  // the initial outputs are the ones the first step continues from.
   if (!input_refs_.empty()) {
-    Check(fn_.set_real(component_, input_refs_.data(), input_refs_.size(), zero_inputs_.data()),
+    Check(fn_.set_real(component_, input_refs_.data(), input_refs_.size(),
+                       initial_inputs_.data()),
           "fmi2SetReal");
   }
   Check(fn_.exit_initialization_mode(component_), "fmi2ExitInitializationMode");
@@ -154,8 +181,8 @@ void FmuPlantImpl::Initialise(std::span<double> y0) {
 
 void FmuPlantImpl::Start(double step_s, std::span<double> y0) {
   if (!(step_s > 0.0) || !std::isfinite(step_s)) {
-    throw PlantError(info_.name + ": the step must be a positive number of seconds, not " +
-                     std::to_string(step_s));
+    throw plant::PlantStepError(info_.name + ": the step must be a positive number of seconds, "
+                                "not " + std::to_string(step_s));
   }
   CheckOutputSpan(y0, "Start");
   Finish();  // a second Start begins with a fresh instance
@@ -243,16 +270,14 @@ std::string FmuPlantImpl::ExplainNonPort(std::string_view name) const {
     return {};
   }
   const std::string file = std::filesystem::path(fmu_name_).filename().string();
-  const std::string quoted = "'" + variable->name + "'";
   if (variable->type != "Real") {
-    const bool vowel = variable->type.find_first_of("AEIOU") == 0;
-    return quoted + (vowel ? " is an " : " is a ") + variable->type + " variable of " + file +
+    return "is " + WithArticle(variable->type) + " variable of " + file +
            "; only Real ports can be mapped";
   }
   if (variable->causality == "input" || variable->causality == "output") {
     return {};
   }
-  return quoted + " is a " + variable->causality + " of " + file + " (causality \"" +
+  return "is " + CausalityNoun(variable->causality) + " of " + file + " (causality \"" +
          variable->causality + "\"); only inputs can be driven and outputs followed";
 }
 

@@ -28,6 +28,7 @@ class FmuPlantImpl final : public FmuPlant {
   FmuPlantImpl& operator=(const FmuPlantImpl&) = delete;
 
   [[nodiscard]] const plant::PlantInfo& Info() const noexcept override { return info_; }
+  void SetInitialInputs(std::span<const double> u0) override;
   void Start(double step_s, std::span<double> y0) override;
   [[nodiscard]] plant::PlantStatus Step(std::span<const double> u,
                                         std::span<double> y) noexcept override;
@@ -64,7 +65,7 @@ class FmuPlantImpl final : public FmuPlant {
   plant::PlantInfo info_;
   std::vector<fmi2ValueReference> input_refs_;
   std::vector<fmi2ValueReference> output_refs_;
-  std::vector<fmi2Real> zero_inputs_;
+  std::vector<fmi2Real> initial_inputs_;  ///< set in initialisation mode (SetInitialInputs)
 
   fmi2Component component_ = nullptr;
   bool initialised_ = false;   ///< fmi2ExitInitializationMode returned ok

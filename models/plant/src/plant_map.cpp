@@ -10,6 +10,7 @@
 #include <numbers>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 namespace hiltwin::plant {
 namespace {
@@ -20,6 +21,7 @@ std::string Where(std::string_view source, const toml::source_region& region) {
   std::ostringstream out;
   out << source;
   if (region.begin.line != 0) out << ':' << region.begin.line;
+  if (region.begin.line != 0 && region.begin.column != 0) out << ':' << region.begin.column;
   return out.str();
 }
 
@@ -36,15 +38,16 @@ std::string Num(double value) {
 /// Refuses keys a table does not know, so a typo cannot silently fall back to a default.
 void CheckKeys(std::string_view source, const toml::table& table, std::string_view table_name,
                std::initializer_list<std::string_view> known) {
-  for (const auto& [key, node] : table) {
+  for (const auto& entry : table) {
+    const toml::key& key = entry.first;
     bool found = false;
     for (const std::string_view k : known) found = found || k == key.str();
     if (found) continue;
     std::string list;
     for (const std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-    Fail(source, node,
-         "unknown key '" + std::string(key.str()) + "' in " + std::string(table_name) +
-             " (known: " + list + ")");
+    // The key's own place: its value is not what is wrong.
+    throw PlantMapError(Where(source, key.source()) + ": unknown key '" + std::string(key.str()) +
+                        "' in " + std::string(table_name) + " (known: " + list + ")");
   }
 }
 
@@ -87,6 +90,16 @@ class Entry {
     }
     return value;
   }
+  /// A scale that must be > 0: the direction is `reverse`'s, so a negative one is refused.
+  [[nodiscard]] std::optional<double> Scale(std::string_view key) const {
+    const std::optional<double> value = Number(key);
+    if (value && *value < 0.0) {
+      Fail(source_, *table_.get(key), name_ + ": " + std::string(key) + " " + Num(*value) +
+                                          " is negative: give its size and reverse = true (the "
+                                          "direction pin then means the other way)");
+    }
+    return value;
+  }
   [[nodiscard]] double Positive(std::string_view key) const {
     const std::optional<double> value = Number(key);
     if (value && *value <= 0.0) {
@@ -102,7 +115,12 @@ class Entry {
     if (!value) Fail(source_, *node, name_ + ": '" + std::string(key) + "' must be true or false");
     return *value;
   }
-  [[nodiscard]] int Line() const { return static_cast<int>(table_.source().begin.line); }
+  /// Line and column of `key`'s value (the table's when it is missing), for later messages.
+  [[nodiscard]] std::pair<int, int> Place(std::string_view key) const {
+    const toml::node* node = table_.get(key);
+    const toml::source_position at = (node != nullptr ? node->source() : table_.source()).begin;
+    return {static_cast<int>(at.line), static_cast<int>(at.column)};
+  }
   [[nodiscard]] const std::string& name() const { return name_; }
 
  private:
@@ -129,27 +147,46 @@ PwmRoute ParsePwm(std::string_view source, const toml::table& table, std::size_t
   PwmRoute route;
   route.channel = e.Channel();
   route.input = e.String("input", true);
-  route.gain = e.Number("gain").value_or(1.0);
+  route.gain = e.Scale("gain").value_or(1.0);
   if (route.gain == 0.0) {
     Fail(source, *table.get("gain"), e.name() + ": gain 0 would disconnect the input; remove "
                                                 "the entry and give the input a value in [inputs]");
   }
   route.reverse = e.Flag("reverse");
-  route.line = e.Line();
+  std::tie(route.line, route.col) = e.Place("input");
   return route;
+}
+
+/// A scale the board can follow: at most kMaxCountsPerUnit. `at` is the key that set it last.
+double CheckRepresentable(std::string_view source, const toml::node& at, const Entry& e,
+                          const std::string& unit, double counts_per_unit) {
+  if (!(counts_per_unit > 0.0)) {  // keys far below 1 multiplied to nothing
+    Fail(source, at, e.name() + ": the scale comes to 0 counts per " + unit +
+                         ": check the scale's keys and their units");
+  }
+  if (counts_per_unit <= kMaxCountsPerUnit) return counts_per_unit;
+  Fail(source, at,
+       e.name() + ": " + Num(counts_per_unit) + " counts per " + unit + " is more than " +
+           Num(kMaxCountsPerUnit) + ", the most counts the board emits in a second (" +
+           Num(static_cast<double>(io::kFpgaClockHz) / 1e6) + " MHz over its smallest clock "
+           "divider, " + std::to_string(io::kMinClockDivider) +
+           "): it could not follow the output moving one " + unit +
+           " per second; check the scale's keys and their units");
 }
 
 /// counts per unit of the output: given directly, or from the encoder on a geared shaft.
 double EncoderScale(std::string_view source, const toml::table& table, const Entry& e,
                     const std::string& unit) {
-  const std::optional<double> direct = e.Number("counts_per_unit");
+  const std::optional<double> direct = e.Scale("counts_per_unit");
   const double per_rev = e.Positive("counts_per_rev");
   if (direct && per_rev > 0.0) {
-    Fail(source, table, e.name() + " gives both counts_per_unit and counts_per_rev: keep one");
+    Fail(source, *table.get("counts_per_rev"),
+         e.name() + " gives both counts_per_unit and counts_per_rev: keep one");
   }
   if (direct) {
-    if (*direct == 0.0) Fail(source, *table.get("counts_per_unit"), e.name() + ": 0 counts per unit");
-    return *direct;
+    const toml::node& at = *table.get("counts_per_unit");
+    if (*direct == 0.0) Fail(source, at, e.name() + ": 0 counts per unit");
+    return CheckRepresentable(source, at, e, unit, *direct);
   }
   if (per_rev == 0.0) {
     Fail(source, table, e.name() + " has no scale: give counts_per_unit, or counts_per_rev "
@@ -158,12 +195,14 @@ double EncoderScale(std::string_view source, const toml::table& table, const Ent
   const double ratio = table.contains("gear_ratio") ? e.Positive("gear_ratio") : 1.0;
   // Output radians turn the encoder's shaft `ratio` times as far; metres are radians times r.
   const double per_rad = per_rev * ratio / (2.0 * std::numbers::pi);
-  if (unit == "rad") return per_rad;
+  const toml::node& shaft =
+      *table.get(table.contains("gear_ratio") ? "gear_ratio" : "counts_per_rev");
+  if (unit == "rad") return CheckRepresentable(source, shaft, e, unit, per_rad);
   const double radius_m = e.Positive("wheel_radius_m");
   if (radius_m == 0.0) {
     Fail(source, table, e.name() + ": unit \"m\" with counts_per_rev needs wheel_radius_m");
   }
-  return per_rad / radius_m;
+  return CheckRepresentable(source, *table.get("wheel_radius_m"), e, unit, per_rad / radius_m);
 }
 
 EncoderRoute ParseEncoder(std::string_view source, const toml::table& table, std::size_t index) {
@@ -185,7 +224,7 @@ EncoderRoute ParseEncoder(std::string_view source, const toml::table& table, std
   if (route.column.empty()) route.column = "enc" + std::to_string(route.channel);
   route.joint = e.String("joint", false);
   route.wheel_radius_m = e.Positive("wheel_radius_m");
-  route.line = e.Line();
+  std::tie(route.line, route.col) = e.Place("output");
   return route;
 }
 
@@ -199,7 +238,9 @@ void ParseInputs(std::string_view source, const toml::table& root, PlantMap& map
     if (!number || !std::isfinite(*number)) {
       Fail(source, value, "[inputs] " + std::string(key.str()) + " must be a finite number");
     }
-    map.constant_inputs.emplace_back(std::string(key.str()), *number);
+    const toml::source_position at = value.source().begin;
+    map.constant_inputs.push_back({std::string(key.str()), *number, static_cast<int>(at.line),
+                                   static_cast<int>(at.column)});
   }
 }
 
@@ -224,17 +265,17 @@ void ParseTelemetry(std::string_view source, const toml::table& root, PlantMap& 
   map.pose = outputs;
 }
 
-/// One PWM channel drives one input; one encoder channel follows one output.
+/// One PWM channel drives one input; one encoder channel follows one output. `tables` are the
+/// routes' own, for the place of the second `channel`.
 template <class Route>
-void CheckChannelsOnce(std::string_view source, const std::vector<Route>& routes,
-                       std::string_view what) {
+void CheckChannelsOnce(std::string_view source, const toml::array* tables,
+                       const std::vector<Route>& routes, std::string_view what) {
   std::set<int> seen;
-  for (const Route& route : routes) {
-    if (!seen.insert(route.channel).second) {
-      throw PlantMapError(std::string(source) + ":" + std::to_string(route.line) + ": " +
-                          std::string(what) + " channel " + std::to_string(route.channel) +
-                          " is mapped twice: a channel carries one signal");
-    }
+  for (std::size_t i = 0; i < routes.size(); ++i) {
+    if (seen.insert(routes[i].channel).second) continue;
+    Fail(source, *(*tables)[i].as_table()->get("channel"),
+         std::string(what) + " channel " + std::to_string(routes[i].channel) +
+             " is mapped twice: a channel carries one signal");
   }
 }
 
@@ -251,18 +292,16 @@ PlantMap ParsePlantMap(std::string_view toml_text, std::string_view source_name)
   CheckKeys(source_name, root, "the plant map", {"pwm", "encoder", "inputs", "telemetry"});
   PlantMap map;
   map.source = std::string(source_name);
-  if (const toml::array* pwm = ArrayOfTables(source_name, root, "pwm")) {
-    for (std::size_t i = 0; i < pwm->size(); ++i) {
-      map.pwm.push_back(ParsePwm(source_name, *(*pwm)[i].as_table(), i));
-    }
+  const toml::array* pwm = ArrayOfTables(source_name, root, "pwm");
+  for (std::size_t i = 0; pwm != nullptr && i < pwm->size(); ++i) {
+    map.pwm.push_back(ParsePwm(source_name, *(*pwm)[i].as_table(), i));
   }
-  if (const toml::array* encoders = ArrayOfTables(source_name, root, "encoder")) {
-    for (std::size_t i = 0; i < encoders->size(); ++i) {
-      map.encoders.push_back(ParseEncoder(source_name, *(*encoders)[i].as_table(), i));
-    }
+  const toml::array* encoders = ArrayOfTables(source_name, root, "encoder");
+  for (std::size_t i = 0; encoders != nullptr && i < encoders->size(); ++i) {
+    map.encoders.push_back(ParseEncoder(source_name, *(*encoders)[i].as_table(), i));
   }
-  CheckChannelsOnce(source_name, map.pwm, "PWM");
-  CheckChannelsOnce(source_name, map.encoders, "encoder");
+  CheckChannelsOnce(source_name, pwm, map.pwm, "PWM");
+  CheckChannelsOnce(source_name, encoders, map.encoders, "encoder");
   ParseInputs(source_name, root, map);
   ParseTelemetry(source_name, root, map);
   return map;

@@ -21,46 +21,55 @@ std::string Names(const std::vector<Port>& ports) {
   return out;
 }
 
+/// A line and column in the map.
+struct Place {
+  int line = 0;
+  int column = 0;
+};
+
 /// Says where in the map and which plant, then what.
 class Binder {
  public:
   Binder(const PlantMap& map, const Plant& plant) : map_(map), plant_(plant) {}
 
-  [[noreturn]] void Fail(int line, const std::string& what) const {
-    const std::string where = line > 0 ? map_.source + ":" + std::to_string(line) : map_.source;
+  /// `at` is where the map names what is at fault (line 0: nowhere, the map as a whole).
+  [[noreturn]] void Fail(Place at, const std::string& what) const {
+    std::string where = map_.source;
+    if (at.line > 0) where += ":" + std::to_string(at.line);
+    if (at.line > 0 && at.column > 0) where += ":" + std::to_string(at.column);
     throw PlantMapError(where + ": " + what + " (plant " + plant_.Info().name + ")");
   }
 
   /// An input by name; a name that is an output or something else gets its own message.
-  std::size_t Input(const std::string& name, int line, const char* what) const {
+  std::size_t Input(const std::string& name, Place at, const char* what) const {
     const PlantInfo& info = plant_.Info();
     if (const auto i = IndexOf(info.inputs, name)) return *i;
     if (IndexOf(info.outputs, name)) {
-      Fail(line, what + std::string(" '") + name +
-                     "' is an output of the plant; only inputs can be driven (inputs: " +
-                     Names(info.inputs) + ")");
+      Fail(at, what + std::string(" '") + name +
+                   "' is an output of the plant; only inputs can be driven (inputs: " +
+                   Names(info.inputs) + ")");
     }
-    Unknown(name, line, what, "inputs", info.inputs);
+    Unknown(name, at, what, "inputs", info.inputs);
   }
 
-  std::size_t Output(const std::string& name, int line, const char* what) const {
+  std::size_t Output(const std::string& name, Place at, const char* what) const {
     const PlantInfo& info = plant_.Info();
     if (const auto i = IndexOf(info.outputs, name)) return *i;
     if (IndexOf(info.inputs, name)) {
-      Fail(line, what + std::string(" '") + name +
-                     "' is an input of the plant; only outputs can be followed (outputs: " +
-                     Names(info.outputs) + ")");
+      Fail(at, what + std::string(" '") + name +
+                   "' is an input of the plant; only outputs can be followed (outputs: " +
+                   Names(info.outputs) + ")");
     }
-    Unknown(name, line, what, "outputs", info.outputs);
+    Unknown(name, at, what, "outputs", info.outputs);
   }
 
  private:
-  [[noreturn]] void Unknown(const std::string& name, int line, const char* what,
+  [[noreturn]] void Unknown(const std::string& name, Place at, const char* what,
                             const char* kind, const std::vector<Port>& ports) const {
     const std::string known = plant_.ExplainNonPort(name);
-    Fail(line, what + std::string(" '") + name + "' " +
-                   (known.empty() ? "is not a port of the plant" : known) + " (" + kind + ": " +
-                   Names(ports) + ")");
+    Fail(at, what + std::string(" '") + name + "' " +
+                 (known.empty() ? "is not a port of the plant" : known) + " (" + kind + ": " +
+                 Names(ports) + ")");
   }
 
   const PlantMap& map_;
@@ -69,10 +78,9 @@ class Binder {
 
 void BindPwm(const Binder& b, const PlantMap& map, BoundPlantMap& out, std::vector<bool>& driven) {
   for (const PwmRoute& route : map.pwm) {
-    const std::size_t input = b.Input(route.input, route.line, "PWM channel input");
-    if (driven[input]) {
-      b.Fail(route.line, "input '" + route.input + "' is driven by two PWM channels");
-    }
+    const Place at{route.line, route.col};
+    const std::size_t input = b.Input(route.input, at, "PWM channel input");
+    if (driven[input]) b.Fail(at, "input '" + route.input + "' is driven by two PWM channels");
     driven[input] = true;
     out.pwm.push_back({static_cast<std::size_t>(route.channel - 1), input,
                        route.reverse ? -route.gain : route.gain});
@@ -81,10 +89,11 @@ void BindPwm(const Binder& b, const PlantMap& map, BoundPlantMap& out, std::vect
 
 void BindEncoder(const Binder& b, const Plant& plant, const EncoderRoute& route,
                  BoundPlantMap& out) {
-  const std::size_t output = b.Output(route.output, route.line, "encoder output");
+  const Place at{route.line, route.col};
+  const std::size_t output = b.Output(route.output, at, "encoder output");
   const std::string& unit = plant.Info().outputs[output].unit;
   if (!unit.empty() && unit != route.unit) {
-    b.Fail(route.line, "encoder output '" + route.output + "' is in " + unit +
+    b.Fail(at, "encoder output '" + route.output + "' is in " + unit +
                            " but the map says unit = \"" + route.unit +
                            "\": an encoder counts metres of travel or radians of rotation");
   }
@@ -107,13 +116,15 @@ void BindEncoder(const Binder& b, const Plant& plant, const EncoderRoute& route,
 
 void BindConstants(const Binder& b, const PlantMap& map, BoundPlantMap& out,
                    std::vector<bool>& driven) {
-  for (const auto& [name, value] : map.constant_inputs) {
-    const std::size_t input = b.Input(name, 0, "[inputs]");
+  for (const ConstantInput& constant : map.constant_inputs) {
+    const Place at{constant.line, constant.col};
+    const std::size_t input = b.Input(constant.name, at, "[inputs]");
     if (driven[input]) {
-      b.Fail(0, "[inputs] gives '" + name + "' a value but a PWM channel drives it: keep one");
+      b.Fail(at, "[inputs] gives '" + constant.name +
+                     "' a value but a PWM channel drives it: keep one");
     }
     driven[input] = true;
-    out.initial_inputs[input] = value;
+    out.initial_inputs[input] = constant.value;
   }
 }
 
@@ -121,7 +132,7 @@ void CheckEveryInputSet(const Binder& b, const Plant& plant, const std::vector<b
   const std::vector<Port>& inputs = plant.Info().inputs;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (driven[i]) continue;
-    b.Fail(0, "plant input '" + inputs[i].name +
+    b.Fail({}, "plant input '" + inputs[i].name +
                   "' is driven by no PWM channel and has no value: add a [[pwm]] entry for it, "
                   "or hold it constant with '" + inputs[i].name + " = 0.0' under [inputs]");
   }
@@ -133,7 +144,7 @@ void CheckColumnsUnique(const Binder& b, const Plant& plant, const BoundPlantMap
   for (const Port& port : plant.Info().outputs) columns.insert(port.name);
   for (const std::string& column : out.encoder_columns) {
     if (!columns.insert(column).second) {
-      b.Fail(0, "log column '" + column + "' appears twice: give the encoder another column");
+      b.Fail({}, "log column '" + column + "' appears twice: give the encoder another column");
     }
   }
 }
@@ -152,7 +163,7 @@ BoundPlantMap BindPlantMap(const PlantMap& map, const Plant& plant) {
   for (const EncoderRoute& route : map.encoders) BindEncoder(b, plant, route, out);
   if (map.pose) {
     std::array<std::size_t, 3> pose{};
-    for (std::size_t i = 0; i < 3; ++i) pose[i] = b.Output((*map.pose)[i], 0, "[telemetry] pose");
+    for (std::size_t i = 0; i < 3; ++i) pose[i] = b.Output((*map.pose)[i], {}, "[telemetry] pose");
     out.pose = pose;
   }
   CheckColumnsUnique(b, plant, out);

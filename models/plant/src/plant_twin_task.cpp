@@ -3,10 +3,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "hiltwin/io/conversions.h"
+#include "hiltwin/io/encoder_emulator.h"
 
 namespace hiltwin::plant {
+namespace {
+
+// Static reasons per board channel: the loop cannot build strings.
+#define HILTWIN_ENCODER_REASONS(what)                                                           \
+  {                                                                                             \
+    "encoder channel 1: " what, "encoder channel 2: " what, "encoder channel 3: " what,        \
+        "encoder channel 4: " what                                                              \
+  }
+constexpr const char* kHalfTurnReasons[] = HILTWIN_ENCODER_REASONS(
+    "the plant's output moved by half an encoder turn (8192 counts) or more in one period, "
+    "which the board cannot represent: lower the map's counts_per_unit or raise --rate");
+constexpr const char* kBeyondReasons[] = HILTWIN_ENCODER_REASONS(
+    "the plant's output times counts_per_unit is beyond +-2^62 counts (or not finite), which no "
+    "encoder counts: check the map's scale and the plant's output");
+#undef HILTWIN_ENCODER_REASONS
+static_assert(std::size(kHalfTurnReasons) == io::kChannels &&
+              std::size(kBeyondReasons) == io::kChannels);
+static_assert(io::kMaxRepresentablePulses == 8192, "the reasons above say 8192");
+
+}  // namespace
 
 PlantTwinTask::PlantTwinTask(io::IcoBoardInverse& board, Plant& plant, BoundPlantMap map,
                              double step_s, std::span<const double> initial_outputs)
@@ -25,11 +47,26 @@ PlantTwinTask::PlantTwinTask(io::IcoBoardInverse& board, Plant& plant, BoundPlan
   }
 }
 
-void PlantTwinTask::CountsFromOutputs() noexcept {
+runtime::StepStatus PlantTwinTask::CountsFromOutputs() noexcept {
   for (const BoundPlantMap::Encoder& e : map_.encoders) {
-    const std::int64_t counts = io::ValueToCounts(y_[e.output_index], e.counts_per_unit);
-    encoder_out_[e.channel_index] = static_cast<std::int32_t>(counts - counts_origin_[e.channel_index]);
+    const std::size_t c = e.channel_index;
+    // Counts the twin cannot hold were clamped (or zeroed) and read as standing still.
+    if (!(std::abs(y_[e.output_index] * e.counts_per_unit) < io::kMaxAbsCounts)) {
+      return runtime::StepStatus::ModelFault(kBeyondReasons[c]);
+    }
+    const std::int64_t counts =
+        io::ValueToCounts(y_[e.output_index], e.counts_per_unit) - counts_origin_[c];
+    // The 14-bit relative position cannot tell a change of half a turn or more from a smaller
+    // one the other way (docs/spi-protocol.md, "Pulse-rate limit"): the ECS would misread it.
+    const std::int64_t change = counts - counts_[c];
+    constexpr auto kHalfTurn = static_cast<std::int64_t>(io::kMaxRepresentablePulses);
+    if (change >= kHalfTurn || -change >= kHalfTurn) {
+      return runtime::StepStatus::ModelFault(kHalfTurnReasons[c]);
+    }
+    counts_[c] = counts;
+    encoder_out_[c] = static_cast<std::int32_t>(counts);
   }
+  return runtime::StepStatus::Ok();
 }
 
 io::ExchangeStatus PlantTwinTask::Exchange(bool live_outputs) noexcept {
@@ -52,8 +89,7 @@ runtime::StepStatus PlantTwinTask::Step(const scheduler::CycleContext&) noexcept
   if (!std::all_of(y_.begin(), y_.end(), [](double v) { return std::isfinite(v); })) {
     return runtime::StepStatus::ModelFault("the plant's output became non-finite (NaN or Inf)");
   }
-  CountsFromOutputs();
-  return runtime::StepStatus::Ok();
+  return CountsFromOutputs();
 }
 
 std::vector<std::string> PlantTwinTask::LogColumns() const {

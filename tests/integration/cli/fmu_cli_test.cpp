@@ -177,7 +177,8 @@ TEST_F(FmuCli, AMapThatDoesNotFitTheFmuSaysWhichVariableAndWhy) {
   const auto parameter = Run({"--plant", "fmu:" + Fmu("lag"), "--plant-map",
                               Write("k.toml", "[[pwm]]\nchannel = 1\ninput = \"K\"\n")});
   EXPECT_EQ(parameter.exit_code, 2);
-  EXPECT_THAT(parameter.err, AllOf(HasSubstr("k.toml:1"), HasSubstr("'K'"), HasSubstr("parameter")));
+  EXPECT_THAT(parameter.err, HasSubstr("k.toml:3:9: PWM channel input 'K' is a parameter of "
+                                       "lag.fmu"));
   const auto reversed = Run({"--plant", "fmu:" + Fmu("lag"), "--plant-map",
                              Write("rev.toml", "[[pwm]]\nchannel = 1\ninput = \"y\"\n")});
   EXPECT_EQ(reversed.exit_code, 2);
@@ -193,6 +194,49 @@ TEST_F(FmuCli, AMapThatDoesNotFitTheFmuSaysWhichVariableAndWhy) {
                            "--integrator", "euler"});
   EXPECT_EQ(config.exit_code, 2);
   EXPECT_THAT(config.err, HasSubstr("--integrator"));
+}
+
+// The map's [inputs] constants are set while the FMU initialises: lag_steady starts in
+// equilibrium with u = 0.5 (y = K u = 1) and stays there, so its encoder reads 0 all run. It
+// was initialised with u = 0 and rose to 1 over the run: 1000 counts of motion nothing drove.
+TEST_F(FmuCli, TheMapsConstantInputsAreSetBeforeTheFirstStep) {
+  const auto r = Run({"--plant", "fmu:" + Fmu("lag_steady"), "--plant-map",
+                      Write("steady.toml", "[[encoder]]\nchannel = 1\noutput = \"y\"\n"
+                                           "unit = \"rad\"\ncounts_per_unit = 1000\n"
+                                           "[inputs]\nu = 0.5\n"),
+                      "--rate", "1000", "--duration", "0.5", "--log", Path("steady.csv")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CsvTable log = hiltwin::test::ReadCsvTable(Path("steady.csv"));
+  ASSERT_EQ(log.rows.size(), 500U);
+  const std::size_t y = Column(log, "y");
+  const std::size_t enc = Column(log, "enc1");
+  for (const std::vector<double>& row : log.rows) {
+    ASSERT_EQ(row[y], 1.0) << "t = " << row[0];
+    ASSERT_EQ(row[enc], 0.0) << "t = " << row[0];
+  }
+}
+
+// An FMU that fails while starting is a plant error, not a --rate one: --rate was not given.
+TEST_F(FmuCli, AStartErrorNamesThePlantNotTheRate) {
+  const auto r = Run({"--plant", "fmu:" + Fmu("bad_init"), "--plant-map",
+                      Write("lag.toml", kLagMap)});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("hiltwin run: --plant fmu:" + Fmu("bad_init") + ": " +
+                                     Fmu("bad_init") + ": fmi2ExitInitializationMode returned "
+                                     "fmi2Error while starting the FMU"),
+                           ::testing::Not(HasSubstr("--rate"))));
+}
+
+// A scale the board cannot follow is refused on the FMU side too (1e15 counts per radian ran
+// and passed with wrapped counts).
+TEST_F(FmuCli, AnEncoderScaleBeyondTheBoardIsRefused) {
+  const auto r = Run({"--plant", "fmu:" + Fmu("lag"), "--plant-map",
+                      Write("huge.toml", "[[pwm]]\nchannel = 1\ninput = \"u\"\n[[encoder]]\n"
+                                         "channel = 1\noutput = \"y\"\nunit = \"rad\"\n"
+                                         "counts_per_unit = 1e15\n")});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("huge.toml:8:19: [[encoder]] #1: 1e+15 counts per rad is more "
+                               "than 2.5e+07, the most counts the board emits in a second"));
 }
 
 }  // namespace

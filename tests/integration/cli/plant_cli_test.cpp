@@ -78,7 +78,8 @@ TEST_F(PlantCli, ABadMapIsRefusedWithItsLineBeforeAnythingRuns) {
                                 "[[pwm]]\nchannel = 1\ninput = \"wheel_right_m\"\n");
   const auto r = Run({"--plant-map", map, "--log", Path("never.csv")});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_THAT(r.err, AllOf(HasSubstr(map + ":4"), HasSubstr("'wheel_right_m' is an output")));
+  // The line and column of the input key at fault, not of its [[pwm]] header (line 4).
+  EXPECT_THAT(r.err, AllOf(HasSubstr(map + ":6:9: "), HasSubstr("'wheel_right_m' is an output")));
   EXPECT_FALSE(fs::exists(Path("never.csv")));
   const std::string unset = Write("unset.toml", "[[pwm]]\nchannel = 2\ninput = \"duty_left\"\n");
   EXPECT_THAT(Run({"--plant-map", unset}).err,

@@ -298,6 +298,23 @@ TEST_F(FmuRefused, DanglingModelStructureIndicesAreRefusedWithTheirLine) {
   EXPECT_TRUE(NothingLeftBehind());
 }
 
+// A name that is a variable of another causality is explained with the right article.
+TEST_F(FmuRefused, NonPortsAreExplainedByTheirCausality) {
+  const std::string xml = LagDescriptionWith(
+      "  </ModelVariables>",
+      "    <ScalarVariable name=\"time\" valueReference=\"8\" causality=\"independent\">"
+      "<Real/></ScalarVariable>\n"
+      "    <ScalarVariable name=\"energy\" valueReference=\"9\"><Real/></ScalarVariable>\n"
+      "  </ModelVariables>");
+  const auto plant = OpenFmu(MakeZip("vars.fmu", {{"modelDescription.xml", xml}}, TestFmu("lag")));
+  EXPECT_EQ(plant->ExplainNonPort("time"),
+            "is the independent variable of vars.fmu (causality \"independent\"); only inputs "
+            "can be driven and outputs followed");
+  EXPECT_EQ(plant->ExplainNonPort("energy"),
+            "is a local variable of vars.fmu (causality \"local\"); only inputs can be driven "
+            "and outputs followed");
+}
+
 TEST(FmuArchive, SafeEntryNames) {
   EXPECT_TRUE(IsSafeEntryName("modelDescription.xml"));
   EXPECT_TRUE(IsSafeEntryName("binaries/linux64/lag.so"));

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fakes/alloc_counter.h"
+#include "hiltwin/plant/plant_map.h"
 #include "test_fmus.h"
 
 namespace hiltwin::fmi {
@@ -61,15 +62,50 @@ TEST(FmuInfo, MsdUnitsIncludingADeclaredType) {
   EXPECT_DOUBLE_EQ(info.model_step_s, 0.0005);
 }
 
+// Plant::ExplainNonPort says what follows the name: the map error quotes the name itself.
 TEST(FmuInfo, ExplainNonPortNamesParametersAndNonRealVariables) {
   const auto plant = OpenFmu(TestFmu("lag"));
   EXPECT_EQ(plant->ExplainNonPort("K"),
-            "'K' is a parameter of lag.fmu (causality \"parameter\"); only inputs can be "
-            "driven and outputs followed");
+            "is a parameter of lag.fmu (causality \"parameter\"); only inputs can be driven and "
+            "outputs followed");
   EXPECT_EQ(plant->ExplainNonPort("steps"),
-            "'steps' is an Integer variable of lag.fmu; only Real ports can be mapped");
+            "is an Integer variable of lag.fmu; only Real ports can be mapped");
   EXPECT_EQ(plant->ExplainNonPort("u"), "");  // a port: nothing to explain
   EXPECT_EQ(plant->ExplainNonPort("nope"), "");
+}
+
+// The map error names the variable once ('K' 'K' is a parameter ... before).
+TEST(FmuInfo, AMapErrorNamesTheVariableOnce) {
+  const auto plant = OpenFmu(TestFmu("lag"));
+  try {
+    static_cast<void>(plant::BindPlantMap(
+        plant::ParsePlantMap("[[pwm]]\nchannel = 1\ninput = \"K\"\n", "map.toml"), *plant));
+    FAIL() << "bound";
+  } catch (const plant::PlantMapError& e) {
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("map.toml:3:9: PWM channel input 'K' is a parameter of "
+                                          "lag.fmu (causality \"parameter\")"),
+                                ::testing::Not(HasSubstr("'K' 'K'"))));
+  }
+}
+
+// The plant map's [inputs] constants are the inputs during initialisation: an FMU initialised
+// in equilibrium with its input starts at K u and stays there (it started at 0 and rose).
+TEST(FmuPlantStart, TheInitialInputsAreSetDuringInitialisation) {
+  const auto plant = OpenFmu(TestFmu("lag_steady"));
+  const std::array<double, 1> u{0.5};
+  plant->SetInitialInputs(u);
+  std::array<double, 1> y{-1.0};
+  plant->Start(kStepS, y);
+  EXPECT_EQ(y[0], test::kLagGain * 0.5);
+  for (int k = 1; k <= 100; ++k) {
+    ASSERT_TRUE(plant->Step(u, y).ok());
+    ASSERT_NEAR(y[0], test::kLagGain * 0.5, 1e-12) << "step " << k;
+  }
+  plant->Reset(y);
+  EXPECT_EQ(y[0], test::kLagGain * 0.5);
+  const auto zero = OpenFmu(TestFmu("lag_steady"));  // without initial inputs: u = 0
+  zero->Start(kStepS, y);
+  EXPECT_EQ(y[0], 0.0);
 }
 
 TEST(FmuPlantOpen, CommandLineOptionsAnFmuCannotUseAreRefused) {

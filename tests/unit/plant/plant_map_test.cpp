@@ -74,7 +74,8 @@ TEST(PlantMap, ParsesEveryKey) {
   EXPECT_EQ(map.pwm[0].input, "force_n");
   EXPECT_EQ(map.pwm[0].gain, 10.0);
   EXPECT_TRUE(map.pwm[0].reverse);
-  EXPECT_EQ(map.pwm[0].line, 2);
+  EXPECT_EQ(map.pwm[0].line, 4);  // where it names its input
+  EXPECT_EQ(map.pwm[0].col, 9);
   ASSERT_EQ(map.encoders.size(), 2U);
   // 1024 counts per shaft turn, the shaft turns 4 times per output radian's turn.
   EXPECT_DOUBLE_EQ(map.encoders[0].counts_per_unit, 1024.0 * 4.0 / (2.0 * std::numbers::pi));
@@ -84,8 +85,9 @@ TEST(PlantMap, ParsesEveryKey) {
   EXPECT_EQ(map.encoders[1].column, "enc_pos");
   EXPECT_TRUE(map.encoders[1].reverse);
   ASSERT_EQ(map.constant_inputs.size(), 1U);
-  EXPECT_EQ(map.constant_inputs[0].first, "load_n");
-  EXPECT_EQ(map.constant_inputs[0].second, 2.5);
+  EXPECT_EQ(map.constant_inputs[0].name, "load_n");
+  EXPECT_EQ(map.constant_inputs[0].value, 2.5);
+  EXPECT_EQ(map.constant_inputs[0].line, 25);
   ASSERT_TRUE(map.pose.has_value());
   EXPECT_EQ((*map.pose)[0], "position_m");
 }
@@ -101,13 +103,13 @@ TEST(PlantMap, MetresFromAShaftEncoderUseTheWheelRadius) {
 
 TEST(PlantMap, MistakesAreRefusedWithTheLineAndAFix) {
   EXPECT_THAT(ParseError("[[pwm]]\nchannel = 1\ninput = \"u\"\ngian = 2\n"),
-              AllOf(HasSubstr("map.toml:4"), HasSubstr("unknown key 'gian'"), HasSubstr("gain")));
+              AllOf(HasSubstr("map.toml:4:1"), HasSubstr("unknown key 'gian'"), HasSubstr("gain")));
   EXPECT_THAT(ParseError("[[pwm]]\nchannel = 5\ninput = \"u\"\n"),
               AllOf(HasSubstr("map.toml:2"), HasSubstr("1..4")));
   EXPECT_THAT(ParseError("[[pwm]]\ninput = \"u\"\n"), HasSubstr("has no 'channel'"));
   EXPECT_THAT(ParseError("[[pwm]]\nchannel = 1\ninput = \"u\"\n[[pwm]]\nchannel = 1\ninput = "
                          "\"v\"\n"),
-              AllOf(HasSubstr("map.toml:4"), HasSubstr("channel 1 is mapped twice")));
+              AllOf(HasSubstr("map.toml:5:11"), HasSubstr("channel 1 is mapped twice")));
   EXPECT_THAT(ParseError("[[pwm]]\nchannel = 1\ninput = \"u\"\ngain = 0\n"),
               HasSubstr("gain 0 would disconnect"));
   EXPECT_THAT(ParseError("[[encoder]]\nchannel = 1\noutput = \"y\"\nunit = \"deg\"\n"
@@ -125,6 +127,62 @@ TEST(PlantMap, MistakesAreRefusedWithTheLineAndAFix) {
   EXPECT_THAT(ParseError("[telemetry]\npose = [\"x\"]\n"), HasSubstr("three outputs"));
   EXPECT_THAT(ParseError("[[pwm]\n"), AllOf(HasSubstr("map.toml:1"), HasSubstr("not valid TOML")));
   EXPECT_THAT(ParseError("[inputs]\nload = \"high\"\n"), HasSubstr("finite number"));
+}
+
+// Every message names the line and column of the key at fault, not its [[pwm]] or [[encoder]]
+// header; binding names the input or output key's own place, and [inputs] the constant's.
+TEST(PlantMap, ErrorsNameTheOffendingKeysLineAndColumn) {
+  EXPECT_THAT(ParseError("[[pwm]]\nchannel = 1\ninput = \"u\"\ngain = 0\n"),
+              HasSubstr("map.toml:4:8: [[pwm]] #1: gain 0 would disconnect"));
+  EXPECT_THAT(ParseError("[[pwm]]\nchannel = 1\ninput = \"u\"\n[[pwm]]\ninput = \"v\"\n"
+                         "channel = 1\n"),
+              HasSubstr("map.toml:6:11: PWM channel 1 is mapped twice"));
+  EXPECT_THAT(ParseError("[[encoder]]\nchannel = 1\noutput = \"y\"\nunit = \"rad\"\n"
+                         "counts_per_unit = 1\ncounts_per_rev = 4\n"),
+              HasSubstr("map.toml:6:18: [[encoder]] #1 gives both counts_per_unit and "
+                        "counts_per_rev: keep one"));
+  const FakePlant plant = ThreePortPlant();
+  EXPECT_THAT(BindError("[[pwm]]\nchannel = 1\ninput = \"position_m\"\n[inputs]\nload_n = 0\n",
+                        plant),
+              HasSubstr("map.toml:3:9: PWM channel input 'position_m' is an output"));
+  EXPECT_THAT(BindError("[[encoder]]\nchannel = 1\nunit = \"m\"\ncounts_per_unit = 1\n"
+                        "output = \"force_n\"\n[inputs]\nforce_n = 0\nload_n = 0\n",
+                        plant),
+              HasSubstr("map.toml:5:10: encoder output 'force_n' is an input"));
+  EXPECT_THAT(BindError("[inputs]\nforce_n = 0\n  load_n = 0\nnope = 1\n", plant),
+              HasSubstr("map.toml:4:8: [inputs] 'nope' is not a port of the plant"));
+  EXPECT_THAT(BindError("[[pwm]]\nchannel = 1\ninput = \"force_n\"\n[inputs]\nforce_n = 1\n"
+                        "load_n = 0\n",
+                        plant),
+              HasSubstr("map.toml:5:11: [inputs] gives 'force_n' a value but a PWM channel "
+                        "drives it"));
+}
+
+// A negative scale is refused (reverse = true says the direction); so is an encoder scale
+// beyond the most counts the board emits in a second (100 MHz over its smallest clock divider,
+// 4: 25 M), at which it could not follow the output moving one unit per second: a wheel radius
+// of 1e-200 m made the encoder read 0 all run while the wheel moved.
+TEST(PlantMap, NegativeScalesAndScalesBeyondTheBoardsCountRateAreRefused) {
+  EXPECT_THAT(ParseError("[[pwm]]\nchannel = 1\ninput = \"u\"\ngain = -2\n"),
+              HasSubstr("map.toml:4:8: [[pwm]] #1: gain -2 is negative: give its size and "
+                        "reverse = true"));
+  const std::string encoder = "[[encoder]]\nchannel = 1\noutput = \"y\"\n";
+  EXPECT_THAT(ParseError(encoder + "unit = \"rad\"\ncounts_per_unit = -5\n"),
+              HasSubstr("map.toml:5:19: [[encoder]] #1: counts_per_unit -5 is negative: give "
+                        "its size and reverse = true"));
+  EXPECT_THAT(ParseError(encoder + "unit = \"rad\"\ncounts_per_unit = 1e15\n"),
+              HasSubstr("map.toml:5:19: [[encoder]] #1: 1e+15 counts per rad is more than "
+                        "2.5e+07, the most counts the board emits in a second"));
+  EXPECT_THAT(ParseError(encoder + "unit = \"m\"\ncounts_per_rev = 64\ngear_ratio = 50\n"
+                                   "wheel_radius_m = 1e-200\n"),
+              HasSubstr("map.toml:7:18: [[encoder]] #1: 5.09296e+202 counts per m is more than "
+                        "2.5e+07"));
+  EXPECT_THAT(ParseError(encoder + "unit = \"rad\"\ncounts_per_rev = 1e300\ngear_ratio = 1e300\n"),
+              HasSubstr("map.toml:6:14: [[encoder]] #1: inf counts per rad"));
+  EXPECT_EQ(ParsePlantMap(encoder + "unit = \"rad\"\ncounts_per_unit = 2.5e7\n", "m.toml")
+                .encoders[0]
+                .counts_per_unit,
+            kMaxCountsPerUnit);
 }
 
 // Found by fuzz/toml_config (fuzz/corpus/toml_config/regression_float_channel.toml): a float
@@ -173,7 +231,7 @@ TEST(PlantMap, BindingRefusesWhatThePlantCannotDo) {
   const std::string enc = "[[encoder]]\nchannel = 1\nunit = \"m\"\ncounts_per_unit = 1\n";
   const std::string load = "[inputs]\nload_n = 0\n";
   EXPECT_THAT(BindError("[[pwm]]\nchannel = 1\ninput = \"position_m\"\n" + load, plant),
-              AllOf(HasSubstr("map.toml:1"), HasSubstr("is an output of the plant"),
+              AllOf(HasSubstr("map.toml:3:9"), HasSubstr("is an output of the plant"),
                     HasSubstr("inputs: force_n, load_n"), HasSubstr("plant fake")));
   EXPECT_THAT(BindError(enc + "output = \"force_n\"\n[[pwm]]\nchannel = 1\ninput = \"force_n\"\n" +
                             load,

@@ -159,6 +159,35 @@ TEST(PlantTwinTask, FaultsFinishesAndNonFiniteOutputsBecomeStepStatuses) {
   EXPECT_EQ(nan.task->encoder_next()[1], 0);  // no count computed from a NaN
 }
 
+// The board represents a change of less than half an encoder turn (8192 counts) per period;
+// more aliases into a change the other way. 10 m per step at 1000 counts per metre is a model
+// fault naming the channel, not counts the ECS misreads (it ran and passed before).
+TEST(PlantTwinTask, AChangeOfHalfAnEncoderTurnInOnePeriodIsAModelFault) {
+  Rig fast(/*initial=*/0.0, {0, 0, 0, 0});
+  fast.plant.slope = 10.0;
+  const runtime::StepStatus status = fast.Cycle(0);
+  EXPECT_EQ(status.code, runtime::StepStatus::Code::kModelFault);
+  EXPECT_STREQ(status.reason,
+               "encoder channel 2: the plant's output moved by half an encoder turn (8192 counts) "
+               "or more in one period, which the board cannot represent: lower the map's "
+               "counts_per_unit or raise --rate");
+  Rig slow(/*initial=*/0.0, {0, 0, 0, 0});
+  slow.plant.slope = 8.0;  // 8000 counts per step: just inside
+  EXPECT_EQ(slow.Cycle(0).code, runtime::StepStatus::Code::kOk);
+}
+
+// Counts of a finite output that leave what the twin holds (here 1e300 m at 1000 counts per
+// metre) are a model fault: they were clamped, and the encoder read 0 all run.
+TEST(PlantTwinTask, CountsBeyondWhatTheTwinHoldsAreAModelFault) {
+  Rig far(/*initial=*/1e300, {0, 0, 0, 0});
+  const runtime::StepStatus status = far.Cycle(0);
+  EXPECT_EQ(status.code, runtime::StepStatus::Code::kModelFault);
+  EXPECT_STREQ(status.reason,
+               "encoder channel 2: the plant's output times counts_per_unit is beyond +-2^62 "
+               "counts (or not finite), which no encoder counts: check the map's scale and the "
+               "plant's output");
+}
+
 TEST(PlantTwinTask, SafeExchangesRepeatTheLastCountsSent) {
   Rig rig;
   for (std::uint64_t k = 0; k < 5; ++k) ASSERT_EQ(rig.Cycle(k).code, runtime::StepStatus::Code::kOk);

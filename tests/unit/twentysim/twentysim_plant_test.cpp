@@ -116,7 +116,7 @@ TEST(TwentySimPlant, StartAtAnotherStepSaysWhichRateToUse) {
   try {
     plant->Start(0.00025, y0);  // --rate 4000
     FAIL() << "a 4 kHz step was accepted by a model generated for 1 kHz";
-  } catch (const PlantError& e) {
+  } catch (const PlantStepError& e) {  // a step error: the command line names --rate
     const std::string message = e.what();
     EXPECT_THAT(message, HasSubstr("--rate 4000 Hz gives a step of 0.00025 s"));
     EXPECT_THAT(message, HasSubstr("the 20-sim plant 'msd20sim' was generated for a step of "
@@ -128,6 +128,36 @@ TEST(TwentySimPlant, StartAtAnotherStepSaysWhichRateToUse) {
   EXPECT_THROW(plant->Start(kStepS + 2e-9, y0), PlantError);
   // ...one within it is the same step.
   EXPECT_NO_THROW(plant->Start(kStepS + 0.4e-9, y0));
+}
+
+/// A 20-sim-shaped submodel whose output is twice its input at once (direct feedthrough).
+struct Doubler {
+  double m_step_size = 0.001;
+  void Initialize(double* u, double* y, double /*t*/) { y[0] = 2.0 * u[0]; }
+  void Calculate(double* u, double* y) { y[0] = 2.0 * u[0]; }
+  void Terminate(double* /*u*/, double* /*y*/) {}
+  void SetFinishTime(double /*t*/) {}
+  [[nodiscard]] bool IsFinished() const { return false; }
+};
+
+// Initialize gets the plant map's constant inputs, so an output that follows an input at once
+// starts where the first step continues (it was computed with u = 0 and jumped in step 1).
+TEST(TwentySimPlant, InitializeIsGivenTheInitialInputs) {
+  TwentySimPlantSpec spec;
+  spec.plant_name = "doubler";
+  spec.class_name = "Doubler";
+  spec.inputs = {{"u", "1"}};
+  spec.outputs = {{"y", "1"}};
+  TwentySimPlant<Doubler> plant(spec);
+  const std::array<double, 1> u0{0.25};
+  plant.SetInitialInputs(u0);
+  std::array<double, 1> y{};
+  plant.Start(kStepS, y);
+  EXPECT_EQ(y[0], 0.5);
+  ASSERT_TRUE(plant.Step(u0, y).ok());
+  EXPECT_EQ(y[0], 0.5);
+  plant.Reset(y);
+  EXPECT_EQ(y[0], 0.5);
 }
 
 TEST(TwentySimPlant, SuggestedRateMeetsTheStepAtWholeNanoseconds) {

@@ -49,9 +49,12 @@ struct WheelGeometry {
 /// Encoder counts per metre of wheel travel for `geometry`.
 [[nodiscard]] double CountsPerMetre(const WheelGeometry& geometry) noexcept;
 
+/// The largest magnitude of absolute encoder counts: ValueToCounts clamps to ±kMaxAbsCounts.
+constexpr double kMaxAbsCounts = 4.611686018427387904e18;  // 2^62
+
 /// A plant output to absolute encoder counts: floor(value · counts_per_unit), the one rule
 /// every encoder channel uses (plant maps, plant/plant_map.h). Non-finite results give 0;
-/// results are clamped to ±2^62.
+/// results are clamped to ±kMaxAbsCounts.
 [[nodiscard]] std::int64_t ValueToCounts(double value, double counts_per_unit) noexcept;
 
 /// Wheel travel in metres to absolute encoder counts, floored: appendix G truncates towards

@@ -47,6 +47,14 @@ class PlantError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A PlantError about the step Start was given: the plant cannot run at that rate (a 20-sim
+/// model generated for another step, a step the RELbot's integrator cannot keep stable). The
+/// command line names --rate for these, and the plant for every other PlantError.
+class PlantStepError : public PlantError {
+ public:
+  using PlantError::PlantError;
+};
+
 /// How one step ended. `reason` is static text (the real-time path cannot build strings).
 struct PlantStatus {
   enum class Code : std::uint8_t {
@@ -71,10 +79,19 @@ class Plant {
 
   [[nodiscard]] virtual const PlantInfo& Info() const noexcept = 0;
 
+  /// Not real-time; before Start. The inputs the plant holds until its first Step
+  /// (Info().inputs.size() values): the plant map's [inputs] constants, and 0 for the inputs a
+  /// PWM channel drives (no board value exists yet). Start and Reset initialise the model with
+  /// them, so an output that follows a constant input at once, or a state initialised in
+  /// equilibrium with it, starts where the first step continues instead of jumping there. The
+  /// default ignores them: right for a plant whose initial outputs do not depend on its inputs.
+  virtual void SetInitialInputs(std::span<const double> u0) { static_cast<void>(u0); }
+
   /// Not real-time. Makes the plant ready to step every `step_s` seconds from model time 0 and
-  /// writes its initial outputs into `y0` (Info().outputs.size() values). Throws PlantError
-  /// when it cannot run at that step (a 20-sim model built for another step, a step the
-  /// RELbot's integrator cannot keep stable) or cannot start (an FMU whose initialisation fails).
+  /// writes its initial outputs into `y0` (Info().outputs.size() values). Throws
+  /// PlantStepError when it cannot run at that step (a 20-sim model built for another step, a
+  /// step the RELbot's integrator cannot keep stable) and PlantError when it cannot start (an
+  /// FMU whose initialisation fails).
   virtual void Start(double step_s, std::span<double> y0) = 0;
 
   /// Real-time. Advances one step with the inputs `u` held over it (Info().inputs.size()
@@ -90,7 +107,9 @@ class Plant {
   virtual void Finish() noexcept {}
 
   /// Why `name` is not one of the plant's ports, when the plant knows the name as something
-  /// else (an FMU parameter, an Integer variable): used in plant-map errors. Empty otherwise.
+  /// else (an FMU parameter, an Integer variable): used in plant-map errors, which quote the
+  /// name before it, so it starts with the verb ("is a parameter of lag.fmu ..."). Empty
+  /// otherwise.
   [[nodiscard]] virtual std::string ExplainNonPort(std::string_view name) const {
     static_cast<void>(name);
     return {};

@@ -35,6 +35,8 @@
 #include <utility>
 #include <vector>
 
+#include "hiltwin/io/conversions.h"
+#include "hiltwin/io/encoder_emulator.h"
 #include "hiltwin/plant/plant.h"
 
 namespace hiltwin::plant {
@@ -45,13 +47,21 @@ class PlantMapError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The largest encoder scale a map may give, in counts per unit of the output (m or rad): the
+/// most counts the board's encoder emulator emits in a second, 100 MHz over its smallest clock
+/// divider (4), 25 M (docs/spi-protocol.md, "Pulse-rate limit"). At a larger scale the board
+/// could not follow the output moving even one unit per second.
+constexpr double kMaxCountsPerUnit =
+    static_cast<double>(io::kFpgaClockHz) / static_cast<double>(io::kMinClockDivider);
+
 /// A PWM channel driving a plant input: u[input] = gain * duty (negated when reversed).
 struct PwmRoute {
   int channel = 0;  ///< board channel, 1..4
   std::string input;
-  double gain = 1.0;
+  double gain = 1.0;  ///< > 0; the direction is `reverse`
   bool reverse = false;
-  int line = 0;  ///< where in the map, for messages
+  int line = 0;  ///< where the map names the input (its `input` key), for messages; 0: nowhere
+  int col = 0;
 };
 
 /// An encoder channel following a plant output: counts = floor(y * counts_per_unit) (negated
@@ -66,7 +76,16 @@ struct EncoderRoute {
   std::string joint;   ///< telemetry joint name; "" = not published
   /// Radius that turns the output into a wheel angle or travel for telemetry (0: unknown).
   double wheel_radius_m = 0.0;
-  int line = 0;
+  int line = 0;  ///< where the map names the output (its `output` key); 0: nowhere
+  int col = 0;
+};
+
+/// A plant input no PWM channel drives, held at a constant ([inputs] name = value).
+struct ConstantInput {
+  std::string name;
+  double value = 0.0;
+  int line = 0;  ///< where in the map, for messages
+  int col = 0;
 };
 
 /// A parsed map, not yet checked against a plant.
@@ -74,13 +93,14 @@ struct PlantMap {
   std::string source;  ///< the file, or "the built-in map of <plant>"
   std::vector<PwmRoute> pwm;
   std::vector<EncoderRoute> encoders;
-  std::vector<std::pair<std::string, double>> constant_inputs;  ///< [inputs]
+  std::vector<ConstantInput> constant_inputs;                   ///< [inputs]
   std::optional<std::array<std::string, 3>> pose;               ///< [telemetry] pose: x, y, theta
 };
 
 /// Parses a map. `source_name` names it in messages. Unknown keys, a channel outside 1..4, a
-/// channel used twice, a non-finite or zero scale, an encoder without a scale or with two,
-/// an unknown unit are refused with file:line.
+/// channel used twice, a non-finite, zero or negative scale, an encoder scale above
+/// kMaxCountsPerUnit, an encoder without a scale or with two, an unknown unit are refused with
+/// file:line:column of the key at fault (of the table when a key is missing).
 [[nodiscard]] PlantMap ParsePlantMap(std::string_view toml_text, std::string_view source_name);
 /// Reads and parses a map file; an unreadable file is a PlantMapError naming it.
 [[nodiscard]] PlantMap LoadPlantMap(const std::filesystem::path& path);
@@ -116,7 +136,8 @@ struct BoundPlantMap {
 /// Checks `map` against `plant`'s ports: every name exists with the right causality (an
 /// output cannot be driven, an input cannot be followed), units agree, every plant input is
 /// driven by a PWM channel or given a constant in [inputs], log columns are unique. Throws
-/// PlantMapError saying which entry, where, and what exists instead.
+/// PlantMapError saying which entry, where (the line and column of the name at fault), and
+/// what exists instead.
 [[nodiscard]] BoundPlantMap BindPlantMap(const PlantMap& map, const Plant& plant);
 
 }  // namespace hiltwin::plant

@@ -55,7 +55,9 @@ class PlantTwinTask final : public runtime::RunTask {
   [[nodiscard]] const BoundPlantMap& map() const noexcept { return map_; }
 
  private:
-  void CountsFromOutputs() noexcept;
+  /// The counts of the last step's outputs into encoder_out_; a model fault when they cannot
+  /// be represented (beyond kMaxAbsCounts, or half an encoder turn since the last step).
+  runtime::StepStatus CountsFromOutputs() noexcept;
 
   io::IcoBoardInverse& board_;
   Plant& plant_;
@@ -65,6 +67,7 @@ class PlantTwinTask final : public runtime::RunTask {
   std::vector<double> u_;
   std::vector<double> y_;
   std::array<std::int64_t, io::kChannels> counts_origin_{};  ///< counts of the initial outputs
+  std::array<std::int64_t, io::kChannels> counts_{};  ///< of the last step, from the origin
   std::array<std::int32_t, io::kChannels> encoder_out_{};   ///< computed by the last step
   std::array<std::int32_t, io::kChannels> encoder_sent_{};  ///< on the wire last
   std::uint64_t steps_ = 0;

@@ -182,6 +182,16 @@ class TwentySimPlant final : public Plant {
 
   [[nodiscard]] const PlantInfo& Info() const noexcept override { return info_; }
 
+  /// Held for Start and Reset: Initialize computes the initial outputs from them.
+  void SetInitialInputs(std::span<const double> u0) override {
+    if (u0.size() != spec_.inputs.size()) {
+      throw PlantError("the 20-sim plant '" + spec_.plant_name + "' has " +
+                       std::to_string(spec_.inputs.size()) + " inputs, SetInitialInputs was " +
+                       "given " + std::to_string(u0.size()) + " values");
+    }
+    initial_u_.assign(u0.begin(), u0.end());
+  }
+
   void Start(double step_s, std::span<double> y0) override {
     CheckStep(step_s);
     if (y0.size() != spec_.outputs.size()) {
@@ -191,6 +201,7 @@ class TwentySimPlant final : public Plant {
     }
     if (!fresh_) Rebuild();  // a second Start begins from the constructor's state again
     std::fill(u_buf_.begin(), u_buf_.end(), 0.0);
+    std::copy(initial_u_.begin(), initial_u_.end(), u_buf_.begin());
     std::fill(y_buf_.begin(), y_buf_.end(), 0.0);
     // Initialise here, not in the first Step. The generated Calculate() initialises on its
     // first call (state initialrun: Initialize(u, y, 0.0), no integration) and integrates only
@@ -198,7 +209,8 @@ class TwentySimPlant final : public Plant {
     // time, and every output would lag the board by one period. Calling Initialize ourselves
     // moves the class to `mainrun`, so every Calculate() is one real step of m_step_size. It
     // also keeps the integrator's new[] (RungeKutta4's work arrays) out of the real-time path.
-    // No board inputs exist yet: the initial outputs are computed with u = 0.
+    // No board inputs exist yet: the initial outputs are computed with the plant map's
+    // constants (SetInitialInputs) and 0 for the PWM-driven inputs.
     model_->Initialize(u_buf_.data(), y_buf_.data(), 0.0);
     // Again after Initialize (Rebuild set it before): should a 20-sim version set m_finish_time
     // there, ours still wins, and "0 = endless" holds whatever the generator compiled in.
@@ -288,12 +300,12 @@ class TwentySimPlant final : public Plant {
     }
     using twentysim_detail::FormatNumber;
     const std::string step_text = FormatNumber(step_s, 9);
-    throw PlantError("--rate " + FormatNumber(1.0 / step_s, 6) + " Hz gives a step of " +
-                     step_text + " s but the 20-sim plant '" + spec_.plant_name +
-                     "' was generated for a step of " + FormatNumber(model_step_s_, 9) +
-                     " s (m_step_size in " + spec_.class_name + ".cpp): run at --rate " +
-                     twentysim_detail::RateForStep(model_step_s_) +
-                     ", or regenerate the code with step size " + step_text + " s");
+    throw PlantStepError("--rate " + FormatNumber(1.0 / step_s, 6) + " Hz gives a step of " +
+                         step_text + " s but the 20-sim plant '" + spec_.plant_name +
+                         "' was generated for a step of " + FormatNumber(model_step_s_, 9) +
+                         " s (m_step_size in " + spec_.class_name + ".cpp): run at --rate " +
+                         twentysim_detail::RateForStep(model_step_s_) +
+                         ", or regenerate the code with step size " + step_text + " s");
   }
 
   void CheckInitialOutputs() {  // not const: 20-sim's IsFinished() is not
@@ -325,6 +337,7 @@ class TwentySimPlant final : public Plant {
   double model_step_s_ = 0.0;
   std::optional<Submodel> model_;  // rebuilt by Reset: the generated class has no re-init
   std::vector<double> u_buf_;      // sized once: Step copies u here (XXDouble*, not const)
+  std::vector<double> initial_u_;  // SetInitialInputs' values; empty: all 0
   std::vector<double> y_buf_;      // the last outputs, kept over the finished state
   double step_s_ = 0.0;            // of the last Start; 0 before it
   bool fresh_ = true;              // constructed and not yet initialised
