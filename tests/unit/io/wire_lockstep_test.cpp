@@ -26,6 +26,7 @@
 #include "fakes/alloc_counter.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
+#include "wire_poll.h"
 #include "hiltwin/io/wire_segment.h"
 #include "hiltwin/kernel_glue/shared_memory.h"
 
@@ -196,22 +197,13 @@ TEST(WireLockstep, AStoppedPeerReleasesTheWaiterWhoseExchangeThenSaysWhy) {
   EXPECT_STREQ(status.peer_stopped, "wire: the ECS finished its run");
 }
 
-/// Polls until the peer is up (at most 10 s); true when it is.
-bool UpBeside(WireBus& bus) {
-  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
-  while (bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return bus.Poll().result == BusResult::kOk;
-}
-
 /// A child process that attaches as the ECS in lockstep, comes up, takes its turn at 1 ms and
 /// then holds it, only polling (alive, beating, but never releasing the time) until signalled.
 pid_t StartPollingEcs(const std::string& name) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
-    if (!UpBeside(ecs)) ::_exit(1);
+    if (!PollUntilUp(ecs)) ::_exit(1);
     ecs.lockstep_clock()->SleepUntilNs(1'000'000);
     for (;;) {
       static_cast<void>(ecs.Poll());
@@ -225,7 +217,7 @@ pid_t StartPollingEcs(const std::string& name) {
 pid_t StartHoldingEcsBeside(const std::string& name, WireBus& twin_bus, IcoBoardInverse& twin) {
   const pid_t child = StartPollingEcs(name);
   if (child <= 0) return -1;
-  if (!UpBeside(twin_bus) || !twin.Init(250'000).ok) {
+  if (!PollUntilUp(twin_bus) || !twin.Init(250'000).ok) {
     ::kill(child, SIGKILL);
     ::waitpid(child, nullptr, 0);
     return -1;
@@ -285,14 +277,14 @@ TEST(WireLockstep, APeerWhoseSetUpOutlastsTheHeartbeatTimeoutIsWaitedFor) {
   const pid_t child = ::fork();
   if (child == 0) {
     WireBus ecs(name, Image::kIcoboard, {}, WireClock::kLockstep);
-    if (!UpBeside(ecs)) ::_exit(1);
+    if (!PollUntilUp(ecs)) ::_exit(1);
     std::this_thread::sleep_for(std::chrono::nanoseconds(2 * kWireLockstepHeartbeatTimeoutNs));
     ecs.lockstep_clock()->SleepUntilNs(1'000'000);  // its loop's first wait, after a slow set-up
     ecs.AnnounceStop(StopCause::kFinished);
     ::_exit(0);
   }
   ASSERT_GT(child, 0);
-  ASSERT_TRUE(UpBeside(twin_bus));
+  ASSERT_TRUE(PollUntilUp(twin_bus));
   IcoBoardInverse twin(twin_bus);
   ASSERT_TRUE(twin.Init(250'000).ok);
   twin_bus.lockstep_clock()->SleepUntilNs(250'000);  // held by the ECS's set-up, then its turn

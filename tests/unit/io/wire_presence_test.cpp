@@ -17,6 +17,7 @@
 
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/io/wire_bus.h"
+#include "wire_poll.h"
 
 namespace hiltwin::io {
 namespace {
@@ -27,15 +28,6 @@ std::string FreshPresenceName(const char* tag) {
   const std::string name = std::string("utest-here-") + tag + "-" + std::to_string(::getpid());
   WireBus::Unlink(name);
   return name;
-}
-
-/// Polls until the peer is up (at most 10 s); true when it is.
-bool PollUntilUp(WireBus& bus) {
-  const Wall::time_point deadline = Wall::now() + std::chrono::seconds(10);
-  while (bus.Poll().result != BusResult::kOk && Wall::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return bus.Poll().result == BusResult::kOk;
 }
 
 /// A forked ECS on `name` that comes up beside the twin and then only polls until killed.
