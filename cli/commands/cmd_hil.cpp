@@ -1,7 +1,8 @@
 // `hiltwin hil`: the closed HiL loop on one machine. Starts the twin (`hiltwin run`) and the
 // controller (`hiltwin ecs`) as two real processes on a fresh wire, lets them find each other
 // (either may be first), waits for both, reads both run reports back and prints one combined
-// summary; exits with the worse of the two exit codes. No shared memory is left behind.
+// summary; exits with the worse of the two exit codes (or the failed side's, when the other
+// only echoes it). No shared memory is left behind.
 // Flags -> HilRunOptions (checked, read once) -> RunHil (hiltwin/runs/hil_run.h).
 #include <unistd.h>
 

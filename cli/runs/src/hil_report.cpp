@@ -78,6 +78,27 @@ int ExitCodeOf(const kernel_glue::ExitStatus& status) noexcept {
 
 int WorseExitCode(int a, int b) noexcept { return Severity(a) >= Severity(b) ? a : b; }
 
+namespace {
+
+/// A side that judged no cycle because its peer ended first (verdict NONE, stop peer_stopped)
+/// only echoes that peer's end: its exit 5 says nothing the peer's own code does not.
+bool EchoesItsPeer(const HilSide& side) {
+  return side.report && side.report->value("verdict", "") == "NONE" &&
+         side.report->value("stop_reason", "") == "peer_stopped";
+}
+
+/// The pair's exit code: the worse of the two, except that a side echoing a peer that failed
+/// (a QoS abort in the twin's first cycles, say) leaves the code to the peer, which says why.
+int PairExitCode(const HilSide& twin, const HilSide& ecs) {
+  const int twin_code = ExitCodeOf(twin.status);
+  const int ecs_code = ExitCodeOf(ecs.status);
+  if (EchoesItsPeer(ecs) && !EchoesItsPeer(twin) && twin_code != 0) return twin_code;
+  if (EchoesItsPeer(twin) && !EchoesItsPeer(ecs) && ecs_code != 0) return ecs_code;
+  return WorseExitCode(twin_code, ecs_code);
+}
+
+}  // namespace
+
 HilResult CombineHil(std::string wire, std::string mode, HilSide twin, HilSide ecs) {
   HilResult result;
   result.wire = std::move(wire);
@@ -89,7 +110,7 @@ HilResult CombineHil(std::string wire, std::string mode, HilSide twin, HilSide e
       U64At(ecs.report, Json::json_pointer("/encoder_lines/illegal_transitions")) +
       U64At(ecs.report, Json::json_pointer("/encoder_lines/too_fast_edges")) +
       U64At(ecs.report, Json::json_pointer("/encoder_lines/resyncs"));
-  result.exit_code = WorseExitCode(ExitCodeOf(twin.status), ExitCodeOf(ecs.status));
+  result.exit_code = PairExitCode(twin, ecs);
   result.twin = std::move(twin);
   result.ecs = std::move(ecs);
   return result;
@@ -140,8 +161,11 @@ std::string FormatHilSummary(const HilResult& r) {
                 static_cast<unsigned long long>(r.link.encoder_line_errors));
   out += text;
   for (const std::string& warning : r.warnings) out += "warning   " + warning + "\n";
-  std::snprintf(text, sizeof text, "hil       exit %d (the worse of twin %d and ECS %d)\n",
-                r.exit_code, ExitCodeOf(r.twin.status), ExitCodeOf(r.ecs.status));
+  const int twin_code = ExitCodeOf(r.twin.status);
+  const int ecs_code = ExitCodeOf(r.ecs.status);
+  const bool worse = r.exit_code == WorseExitCode(twin_code, ecs_code);
+  std::snprintf(text, sizeof text, "hil       exit %d (%s twin %d and ECS %d)\n", r.exit_code,
+                worse ? "the worse of" : "the side that failed first of", twin_code, ecs_code);
   return out + text;
 }
 

@@ -1,5 +1,6 @@
 // The combined HiL result: figures are read from the ECS's and the twin's reports, a missing
-// report is "no figures" rather than an error, and the exit code is the worse of the two.
+// report is "no figures" rather than an error, and the exit code is the worse of the two
+// (unless one side only echoes its failed peer).
 #include "hiltwin/runs/hil_report.h"
 
 #include <gtest/gtest.h>
@@ -78,6 +79,31 @@ TEST(HilReport, WorseExitCodeOrdersPassFlaggedAbortedStoppedIoUsageInternal) {
       EXPECT_EQ(WorseExitCode(order[i], order[j]), order[std::max(i, j)]) << i << "," << j;
     }
   }
+}
+
+// The twin aborted on its QoS rule in its first cycles (a loaded start), before the ECS judged
+// one: the ECS's NONE/exit 5 only echoes that, and the pair's code is the twin's 4, which says
+// why. When the side that went first did not fail, the echo is still the worse code.
+TEST(HilReport, ASideThatOnlyEchoesItsFailedPeerLeavesThePairsCodeToThePeer) {
+  const Json echo{{"verdict", "NONE"}, {"stop_reason", "peer_stopped"}};
+  const Json aborted{{"verdict", "ABORTED"}, {"stop_reason", "qos_abort"}};
+  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(4), aborted},
+                       HilSide{"ecs", Exited(5), echo})
+                .exit_code,
+            4);
+  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(5), echo},
+                       HilSide{"ecs", Exited(1), std::nullopt})
+                .exit_code,
+            1);
+  const Json passed{{"verdict", "PASS"}, {"stop_reason", "finished"}};
+  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(0), passed},
+                       HilSide{"ecs", Exited(5), echo})
+                .exit_code,
+            5);
+  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(5), echo},
+                       HilSide{"ecs", Exited(5), echo})
+                .exit_code,
+            5);
 }
 
 }  // namespace

@@ -46,7 +46,7 @@ struct HilResult {
   HilSide ecs;
   std::optional<HilTracking> tracking;  ///< closed loop with an ECS report
   HilLinkErrors link;
-  int exit_code = 0;  ///< the worse of the two (WorseExitCode)
+  int exit_code = 0;  ///< the worse of the two, or the failed side's when the other echoes it
   /// What `hil` found doubtful about the pair before it started them (e.g. an --ecs-rate too
   /// slow to follow the twin's encoders; relbot/encoder_reading.h).
   std::vector<std::string> warnings;
