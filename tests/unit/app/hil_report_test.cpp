@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+#include <utility>
+
 namespace hiltwin::app {
 namespace {
 
@@ -84,26 +87,21 @@ TEST(HilReport, WorseExitCodeOrdersPassFlaggedAbortedStoppedIoUsageInternal) {
 // The twin aborted on its QoS rule in its first cycles (a loaded start), before the ECS judged
 // one: the ECS's NONE/exit 5 only echoes that, and the pair's code is the twin's 4, which says
 // why. When the side that went first did not fail, the echo is still the worse code.
+/// The pair's exit code for two sides that exited with these codes and wrote these reports.
+int PairCode(int twin_code, std::optional<Json> twin, int ecs_code, std::optional<Json> ecs) {
+  return CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(twin_code), std::move(twin)},
+                    HilSide{"ecs", Exited(ecs_code), std::move(ecs)})
+      .exit_code;
+}
+
 TEST(HilReport, ASideThatOnlyEchoesItsFailedPeerLeavesThePairsCodeToThePeer) {
   const Json echo{{"verdict", "NONE"}, {"stop_reason", "peer_stopped"}};
   const Json aborted{{"verdict", "ABORTED"}, {"stop_reason", "qos_abort"}};
-  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(4), aborted},
-                       HilSide{"ecs", Exited(5), echo})
-                .exit_code,
-            4);
-  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(5), echo},
-                       HilSide{"ecs", Exited(1), std::nullopt})
-                .exit_code,
-            1);
   const Json passed{{"verdict", "PASS"}, {"stop_reason", "finished"}};
-  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(0), passed},
-                       HilSide{"ecs", Exited(5), echo})
-                .exit_code,
-            5);
-  EXPECT_EQ(CombineHil("wire:w", "closedloop", HilSide{"twin", Exited(5), echo},
-                       HilSide{"ecs", Exited(5), echo})
-                .exit_code,
-            5);
+  EXPECT_EQ(PairCode(4, aborted, 5, echo), 4);
+  EXPECT_EQ(PairCode(5, echo, 1, std::nullopt), 1);
+  EXPECT_EQ(PairCode(0, passed, 5, echo), 5);
+  EXPECT_EQ(PairCode(5, echo, 5, echo), 5);
 }
 
 }  // namespace
