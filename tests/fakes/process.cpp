@@ -1,5 +1,11 @@
 #include "fakes/process.h"
 
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <utility>
+#include <vector>
+
 namespace hiltwin::test {
 
 kernel_glue::Process Spawn(const std::vector<std::string>& argv, const std::string& output_path) {
@@ -9,6 +15,11 @@ kernel_glue::Process Spawn(const std::vector<std::string>& argv, const std::stri
     options.err = kernel_glue::OutputTarget::File(output_path + ".err");
   }
   return kernel_glue::Process::Start(argv, options);
+}
+
+std::string ReadOutput(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 RunResult Run(const std::vector<std::string>& argv, int timeout_ms) {

@@ -14,6 +14,10 @@ namespace hiltwin::test {
 kernel_glue::Process Spawn(const std::vector<std::string>& argv,
                            const std::string& output_path = "");
 
+/// What a spawned process wrote to `path` (its `output_path`, or that with ".err"); empty when
+/// there is no such file.
+std::string ReadOutput(const std::string& path);
+
 /// Runs a command to completion, capturing stdout and stderr separately.
 struct RunResult {
   int exit_code = -1;  ///< -1 when it timed out (and was killed) or died from a signal

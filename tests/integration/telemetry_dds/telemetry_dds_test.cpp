@@ -20,6 +20,7 @@
 #include <string>
 #include <thread>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "fakes/process.h"
@@ -330,8 +331,19 @@ TEST_F(TelemetryDds, ATaskStartedOnANamespaceInUseIsWarnedAtStart) {
   }
 }
 
-// The command lines of `parent`'s children, arguments joined by spaces (from /proc).
+// A process's command line, arguments joined by spaces (from /proc; empty once it is gone).
+std::string CommandLine(const fs::path& proc_entry) {
+  std::ifstream cmdline(proc_entry / "cmdline");
+  std::string line{std::istreambuf_iterator<char>(cmdline), std::istreambuf_iterator<char>()};
+  std::replace(line.begin(), line.end(), '\0', ' ');
+  return line;
+}
+
+// The command lines of `parent`'s children that have started their own program. A child
+// between fork and exec still shows the parent's command line (CI's quick tier under load
+// caught `hil` itself that way), so those are left out until they exec.
 std::vector<std::string> ChildCommandLines(pid_t parent) {
+  const std::string parent_line = CommandLine(fs::path("/proc") / std::to_string(parent));
   std::vector<std::string> lines;
   for (const auto& entry : fs::directory_iterator("/proc")) {
     const std::string pid = entry.path().filename().string();
@@ -345,10 +357,8 @@ std::vector<std::string> ChildCommandLines(pid_t parent) {
     std::string state;
     pid_t ppid = 0;
     if (!(fields >> state >> ppid) || ppid != parent) continue;
-    std::ifstream cmdline(entry.path() / "cmdline");
-    std::string line{std::istreambuf_iterator<char>(cmdline), std::istreambuf_iterator<char>()};
-    std::replace(line.begin(), line.end(), '\0', ' ');
-    lines.push_back(line);
+    std::string line = CommandLine(entry.path());
+    if (line != parent_line) lines.push_back(std::move(line));
   }
   return lines;
 }
