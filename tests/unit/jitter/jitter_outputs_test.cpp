@@ -118,7 +118,7 @@ TEST(JitterOutputs, TextStatesTheKeyFiguresAndNeverHidesDiscardedEvents) {
         "deadline misses: 4", "0 events discarded by the tracer",
         "loop thread tid 1000 on CPU 1 (SCHED_FIFO 80)", "latency ", "period jitter |x|",
         "compute ", "response ", "wake-up latency histogram", "misses: 4 in 2 bursts",
-        "(3,4)-firm", "10 worst cycles by response time", "interrupt: eth0 (irq 42) for 40 us",
+        "(3,4)-firm", "10 worst stalls by response time", "interrupt: eth0 (irq 42) for 40 us",
         "causes of the", "warnings: none"}) {
     EXPECT_NE(text.find(line), std::string::npos) << "missing: " << line << "\n" << text;
   }
