@@ -82,7 +82,23 @@ struct Stall {
   std::size_t first = 0;
   std::size_t last = 0;
   std::size_t worst = 0;
+  Burst burst;
 };
+
+// Cycle `i` alone, or cycle `i` added to the stall before it.
+Stall StartStall(const TimingTrace& trace, std::size_t i) {
+  const scheduler::TimingSample& s = trace.cycles[i].sample;
+  return {i, i, i, Burst{s.cycle, s.cycle, 1, s.releases_skipped, s.end_ns - s.release_ns}};
+}
+void ExtendStall(const TimingTrace& trace, std::size_t i, Stall& stall) {
+  const scheduler::TimingSample& s = trace.cycles[i].sample;
+  stall.last = i;
+  if (ResponseOf(trace.cycles[i]) > ResponseOf(trace.cycles[stall.worst])) stall.worst = i;
+  stall.burst.last_k = s.cycle;
+  ++stall.burst.cycles;
+  stall.burst.releases_skipped += s.releases_skipped;
+  stall.burst.duration_ns = s.end_ns - trace.cycles[stall.first].sample.release_ns;
+}
 
 // The stalls of late cycles (missed, or response above the response p99.9 — the same "above
 // p99.9" as a notable wake-up's), in trace order. Late cycles are one stall while each follows
@@ -103,11 +119,9 @@ std::vector<Stall> LateStalls(const TimingTrace& trace, std::int64_t response_p9
     const bool follows =
         before != nullptr && c.sample.cycle == before->cycle + 1 + before->releases_skipped;
     if (previous_late && follows) {
-      Stall& s = stalls.back();
-      s.last = i;
-      if (ResponseOf(c) > ResponseOf(trace.cycles[s.worst])) s.worst = i;
+      ExtendStall(trace, i, stalls.back());
     } else {
-      stalls.push_back({i, i, i});
+      stalls.push_back(StartStall(trace, i));
     }
     previous_late = true;
   }
@@ -127,26 +141,12 @@ std::vector<Stall> WorstStalls(const TimingTrace& trace, std::vector<Stall> stal
   return stalls;
 }
 
-Burst BurstOf(const TimingTrace& trace, const Stall& stall) {
-  Burst b;
-  const scheduler::TimingSample& first = trace.cycles[stall.first].sample;
-  const scheduler::TimingSample& last = trace.cycles[stall.last].sample;
-  b.first_k = first.cycle;
-  b.last_k = last.cycle;
-  b.cycles = stall.last - stall.first + 1;
-  for (std::size_t i = stall.first; i <= stall.last; ++i) {
-    b.releases_skipped += trace.cycles[i].sample.releases_skipped;
-  }
-  b.duration_ns = last.end_ns - first.release_ns;
-  return b;
-}
-
 // The stall cycle `i` belongs to: a late stall, or the cycle alone.
 Burst BurstAt(const TimingTrace& trace, const std::vector<Stall>& stalls, std::size_t i) {
   auto it = std::upper_bound(stalls.begin(), stalls.end(), i,
                              [](std::size_t key, const Stall& s) { return key < s.first; });
-  if (it != stalls.begin() && std::prev(it)->last >= i) return BurstOf(trace, *std::prev(it));
-  return BurstOf(trace, Stall{i, i, i});
+  if (it != stalls.begin() && std::prev(it)->last >= i) return std::prev(it)->burst;
+  return StartStall(trace, i).burst;
 }
 
 // What the attribution needs of the run: the window and what is normal.
@@ -275,7 +275,7 @@ JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel) 
   for (const Stall& s : WorstStalls(trace, stalls)) {
     worst.push_back(s.worst);
     r.worst.push_back(NotableOf(trace.cycles[s.worst].sample));
-    r.worst.back().burst = BurstOf(trace, s);
+    r.worst.back().burst = s.burst;
   }
   AttributeCauses(trace, kernel, notable, worst, r);
   return r;

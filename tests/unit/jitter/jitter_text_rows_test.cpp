@@ -187,6 +187,21 @@ TEST(JitterTextRows, CatchUpCyclesAfterAStallAreOneStall) {
   }
 }
 
+TEST(JitterTextRows, ARunLateThroughoutIsOneStallFoundInLinearTime) {
+  // Every cycle misses (response 23.1 µs, deadline 20 µs): one stall of 100 000 cycles, each a
+  // notable cycle that names it. A stall's figures are summed once, not per notable cycle
+  // (that was 10^10 steps here).
+  testing::RunSpec spec;
+  spec.releases = 100'000;
+  spec.deadline_ns = 20'000;
+  const JitterReport r = AnalyzeJitter(testing::MakeTrace(spec), nullptr);
+  ASSERT_EQ(r.worst.size(), 1u);
+  EXPECT_EQ(r.worst[0].burst.cycles, 100'000u);
+  ASSERT_EQ(r.notable.size(), 100'000u);
+  EXPECT_EQ(r.notable.back().burst.first_k, 0u);
+  EXPECT_EQ(r.notable.back().burst.cycles, 100'000u);
+}
+
 }  // namespace text_rows_test
 }  // namespace
 }  // namespace hiltwin::analysis
