@@ -116,7 +116,7 @@ void WriteText(const std::string& path, const std::string& text) {
 
 /// Every output of the report into `dir`; prints the text report and the list of files.
 void WriteOutputs(const analysis::JitterReport& report, const analysis::TimingTrace& trace,
-                  const std::string& dir) {
+                  const analysis::KernelTrace* kernel, const std::string& dir) {
   spdlog::info("writing the jitter report into {}", dir);
   const std::string text = analysis::FormatJitterText(report);
   std::vector<std::string> files = {dir + "/" + kTextReportName, dir + "/" + kJsonReportName};
@@ -124,7 +124,7 @@ void WriteOutputs(const analysis::JitterReport& report, const analysis::TimingTr
   WriteText(files[1], analysis::JitterToJson(report).dump(2) + "\n");
   for (std::string& png : WritePictures(report, trace, dir)) files.push_back(std::move(png));
   files.push_back(analysis::WriteJitterHtml(report, trace, dir));
-  files.push_back(analysis::WritePerfettoTrace(report, trace, dir));
+  files.push_back(analysis::WritePerfettoTrace(report, trace, kernel, dir));
   std::fputs(text.c_str(), stdout);
   std::fprintf(stdout, "jitter report files:\n");
   for (const std::string& file : files) std::fprintf(stdout, "  %s\n", file.c_str());
@@ -217,7 +217,7 @@ int TraceTwin(const TraceOptions& o) {
     for (const std::string& line : CompareWithRunReport(outcome.report, report)) {
       report.warnings.push_back("the trace disagrees with the run report: " + line);
     }
-    WriteOutputs(report, trace, o.output_dir);
+    WriteOutputs(report, trace, kernel ? &*kernel : nullptr, o.output_dir);
     for (const std::string& warning : report.warnings) spdlog::warn("{}", warning);
   } catch (const std::exception& e) {
     // The run happened and its report stands; the trace of it is what failed.
@@ -245,7 +245,7 @@ int AnalyzeTrace(const TraceOptions& o) {
     const analysis::JitterReport report = Analyze(trace, kernel ? &*kernel : nullptr);
     fs::create_directories(dir, ec);
     if (ec) ThrowUsage("--output " + dir + ": cannot create the folder: " + ec.message());
-    WriteOutputs(report, trace, dir);
+    WriteOutputs(report, trace, kernel ? &*kernel : nullptr, dir);
     for (const std::string& warning : report.warnings) spdlog::warn("{}", warning);
   } catch (const analysis::TraceReadError& e) {
     ThrowUsage(e.what());

@@ -1,6 +1,6 @@
 #include <algorithm>
+#include <iterator>
 #include <memory>
-#include <numeric>
 
 #include "cause_attribution.h"
 #include "hiltwin/jitter/jitter_report.h"
@@ -74,20 +74,79 @@ std::vector<std::size_t> NotableIndices(const TimingTrace& trace, const detail::
   return out;
 }
 
-// The cycles with the longest response, longest first (earlier k first on a tie).
-std::vector<std::size_t> WorstIndices(const TimingTrace& trace) {
-  std::vector<std::size_t> order(trace.cycles.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  const std::size_t n = std::min(kWorstCycles, order.size());
-  auto response = [&](std::size_t i) {
-    return trace.cycles[i].sample.end_ns - trace.cycles[i].sample.release_ns;
-  };
-  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n), order.end(),
-                    [&](std::size_t a, std::size_t b) {
-                      return response(a) != response(b) ? response(a) > response(b) : a < b;
+std::int64_t ResponseOf(const TracedCycle& c) { return c.sample.end_ns - c.sample.release_ns; }
+
+// A run of consecutive late cycles, by index into the trace; `worst` has the longest response
+// (the earliest of equals).
+struct Stall {
+  std::size_t first = 0;
+  std::size_t last = 0;
+  std::size_t worst = 0;
+  Burst burst;
+};
+
+// Cycle `i` alone, or cycle `i` added to the stall before it.
+Stall StartStall(const TimingTrace& trace, std::size_t i) {
+  const scheduler::TimingSample& s = trace.cycles[i].sample;
+  return {i, i, i, Burst{s.cycle, s.cycle, 1, s.releases_skipped, s.end_ns - s.release_ns}};
+}
+void ExtendStall(const TimingTrace& trace, std::size_t i, Stall& stall) {
+  const scheduler::TimingSample& s = trace.cycles[i].sample;
+  stall.last = i;
+  if (ResponseOf(trace.cycles[i]) > ResponseOf(trace.cycles[stall.worst])) stall.worst = i;
+  stall.burst.last_k = s.cycle;
+  ++stall.burst.cycles;
+  stall.burst.releases_skipped += s.releases_skipped;
+  stall.burst.duration_ns = s.end_ns - trace.cycles[stall.first].sample.release_ns;
+}
+
+// The stalls of late cycles (missed, or response above the response p99.9 — the same "above
+// p99.9" as a notable wake-up's), in trace order. Late cycles are one stall while each follows
+// the previous (k on by one plus its skipped releases): a catch-up cycle released while the
+// stalled one ran, or the cycle after a skipped release, belongs to the same stall; a cycle
+// lost from the trace ends it.
+std::vector<Stall> LateStalls(const TimingTrace& trace, std::int64_t response_p999_ns) {
+  std::vector<Stall> stalls;
+  bool previous_late = false;
+  for (std::size_t i = 0; i < trace.cycles.size(); ++i) {
+    const TracedCycle& c = trace.cycles[i];
+    const bool late = c.sample.missed || ResponseOf(c) > response_p999_ns;
+    if (!late) {
+      previous_late = false;
+      continue;
+    }
+    const scheduler::TimingSample* before = i > 0 ? &trace.cycles[i - 1].sample : nullptr;
+    const bool follows =
+        before != nullptr && c.sample.cycle == before->cycle + 1 + before->releases_skipped;
+    if (previous_late && follows) {
+      ExtendStall(trace, i, stalls.back());
+    } else {
+      stalls.push_back(StartStall(trace, i));
+    }
+    previous_late = true;
+  }
+  return stalls;
+}
+
+// The worst stalls, longest response first (earlier first on a tie).
+std::vector<Stall> WorstStalls(const TimingTrace& trace, std::vector<Stall> stalls) {
+  const std::size_t n = std::min(kWorstCycles, stalls.size());
+  auto response = [&](const Stall& s) { return ResponseOf(trace.cycles[s.worst]); };
+  std::partial_sort(stalls.begin(), stalls.begin() + static_cast<std::ptrdiff_t>(n), stalls.end(),
+                    [&](const Stall& a, const Stall& b) {
+                      return response(a) != response(b) ? response(a) > response(b)
+                                                        : a.worst < b.worst;
                     });
-  order.resize(n);
-  return order;
+  stalls.resize(n);
+  return stalls;
+}
+
+// The stall cycle `i` belongs to: a late stall, or the cycle alone.
+Burst BurstAt(const TimingTrace& trace, const std::vector<Stall>& stalls, std::size_t i) {
+  auto it = std::upper_bound(stalls.begin(), stalls.end(), i,
+                             [](std::size_t key, const Stall& s) { return key < s.first; });
+  if (it != stalls.begin() && std::prev(it)->last >= i) return std::prev(it)->burst;
+  return StartStall(trace, i).burst;
 }
 
 // What the attribution needs of the run: the window and what is normal.
@@ -206,10 +265,18 @@ JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel) 
   CountReleases(trace, r);
   TraceWarnings(trace, stats, r);
 
+  const std::vector<Stall> stalls = LateStalls(trace, r.response.summary.p999_ns);
   const std::vector<std::size_t> notable = NotableIndices(trace, stats, r.latency.summary.p999_ns);
-  for (const std::size_t i : notable) r.notable.push_back(NotableOf(trace.cycles[i].sample));
-  const std::vector<std::size_t> worst = WorstIndices(trace);
-  for (const std::size_t i : worst) r.worst.push_back(NotableOf(trace.cycles[i].sample));
+  for (const std::size_t i : notable) {
+    r.notable.push_back(NotableOf(trace.cycles[i].sample));
+    r.notable.back().burst = BurstAt(trace, stalls, i);
+  }
+  std::vector<std::size_t> worst;
+  for (const Stall& s : WorstStalls(trace, stalls)) {
+    worst.push_back(s.worst);
+    r.worst.push_back(NotableOf(trace.cycles[s.worst].sample));
+    r.worst.back().burst = s.burst;
+  }
   AttributeCauses(trace, kernel, notable, worst, r);
   return r;
 }

@@ -51,6 +51,14 @@ ordered_json CauseJson(const Cause& c) {
           {"faults", c.faults},         {"address", c.address},         {"evidence", c.evidence}};
 }
 
+ordered_json BurstJson(const Burst& b) {
+  return {{"first_k", b.first_k},
+          {"last_k", b.last_k},
+          {"cycles", b.cycles},
+          {"releases_skipped", b.releases_skipped},
+          {"duration_ns", b.duration_ns}};
+}
+
 ordered_json CycleJson(const NotableCycle& n) {
   return {{"k", n.k},
           {"release_ns", n.release_ns},
@@ -58,7 +66,8 @@ ordered_json CycleJson(const NotableCycle& n) {
           {"compute_ns", n.compute_ns},
           {"response_ns", n.response_ns},
           {"missed", n.missed},
-          {"cause", CauseJson(n.cause)}};
+          {"cause", CauseJson(n.cause)},
+          {"burst", BurstJson(n.burst)}};
 }
 
 ordered_json CyclesJson(const std::vector<NotableCycle>& cycles) {

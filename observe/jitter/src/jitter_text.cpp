@@ -7,6 +7,7 @@
 #include "jitter_format.h"
 #include "hiltwin/report_kit/string_format.h"
 #include "hiltwin/report_kit/time_units.h"
+#include "hiltwin/scheduler/log_linear_histogram.h"
 
 namespace hiltwin::analysis {
 namespace {
@@ -53,13 +54,39 @@ void Table(const JitterReport& r, std::string& out) {
   out += "(period jitter: min and max signed, percentiles of the magnitude)\n\n";
 }
 
-// Rows on a 1-2-5 scale from the first to the last non-empty one; bars on a log scale.
-void AsciiHistogram(const Distribution& d, std::string& out) {
-  if (d.bins.empty()) return;
+// A bin edge in µs to the nanosecond: "4.992", "50", "1998.848".
+std::string ExactUs(std::int64_t ns) {
+  std::string text = Format("%.3f", Us(ns));
+  text.erase(text.find_last_not_of('0') + 1);
+  if (text.back() == '.') text.pop_back();
+  return text;
+}
+
+// Row edges on a 1-2-5 scale from 0 to past `last_low_ns`, each moved down to the edge of the
+// histogram bin it falls in (5 µs lies inside the bin [4992, 5024) ns: the row edge is 4992),
+// so a row holds whole bins and its count is exact for the range it prints. The histogram's
+// top bin (2^40 ns and above) ends the scale: what lies past the last edge is the last row's.
+std::vector<std::int64_t> RowEdges(std::int64_t last_low_ns) {
+  using Bins = scheduler::LogLinearHistogram;
+  constexpr std::int64_t kLastDecade = 1'000'000'000'000;  // 1000 s, past the top bin
   std::vector<std::int64_t> edges = {0};
-  for (std::int64_t decade = 100; edges.back() <= d.bins.back().low_ns; decade *= 10) {
-    for (const std::int64_t step : {1, 2, 5}) edges.push_back(decade * step);
+  for (std::int64_t decade = 100; edges.back() <= last_low_ns && decade <= kLastDecade;
+       decade *= 10) {
+    for (const std::int64_t step : {1, 2, 5}) {
+      const std::int64_t edge = Bins::BucketLow(Bins::BucketIndex(decade * step));
+      if (edge > edges.back()) edges.push_back(edge);
+    }
   }
+  return edges;
+}
+
+// Rows from the first to the last non-empty one, bars on a log scale, then the cycles with no
+// wake-up latency (released while the previous one ran, as the run report leaves them out),
+// so the rows add up to every cycle of the trace.
+void AsciiHistogram(const JitterReport& r, std::string& out) {
+  const Distribution& d = r.latency;
+  if (d.bins.empty()) return;
+  const std::vector<std::int64_t> edges = RowEdges(d.bins.back().low_ns);
   std::vector<std::uint64_t> counts(edges.size(), 0);
   for (const HistogramBin& b : d.bins) {
     const auto row = std::upper_bound(edges.begin(), edges.end(), b.low_ns) - edges.begin() - 1;
@@ -70,16 +97,22 @@ void AsciiHistogram(const Distribution& d, std::string& out) {
   std::size_t last = counts.size() - 1;
   while (counts[last] == 0) --last;
   const std::uint64_t most = *std::max_element(counts.begin(), counts.end());
-  out += "wake-up latency histogram (bars on a log scale):\n";
+  out += "wake-up latency histogram (bars on a log scale; rows are whole bins of the JSON's\n"
+         "latency_ns.bins, so each count is exact for its range):\n";
   for (std::size_t i = first; i <= last; ++i) {
     const double scale = std::log10(static_cast<double>(most) + 1.0);
     const auto width = static_cast<std::size_t>(
         std::lround(40.0 * std::log10(static_cast<double>(counts[i]) + 1.0) / scale));
-    const std::string upper = i + 1 < edges.size() ? Format("%g", Us(edges[i + 1])) : "inf";
-    out += Format("  %8g - %-6s us |%-40s %llu\n", Us(edges[i]), upper.c_str(),
+    const std::string upper = i + 1 < edges.size() ? ExactUs(edges[i + 1]) : "inf";
+    out += Format("  %9s - %-9s us |%-40s %llu\n", ExactUs(edges[i]).c_str(), upper.c_str(),
                   std::string(width, '#').c_str(), static_cast<unsigned long long>(counts[i]));
   }
-  out += "\n";
+  const std::uint64_t without = r.cycles - d.summary.count;
+  if (without > 0) {
+    out += Format("  no wake-up latency (released while the previous cycle ran): %llu\n",
+                  static_cast<unsigned long long>(without));
+  }
+  out += Format("  total: %llu cycles\n\n", static_cast<unsigned long long>(r.cycles));
 }
 
 void Clusters(const JitterReport& r, std::string& out) {
@@ -101,9 +134,32 @@ void Clusters(const JitterReport& r, std::string& out) {
 
 namespace {
 
+// "stall k=8000..8049: 50 cycles (+2 releases skipped), 2.50 ms".
+std::string StallLine(const Burst& b) {
+  std::string line = "stall k=" + std::to_string(b.first_k);
+  if (b.last_k != b.first_k) line += ".." + std::to_string(b.last_k);
+  line += Format(": %llu cycle%s", static_cast<unsigned long long>(b.cycles),
+                 b.cycles == 1 ? "" : "s");
+  if (b.releases_skipped > 0) {
+    line += Format(" (+%llu release%s skipped)",
+                   static_cast<unsigned long long>(b.releases_skipped),
+                   b.releases_skipped == 1 ? "" : "s");
+  }
+  return line + ", " + detail::FormatDuration(b.duration_ns);
+}
+
+// One entry per stall (consecutive late cycles), shown by its worst cycle: a stall and the
+// catch-up behind it are one event, not ten.
 void Worst(const JitterReport& r, std::string& out) {
-  out += Format("%zu worst cycles by response time (t: seconds since the first release):\n",
-                r.worst.size());
+  const std::string p999 = detail::FormatDuration(r.response.summary.p999_ns);
+  if (r.worst.empty()) {
+    out += "worst stalls: none (no cycle missed or responded above p99.9 = " + p999 + ")\n\n";
+    return;
+  }
+  out += Format("%zu worst stalls by response time (a stall: consecutive cycles that missed or\n"
+                "responded above p99.9 = %s, shown by its worst; t: seconds since the first "
+                "release):\n",
+                r.worst.size(), p999.c_str());
   out += "         k          t    latency    compute   response  miss  cause\n";
   for (const NotableCycle& n : r.worst) {
     out += Format("  %8llu %10.6f %10s %10s %10s  %-4s  %s\n", static_cast<unsigned long long>(n.k),
@@ -112,6 +168,7 @@ void Worst(const JitterReport& r, std::string& out) {
                   detail::FormatDuration(n.compute_ns).c_str(),
                   detail::FormatDuration(n.response_ns).c_str(), n.missed ? "MISS" : "",
                   ToString(n.cause.cause));
+    out += "            " + StallLine(n.burst) + "\n";
     if (!n.cause.evidence.empty()) out += "            " + n.cause.evidence + "\n";
   }
   out += "\n";
@@ -153,7 +210,7 @@ std::string FormatJitterText(const JitterReport& report) {
   std::string out;
   Header(report, out);
   Table(report, out);
-  AsciiHistogram(report.latency, out);
+  AsciiHistogram(report, out);
   Clusters(report, out);
   Worst(report, out);
   Causes(report, out);

@@ -8,13 +8,16 @@
 ///                              WriteJitterPlots (gnuplot, pngcairo)
 ///   DIR/jitter_report.html    WriteJitterHtml (self-contained: inline SVG, no script, no font)
 ///   DIR/perfetto_trace.json   WritePerfettoTrace (Chrome trace-event JSON: one slice per
-///                              cycle, misses as instant events; ui.perfetto.dev opens it)
+///                              cycle, misses as instant events, with the kernel recorded the
+///                              loop CPUs' other threads and interrupts; ui.perfetto.dev
+///                              opens it)
 
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "hiltwin/jitter/jitter_report.h"
+#include "hiltwin/traces/kernel_events.h"
 #include "hiltwin/traces/timing_trace.h"
 
 namespace hiltwin::analysis {
@@ -34,8 +37,10 @@ std::vector<std::string> WriteJitterPlots(const JitterReport& report, const Timi
 std::string WriteJitterHtml(const JitterReport& report, const TimingTrace& trace,
                             const std::string& dir);
 
-/// Writes the Perfetto / Chrome trace-event JSON; returns its path.
+/// Writes the Perfetto / Chrome trace-event JSON; returns its path. With `kernel` (the
+/// recording the report was made from; null: none) each other thread that ran on the loop's
+/// CPUs gets a track of the slices it ran, and each of those CPUs a track of its interrupts.
 std::string WritePerfettoTrace(const JitterReport& report, const TimingTrace& trace,
-                               const std::string& dir);
+                               const KernelTrace* kernel, const std::string& dir);
 
 }  // namespace hiltwin::analysis

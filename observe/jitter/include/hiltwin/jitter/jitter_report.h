@@ -86,6 +86,17 @@ struct Cause {
   std::string evidence;
 };
 
+/// A stall: a run of consecutive late cycles (missed, or response above the response p99.9;
+/// consecutive: no cycle lost from the trace between them). A cycle that is not late is a
+/// stall of its own.
+struct Burst {
+  std::uint64_t first_k = 0;
+  std::uint64_t last_k = 0;
+  std::uint64_t cycles = 1;            ///< cycles run in it
+  std::uint64_t releases_skipped = 0;  ///< releases skipped inside it (not counted in cycles)
+  std::int64_t duration_ns = 0;        ///< first cycle's release to last cycle's end
+};
+
 /// A cycle worth naming: a miss or a wake-up above p99.9.
 struct NotableCycle {
   std::uint64_t k = 0;
@@ -95,6 +106,7 @@ struct NotableCycle {
   std::int64_t response_ns = 0;  ///< end - release
   bool missed = false;
   Cause cause;  ///< the dominant cause (the longest culprit in the window)
+  Burst burst;  ///< the stall this cycle belongs to
 };
 
 /// Ranked causes: how many notable cycles each explains, most first.
@@ -120,8 +132,8 @@ struct JitterReport {
   double miss_pct = 0.0;             ///< misses / (judged cycles + skipped)
   Distribution latency, period_jitter, compute, response;
   MissClusters clusters;
-  /// The 10 worst cycles by response time, judged or not (ties: earlier k first), each with
-  /// its cause like a notable cycle's.
+  /// The 10 worst stalls (Burst), judged cycles or not: of each, the cycle with the longest
+  /// response (ties: earlier k first), with its cause like a notable cycle's; longest first.
   std::vector<NotableCycle> worst;
   bool kernel_recorded = false;
   /// Every judged miss (those `misses` counts) and every wake-up strictly above the latency
