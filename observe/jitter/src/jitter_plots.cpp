@@ -2,11 +2,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "hiltwin/jitter/jitter_outputs.h"
 #include "hiltwin/report_kit/gnuplot.h"
 #include "jitter_format.h"
+#include "plot_series.h"
 
 namespace hiltwin::analysis {
 namespace {
@@ -15,6 +17,10 @@ namespace fs = std::filesystem;
 using detail::GnuplotQuote;
 
 constexpr std::size_t kMaxTimelinePoints = 20000;
+constexpr std::size_t kPngStripBins = 300;  // 3.5 px each on the 1200 px picture
+using detail::kGrey;
+using detail::kPurple;
+using detail::kRed;
 constexpr std::size_t kMaxHistogramBins = 120;
 constexpr const char* kTerminal = "set terminal pngcairo size 1200,700 font 'sans,11' noenhanced\n";
 
@@ -32,8 +38,18 @@ std::string MarkerKey(const std::string& label, const char* colour) {
          GnuplotQuote(label);
 }
 
+// The same, horizontal at y (first axis), in the panel plotted next.
+std::string HorizontalMarker(double y_us, const char* colour) {
+  std::ostringstream line;
+  line << "set arrow from graph 0, first " << y_us << " to graph 1, first " << y_us
+       << " nohead dt 2 lw 1.5 lc rgb '" << colour << "'\n";
+  return line.str();
+}
+
 void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::string& png) {
   const fs::path data = scratch / "histogram.dat";
+  detail::LogRange x;
+  x.Add(static_cast<double>(r.deadline_ns) / 1e3);  // the deadline is always on the picture
   {
     std::ofstream out(data);
     out << "# low_us high_us count\n";
@@ -41,6 +57,8 @@ void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::str
       const double low = static_cast<double>(std::max<std::int64_t>(b.low_ns, 1)) / 1e3;
       const double high = static_cast<double>(std::max<std::int64_t>(b.high_ns, 2)) / 1e3;
       out << low << ' ' << high << ' ' << b.count << '\n';
+      x.Add(low);
+      x.Add(high);
     }
     if (r.latency.bins.empty()) out << "1 2 0\n";
     CheckWritten(out, data);
@@ -49,56 +67,145 @@ void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::str
   {
     std::ofstream gp(script);
     const scheduler::TimingSummary& s = r.latency.summary;
+    const std::string deadline = "deadline " + detail::FormatDuration(r.deadline_ns);
     gp << kTerminal << "set output " << GnuplotQuote(png) << "\n"
        << "set title " << GnuplotQuote("wake-up latency, " + std::to_string(s.count) + " cycles") << "\n"
        << "set logscale xy\nset grid\nset xlabel 'wake-up latency [us]'\n"
        << "set ylabel 'cycles (log scale)'\nset yrange [0.5:*]\nset key top right\n"
+       << "set xrange [" << x.Low() << ":" << x.High() << "]\n"
        << Marker(static_cast<double>(s.p50_ns) / 1e3, "#2ca02c")
        << Marker(static_cast<double>(s.p99_ns) / 1e3, "#ff7f0e")
        << Marker(static_cast<double>(s.p999_ns) / 1e3, "#d62728")
+       << Marker(static_cast<double>(r.deadline_ns) / 1e3, kGrey)
        << "plot " << GnuplotQuote(data.string())
        << " using (sqrt($1*$2)):3:1:2:(0.5):3 with boxxyerror fs solid 0.6 lc rgb '#1f77b4' "
        << "title 'cycles per bin'"
        << MarkerKey("p50 " + detail::FormatDuration(s.p50_ns), "#2ca02c")
        << MarkerKey("p99 " + detail::FormatDuration(s.p99_ns), "#ff7f0e")
-       << MarkerKey("p99.9 " + detail::FormatDuration(s.p999_ns), "#d62728") << "\n"
+       << MarkerKey("p99.9 " + detail::FormatDuration(s.p999_ns), "#d62728")
+       << MarkerKey(deadline, kGrey) << "\n"
        << "set output\n";
     CheckWritten(gp, script);
   }
   detail::RenderWithGnuplot(script, png);
 }
 
+// timeline.dat (every cycle, thinned), misses.dat (the misses while few enough to mark),
+// strip.dat (cycles and misses per time bin); the ranges of the two log panels.
+struct TimelineData {
+  fs::path cycles, misses, strip;
+  bool marked = false;  // misses.dat holds the misses
+  detail::LogRange latency, response;
+};
+
+TimelineData WriteTimelineData(const JitterReport& r, const TimingTrace& trace,
+                               const fs::path& scratch) {
+  TimelineData d;
+  d.cycles = scratch / "timeline.dat";
+  d.misses = scratch / "misses.dat";
+  d.strip = scratch / "strip.dat";
+  const double deadline_us = static_cast<double>(r.deadline_ns) / 1e3;
+  d.latency.Add(deadline_us);
+  d.response.Add(deadline_us);
+  std::ofstream cycles(d.cycles);
+  cycles << "# t_s latency_us compute_us response_us\n";
+  cycles.precision(10);
+  for (const detail::PlotPoint& p : detail::ThinnedCycles(trace, kMaxTimelinePoints)) {
+    cycles << p.t_s << ' ' << p.latency_us << ' ' << p.compute_us << ' ' << p.response_us << '\n';
+    d.latency.Add(p.latency_us);
+    d.response.Add(p.compute_us);
+    d.response.Add(p.response_us);
+  }
+  CheckWritten(cycles, d.cycles);
+  const std::vector<detail::PlotPoint> marked = detail::MissMarkers(trace);
+  d.marked = !marked.empty();
+  if (d.marked) {
+    std::ofstream misses(d.misses);
+    misses << "# t_s response_us\n";
+    misses.precision(10);
+    for (const detail::PlotPoint& p : marked) misses << p.t_s << ' ' << p.response_us << '\n';
+    CheckWritten(misses, d.misses);
+  }
+  std::ofstream strip(d.strip);
+  strip << "# from_s to_s cycles missed\n";
+  strip.precision(10);
+  for (const detail::StripBin& b : detail::MissStrip(trace, kPngStripBins)) {
+    strip << b.from_s << ' ' << b.to_s << ' ' << b.cycles << ' ' << b.missed << '\n';
+  }
+  CheckWritten(strip, d.strip);
+  return d;
+}
+
+// Panels of the timeline, top to bottom, each placed on the page so their x axes line up.
+std::string PanelAt(double top, double bottom) {
+  std::ostringstream at;
+  at << "set tmargin at screen " << top << "\nset bmargin at screen " << bottom << "\n";
+  return at.str();
+}
+
+// The strip: the share of the cycles released in each time bin that missed.
+std::string StripPanel(const JitterReport& r, const TimelineData& d) {
+  std::string gp = PanelAt(0.90, 0.84) +
+                   "set yrange [0:100]\nset ytics (0, 100)\nset format x ''\nunset key\n"
+                   "set ylabel 'missed [%]'\nset style fill solid 0.9 noborder\n";
+  if (r.misses == 0) gp += "set label 1 'no deadline miss' at graph 0.5, graph 0.5 center\n";
+  gp += "plot " + GnuplotQuote(d.strip.string()) +
+        " using (($1+$2)/2):($3 > 0 ? 100.0*$4/$3 : NaN):($2-$1) with boxes lc rgb '" + kRed +
+        "' notitle\nunset label 1\n";
+  return gp;
+}
+
+std::string LogPanel(const detail::LogRange& range, const std::string& ylabel) {
+  std::ostringstream gp;
+  gp << "set logscale y\nset yrange [" << range.Low() << ":" << range.High() << "]\n"
+     << "set ytics autofreq\nset key top right\nset ylabel " << GnuplotQuote(ylabel) << "\n";
+  return gp.str();
+}
+
+std::string LatencyPanel(const JitterReport& r, const TimelineData& d) {
+  const double deadline_us = static_cast<double>(r.deadline_ns) / 1e3;
+  return PanelAt(0.82, 0.50) + LogPanel(d.latency, "wake-up latency [us]") +
+         HorizontalMarker(deadline_us, kGrey) + "plot " + GnuplotQuote(d.cycles.string()) +
+         " using 1:2 with lines lc rgb '" + detail::kBlue + "' title 'wake-up latency'" +
+         MarkerKey("deadline " + detail::FormatDuration(r.deadline_ns), kGrey) + "\nunset arrow\n";
+}
+
+// Response against the deadline, the misses marked at their response (or, when too many to
+// mark, a key entry pointing at the strip).
+std::string ResponsePanel(const JitterReport& r, const TimelineData& d) {
+  const double deadline_us = static_cast<double>(r.deadline_ns) / 1e3;
+  const std::string cycles = GnuplotQuote(d.cycles.string());
+  std::string misses;
+  if (d.marked) {
+    misses = ", " + GnuplotQuote(d.misses.string()) +
+             " using 1:2 with points pt 7 ps 0.8 lc rgb '" + kRed + "' title 'deadline miss'";
+  } else if (r.misses > 0) {
+    misses = ", NaN with boxes fs solid lc rgb '" + std::string(kRed) +
+             "' title 'misses: too many to mark, see the strip above'";
+  }
+  return PanelAt(0.48, 0.09) +
+         "set format x '% g'\nset xlabel 'time since the first release [s]'\n" +
+         LogPanel(d.response, "response and compute [us]") + HorizontalMarker(deadline_us, kGrey) +
+         "plot " + cycles + " using 1:4 with lines lc rgb '" + kPurple +
+         "' title 'response (release to end)', " + cycles +
+         " using 1:3 with lines lc rgb '" + detail::kGreen + "' title 'compute'" + misses +
+         MarkerKey("deadline " + detail::FormatDuration(r.deadline_ns), kGrey) + "\n";
+}
+
 void TimelinePng(const JitterReport& r, const TimingTrace& trace, const fs::path& scratch,
                  const std::string& png) {
-  const fs::path data = scratch / "timeline.dat";
-  {
-    std::ofstream out(data);
-    out << "# t_s latency_us compute_us missed\n";
-    out.precision(10);
-    for (const detail::PlotPoint& p : detail::ThinnedCycles(trace, kMaxTimelinePoints)) {
-      out << p.t_s << ' ' << p.latency_us << ' ' << p.compute_us << ' ' << (p.missed ? 1 : 0) << '\n';
-    }
-    CheckWritten(out, data);
-  }
+  const TimelineData d = WriteTimelineData(r, trace, scratch);
   const fs::path script = scratch / "timeline.gp";
   {
     std::ofstream gp(script);
-    const std::string d = GnuplotQuote(data.string());
-    const double deadline_us = static_cast<double>(r.deadline_ns) / 1e3;
-    gp << kTerminal << "set output " << GnuplotQuote(png) << "\n"
-       << "set multiplot layout 2,1 title "
+    gp << "set terminal pngcairo size 1200,800 font 'sans,11' noenhanced\n"
+       << "set output " << GnuplotQuote(png) << "\n"
+       << "set multiplot title "
        << GnuplotQuote(std::to_string(r.cycles) + " cycles, " + std::to_string(r.misses) +
-                       " deadline misses (red)") << "\n"
-       << "set grid\nset logscale y\nset autoscale xfix\nset lmargin 12\nset key top right\n"
-       << "set ylabel 'latency [us]'\n"
-       << "plot " << d << " using 1:2 with lines lc rgb '#1f77b4' title 'wake-up latency', "
-       << d << " using 1:($4 > 0 ? $2 : NaN) with points pt 7 ps 0.8 lc rgb '#d62728' title 'miss'\n"
-       << "set xlabel 'time since the first release [s]'\nset ylabel 'compute [us]'\n"
-       << "set arrow from graph 0, first " << deadline_us << " to graph 1, first " << deadline_us
-       << " nohead dt 2 lc rgb '#7f7f7f'\n"
-       << "plot " << d << " using 1:3 with lines lc rgb '#2ca02c' title 'compute', " << d
-       << " using 1:($4 > 0 ? $3 : NaN) with points pt 7 ps 0.8 lc rgb '#d62728' title 'miss', "
-       << "NaN with lines dt 2 lc rgb '#7f7f7f' title 'deadline'\n"
+                       " deadline misses; top: the share of cycles missed over time")
+       << "\nset grid\nset lmargin at screen 0.08\nset rmargin at screen 0.97\n"
+       << "set xrange [0:" << std::max(detail::TraceSpanS(trace), 1e-6) << "]\n"
+       << StripPanel(r, d) << LatencyPanel(r, d) << ResponsePanel(r, d)
        << "unset multiplot\nset output\n";
     CheckWritten(gp, script);
   }
@@ -123,20 +230,30 @@ std::string NotRecordedNote() {
   return note;
 }
 
+// A double-quoted field of gnuplot's data (a name holding a double quote gets a single one).
+std::string DataQuote(std::string text) {
+  std::replace(text.begin(), text.end(), '"', '\'');
+  return '"' + text + '"';
+}
+
 void CausesPng(const JitterReport& r, const fs::path& scratch, const std::string& png) {
   const std::vector<detail::CauseBar> bars = detail::CauseBars(r);
   const fs::path data = scratch / "causes.dat";
   {
     std::ofstream out(data);
-    out << "# class cycles misses\n";
-    for (const detail::CauseBar& b : bars) out << b.label << ' ' << b.cycles << ' ' << b.misses << '\n';
+    out << "# culprit class cycles misses\n";
+    for (const detail::CauseBar& b : bars) {
+      out << DataQuote(b.label) << ' ' << DataQuote(b.cause) << ' ' << b.cycles << ' ' << b.misses
+          << '\n';
+    }
     CheckWritten(out, data);
   }
   const fs::path script = scratch / "causes.gp";
   {
     std::ofstream gp(script);
     gp << kTerminal << "set output " << GnuplotQuote(png) << "\n"
-       << "set title 'causes of the late cycles (dominant cause per notable cycle)'\n";
+       << "set title 'causes of the late cycles: the culprits of the most notable cycles "
+          "(dominant cause per cycle), and their class'\n";
     if (!r.kernel_recorded) {
       gp << TextOnly(NotRecordedNote());
     } else if (bars.empty()) {
@@ -149,9 +266,10 @@ void CausesPng(const JitterReport& r, const fs::path& scratch, const std::string
          << "set style fill solid 0.7 border -1\nset boxwidth 0.9\nset grid ytics\n"
          << "set yrange [0:" << static_cast<double>(most) * 1.25 << "]\nset ytics "
          << std::max<std::uint64_t>(1, (most + 7) / 8) << "\n"
-         << "set ylabel 'notable cycles'\nset key top right\n"
-         << "plot " << d << " using 2:xtic(1) lc rgb '#1f77b4' title 'notable cycles', " << d
-         << " using 3 lc rgb '#d62728' title 'of them misses'\n";
+         << "set ylabel 'notable cycles'\nset key top right\nset bmargin 5\n"
+         << "plot " << d << " using 3:xtic(stringcolumn(1).\"\\n\".stringcolumn(2)) lc rgb "
+         << "'#1f77b4' title 'notable cycles', " << d
+         << " using 4 lc rgb '#d62728' title 'of them misses'\n";
     }
     gp << "set output\n";
     CheckWritten(gp, script);

@@ -33,10 +33,21 @@ struct SvgAxis {
   bool integer = false;  ///< counts: ticks at whole numbers only
 };
 
+/// One bar of a strip (SvgChart::Strip): an x range and the share of the strip's height it
+/// fills, 0 to 1.
+struct StripBar {
+  double x0 = 0.0;
+  double x1 = 0.0;
+  double fill = 0.0;
+};
+
 /// A chart area of a fixed pixel size; data coordinates map through the axes.
 class SvgChart {
  public:
-  SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title);
+  /// `strip_px` > 0 reserves a lane of that height between the title and the plot area, on
+  /// the same x axis (Strip).
+  SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title,
+           double strip_px = 0.0);
 
   /// Grid, ticks, tick labels and axis labels.
   void Axes();
@@ -52,8 +63,11 @@ class SvgChart {
   void HorizontalMarker(double y, const std::string& label, const char* colour);
   /// Text just above a data position (anchor "start", "middle", "end").
   void Label(double x, double y, const std::string& text, const char* anchor);
-  /// A category's name under the x axis.
-  void XCategory(double x, const std::string& text);
+  /// A category's name under the x axis; `line` 1 is a second line under the first.
+  void XCategory(double x, const std::string& text, int line = 0);
+  /// Bars in the strip lane, from its bottom up (class "strip"), and its name left of it: a
+  /// density over x that stays readable where markers in the plot would cover it.
+  void Strip(const std::vector<StripBar>& bars, const std::string& label, const char* colour);
   /// Text centred in the plot area (for a chart with nothing to draw).
   void Note(const std::string& text);
   /// A legend entry (top right, one per call), a box or (dashed) a line.
@@ -72,6 +86,7 @@ class SvgChart {
   SvgAxis y_;
   double left_ = 70.0;
   double right_ = 20.0;
+  double strip_px_ = 0.0;
   double top_ = 30.0;
   double bottom_ = 50.0;
   int legend_entries_ = 0;
