@@ -29,7 +29,7 @@ constexpr std::size_t kMaxSvgBins = 120;
 constexpr std::size_t kCulpritChars = 24;  // fits a sixth of the chart's width
 using detail::kBlue;
 using detail::kGreen;
-using detail::kGrey;
+using detail::kDeadline;
 using detail::kOrange;
 using detail::kPurple;
 using detail::kRed;
@@ -56,12 +56,12 @@ std::string HistogramSvg(const JitterReport& r) {
   chart.VerticalMarker(Us(s.p50_ns), "", kGreen);
   chart.VerticalMarker(Us(s.p99_ns), "", kOrange);
   chart.VerticalMarker(Us(s.p999_ns), "", kRed);
-  chart.VerticalMarker(Us(r.deadline_ns), "", kGrey);
+  chart.VerticalMarker(Us(r.deadline_ns), "", kDeadline);
   chart.Legend("cycles per bin", kBlue);
   chart.Legend("p50 " + detail::FormatDuration(s.p50_ns), kGreen, true);
   chart.Legend("p99 " + detail::FormatDuration(s.p99_ns), kOrange, true);
   chart.Legend("p99.9 " + detail::FormatDuration(s.p999_ns), kRed, true);
-  chart.Legend("deadline " + detail::FormatDuration(r.deadline_ns), kGrey, true);
+  chart.Legend("deadline " + detail::FormatDuration(r.deadline_ns), kDeadline, true);
   return chart.Finish();
 }
 
@@ -101,11 +101,11 @@ std::string TimelineSvg(const JitterReport& r, const TimingTrace& trace) {
   chart.Axes();
   chart.Strip(MissStripBars(trace), "missed", kRed);
   chart.Line(t, compute, kGreen);
-  chart.Line(t, latency, kBlue);
   chart.Line(t, response, kPurple);
+  chart.Line(t, latency, kBlue);  // over the response, which it is a part of
   chart.Dots(miss_t, miss_response, kRed);
   chart.HorizontalMarker(Us(r.deadline_ns), "deadline " + detail::FormatDuration(r.deadline_ns),
-                         kGrey);
+                         kDeadline);
   chart.Legend("wake-up latency", kBlue);
   chart.Legend("compute", kGreen);
   chart.Legend("response (release to end)", kPurple);
@@ -143,8 +143,10 @@ std::string CausesSvg(const JitterReport& r) {
                 "middle");
     chart.Label(x + 0.7, static_cast<double>(bars[i].misses), std::to_string(bars[i].misses),
                 "middle");
-    chart.XCategory(x + 0.5, Fit(bars[i].label));
-    chart.XCategory(x + 0.5, bars[i].cause, 1);
+    const auto [name, pid] = detail::SplitCulprit(bars[i].label);
+    chart.XCategory(x + 0.5, Fit(name));
+    if (!pid.empty()) chart.XCategory(x + 0.5, pid, 1);
+    chart.XCategory(x + 0.5, bars[i].cause, pid.empty() ? 1 : 2);
   }
   chart.Legend("notable cycles", kBlue);
   chart.Legend("of them misses", kRed);

@@ -18,7 +18,7 @@ using detail::GnuplotQuote;
 
 constexpr std::size_t kMaxTimelinePoints = 20000;
 constexpr std::size_t kPngStripBins = 300;  // 3.5 px each on the 1200 px picture
-using detail::kGrey;
+using detail::kDeadline;
 using detail::kPurple;
 using detail::kRed;
 constexpr std::size_t kMaxHistogramBins = 120;
@@ -28,22 +28,31 @@ void CheckWritten(const std::ofstream& out, const fs::path& path) {
   if (!out) throw PlotError("cannot write gnuplot's input " + path.string());
 }
 
-// A dashed vertical line at x (first axis), named in the key by MarkerKey.
-std::string Marker(double x_us, const char* colour) {
+// Marker lines: the percentiles dashed; the deadline solid, so that it shows in front of a
+// dense band of 20,000 cycles and beside a p50 that falls on it.
+constexpr const char* kDashed = "dt 2 lw 1.5";
+constexpr const char* kSolid = "dt 1 lw 2";
+
+// A vertical line at x (first axis) in front of the data, named in the key by MarkerKey.
+std::string Marker(double x_us, const char* colour, const char* style = kDashed) {
   return "set arrow from " + std::to_string(x_us) + ", graph 0 to " + std::to_string(x_us) +
-         ", graph 1 nohead dt 2 lw 1.5 lc rgb '" + colour + "'\n";
+         ", graph 1 nohead front " + style + " lc rgb '" + colour + "'\n";
 }
-std::string MarkerKey(const std::string& label, const char* colour) {
-  return ", NaN with lines dt 2 lw 1.5 lc rgb '" + std::string(colour) + "' title " +
+std::string MarkerKey(const std::string& label, const char* colour, const char* style = kDashed) {
+  return ", NaN with lines " + std::string(style) + " lc rgb '" + colour + "' title " +
          GnuplotQuote(label);
 }
 
-// The same, horizontal at y (first axis), in the panel plotted next.
-std::string HorizontalMarker(double y_us, const char* colour) {
+// The deadline across the panel plotted next, at y (first axis), with its key entry.
+std::string DeadlineLine(const JitterReport& r) {
   std::ostringstream line;
+  const double y_us = static_cast<double>(r.deadline_ns) / 1e3;
   line << "set arrow from graph 0, first " << y_us << " to graph 1, first " << y_us
-       << " nohead dt 2 lw 1.5 lc rgb '" << colour << "'\n";
+       << " nohead front " << kSolid << " lc rgb '" << kDeadline << "'\n";
   return line.str();
+}
+std::string DeadlineKey(const JitterReport& r) {
+  return MarkerKey("deadline " + detail::FormatDuration(r.deadline_ns), kDeadline, kSolid);
 }
 
 void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::string& png) {
@@ -67,7 +76,6 @@ void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::str
   {
     std::ofstream gp(script);
     const scheduler::TimingSummary& s = r.latency.summary;
-    const std::string deadline = "deadline " + detail::FormatDuration(r.deadline_ns);
     gp << kTerminal << "set output " << GnuplotQuote(png) << "\n"
        << "set title " << GnuplotQuote("wake-up latency, " + std::to_string(s.count) + " cycles") << "\n"
        << "set logscale xy\nset grid\nset xlabel 'wake-up latency [us]'\n"
@@ -76,14 +84,14 @@ void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::str
        << Marker(static_cast<double>(s.p50_ns) / 1e3, "#2ca02c")
        << Marker(static_cast<double>(s.p99_ns) / 1e3, "#ff7f0e")
        << Marker(static_cast<double>(s.p999_ns) / 1e3, "#d62728")
-       << Marker(static_cast<double>(r.deadline_ns) / 1e3, kGrey)
+       << Marker(static_cast<double>(r.deadline_ns) / 1e3, kDeadline, kSolid)
        << "plot " << GnuplotQuote(data.string())
        << " using (sqrt($1*$2)):3:1:2:(0.5):3 with boxxyerror fs solid 0.6 lc rgb '#1f77b4' "
        << "title 'cycles per bin'"
        << MarkerKey("p50 " + detail::FormatDuration(s.p50_ns), "#2ca02c")
        << MarkerKey("p99 " + detail::FormatDuration(s.p99_ns), "#ff7f0e")
        << MarkerKey("p99.9 " + detail::FormatDuration(s.p999_ns), "#d62728")
-       << MarkerKey(deadline, kGrey) << "\n"
+       << DeadlineKey(r) << "\n"
        << "set output\n";
     CheckWritten(gp, script);
   }
@@ -158,22 +166,19 @@ std::string StripPanel(const JitterReport& r, const TimelineData& d) {
 std::string LogPanel(const detail::LogRange& range, const std::string& ylabel) {
   std::ostringstream gp;
   gp << "set logscale y\nset yrange [" << range.Low() << ":" << range.High() << "]\n"
-     << "set ytics autofreq\nset key top right\nset ylabel " << GnuplotQuote(ylabel) << "\n";
+     << "set ytics autofreq\nset key top right opaque\nset ylabel " << GnuplotQuote(ylabel) << "\n";
   return gp.str();
 }
 
 std::string LatencyPanel(const JitterReport& r, const TimelineData& d) {
-  const double deadline_us = static_cast<double>(r.deadline_ns) / 1e3;
-  return PanelAt(0.82, 0.50) + LogPanel(d.latency, "wake-up latency [us]") +
-         HorizontalMarker(deadline_us, kGrey) + "plot " + GnuplotQuote(d.cycles.string()) +
-         " using 1:2 with lines lc rgb '" + detail::kBlue + "' title 'wake-up latency'" +
-         MarkerKey("deadline " + detail::FormatDuration(r.deadline_ns), kGrey) + "\nunset arrow\n";
+  return PanelAt(0.82, 0.50) + LogPanel(d.latency, "wake-up latency [us]") + DeadlineLine(r) +
+         "plot " + GnuplotQuote(d.cycles.string()) + " using 1:2 with lines lc rgb '" +
+         detail::kBlue + "' title 'wake-up latency'" + DeadlineKey(r) + "\nunset arrow\n";
 }
 
 // Response against the deadline, the misses marked at their response (or, when too many to
 // mark, a key entry pointing at the strip).
 std::string ResponsePanel(const JitterReport& r, const TimelineData& d) {
-  const double deadline_us = static_cast<double>(r.deadline_ns) / 1e3;
   const std::string cycles = GnuplotQuote(d.cycles.string());
   std::string misses;
   if (d.marked) {
@@ -185,11 +190,11 @@ std::string ResponsePanel(const JitterReport& r, const TimelineData& d) {
   }
   return PanelAt(0.48, 0.09) +
          "set format x '% g'\nset xlabel 'time since the first release [s]'\n" +
-         LogPanel(d.response, "response and compute [us]") + HorizontalMarker(deadline_us, kGrey) +
+         LogPanel(d.response, "response and compute [us]") + DeadlineLine(r) +
          "plot " + cycles + " using 1:4 with lines lc rgb '" + kPurple +
          "' title 'response (release to end)', " + cycles +
          " using 1:3 with lines lc rgb '" + detail::kGreen + "' title 'compute'" + misses +
-         MarkerKey("deadline " + detail::FormatDuration(r.deadline_ns), kGrey) + "\n";
+         DeadlineKey(r) + "\n";
 }
 
 void TimelinePng(const JitterReport& r, const TimingTrace& trace, const fs::path& scratch,
@@ -236,6 +241,21 @@ std::string DataQuote(std::string text) {
   return '"' + text + '"';
 }
 
+// A tick step for counts up to `most`: 1, 2 or 5 times a power of ten, at most 8 steps.
+std::uint64_t CountStep(std::uint64_t most) {
+  for (std::uint64_t magnitude = 1;; magnitude *= 10) {
+    for (const std::uint64_t m : {1U, 2U, 5U}) {
+      if (most <= 8 * m * magnitude) return m * magnitude;
+    }
+  }
+}
+
+// The culprits' names broken before " (pid N)" (as detail::SplitCulprit does for the SVG),
+// over their class.
+constexpr const char* kCulpritTic =
+    "wrap(s) = strstrt(s, ' (') > 0 ? "
+    "s[1:strstrt(s, ' (') - 1].\"\\n\".s[strstrt(s, ' (') + 1:*] : s\n";
+
 void CausesPng(const JitterReport& r, const fs::path& scratch, const std::string& png) {
   const std::vector<detail::CauseBar> bars = detail::CauseBars(r);
   const fs::path data = scratch / "causes.dat";
@@ -265,9 +285,9 @@ void CausesPng(const JitterReport& r, const fs::path& scratch, const std::string
       gp << "set style data histograms\nset style histogram clustered gap 1\n"
          << "set style fill solid 0.7 border -1\nset boxwidth 0.9\nset grid ytics\n"
          << "set yrange [0:" << static_cast<double>(most) * 1.25 << "]\nset ytics "
-         << std::max<std::uint64_t>(1, (most + 7) / 8) << "\n"
-         << "set ylabel 'notable cycles'\nset key top right\nset bmargin 5\n"
-         << "plot " << d << " using 3:xtic(stringcolumn(1).\"\\n\".stringcolumn(2)) lc rgb "
+         << CountStep(most) << "\n"
+         << "set ylabel 'notable cycles'\nset key top right\nset bmargin 6\n" << kCulpritTic
+         << "plot " << d << " using 3:xtic(wrap(stringcolumn(1)).\"\\n\".stringcolumn(2)) lc rgb "
          << "'#1f77b4' title 'notable cycles', " << d
          << " using 4 lc rgb '#d62728' title 'of them misses'\n";
     }

@@ -67,6 +67,12 @@ double LogRange::High() const noexcept {
   return hi_ > 0.0 ? std::max(hi_ * 1.5, Low() * 10.0) : 10.0;
 }
 
+std::pair<std::string, std::string> SplitCulprit(const std::string& name) {
+  const std::size_t at = name.find(" (");
+  if (at == std::string::npos) return {name, ""};
+  return {name.substr(0, at), name.substr(at + 1)};
+}
+
 std::vector<CauseBar> CauseBars(const JitterReport& report, std::size_t top) {
   if (!report.kernel_recorded) return {};
   // Per (class, culprit), in order of the first notable cycle it explains.

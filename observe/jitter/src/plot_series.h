@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hiltwin/jitter/jitter_report.h"
@@ -21,7 +22,7 @@ inline constexpr const char* kGreen = "#2ca02c";
 inline constexpr const char* kOrange = "#ff7f0e";
 inline constexpr const char* kRed = "#d62728";
 inline constexpr const char* kPurple = "#9467bd";
-inline constexpr const char* kGrey = "#7f7f7f";
+inline constexpr const char* kDeadline = "#000000";
 
 /// At most this many misses are drawn as markers: at 20 kHz an infeasible rate misses tens of
 /// thousands of cycles, whose markers would cover the panels; the strip shows them instead.
@@ -64,6 +65,9 @@ struct CauseBar {
   std::uint64_t cycles = 0;
   std::uint64_t misses = 0;
 };
+/// A culprit's name as two lines: "rt-hog" and "(pid 4242)"; ("local_timer", "") unsplit.
+[[nodiscard]] std::pair<std::string, std::string> SplitCulprit(const std::string& name);
+
 /// The `top` culprits of the most notable cycles (most first; ties: the earlier first), and one
 /// bar "N other culprits" for the rest. Empty without the kernel.
 [[nodiscard]] std::vector<CauseBar> CauseBars(const JitterReport& report, std::size_t top = 5);

@@ -179,8 +179,8 @@ void SvgChart::HorizontalMarker(double y, const std::string& label, const char* 
   const std::string py = Num(Py(y));
   body_ += "<line class=\"marker\" stroke=\"" + std::string(colour) + "\" x1=\"" + Num(left_) +
            "\" y1=\"" + py + "\" x2=\"" + Num(width_px_ - right_) + "\" y2=\"" + py + "\"/>" +
-           "<text fill=\"" + colour + "\" x=\"" + Num(left_ + 4) + "\" y=\"" + Num(Py(y) - 4) +
-           "\">" + HtmlEscape(label) + "</text>\n";
+           "<text class=\"halo\" fill=\"" + colour + "\" x=\"" + Num(left_ + 4) + "\" y=\"" +
+           Num(Py(y) - 4) + "\">" + HtmlEscape(label) + "</text>\n";
 }
 
 void SvgChart::Label(double x, double y, const std::string& text, const char* anchor) {
@@ -218,6 +218,11 @@ void SvgChart::Strip(const std::vector<StripBar>& bars, const std::string& label
 void SvgChart::Legend(const std::string& text, const char* colour, bool dashed) {
   const double y = top_ + 14.0 + 16.0 * legend_entries_++;
   const double x = width_px_ - right_ - 10.0;
+  // A white backing, about as wide as the text (6.2 px a character at 11 px), so dense data
+  // under the legend does not cross it.
+  const double width = 6.2 * static_cast<double>(text.size()) + (dashed ? 24 : 14) + 6;
+  body_ += "<rect fill=\"#fff\" fill-opacity=\"0.85\" x=\"" + Num(x - width) + "\" y=\"" +
+           Num(y - 12) + "\" width=\"" + Num(width + 4) + "\" height=\"16\"/>";
   if (dashed) {
     body_ += "<line class=\"marker\" stroke=\"" + std::string(colour) + "\" x1=\"" + Num(x - 18) +
              "\" y1=\"" + Num(y - 4) + "\" x2=\"" + Num(x) + "\" y2=\"" + Num(y - 4) + "\"/>";

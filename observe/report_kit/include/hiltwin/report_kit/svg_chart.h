@@ -18,6 +18,7 @@ inline constexpr const char* kPageStyle =
     "svg .grid{stroke:#eee}svg .frame{fill:none;stroke:#888}"
     "svg .marker{stroke-dasharray:4 3;stroke-width:1.5}"
     "svg .title{font-size:14px;font-weight:bold}svg .note{font-size:15px;fill:#666}"
+    "svg .halo{paint-order:stroke;stroke:#fff;stroke-width:3px;stroke-linejoin:round}"
     "pre{background:#f7f7f7;border:1px solid #e5e5e5;padding:12px;font-size:12px;overflow-x:auto}";
 
 /// Escapes &, <, >, " for HTML and SVG text.
@@ -58,7 +59,7 @@ class SvgChart {
   /// A dot at each point.
   void Dots(const std::vector<double>& xs, const std::vector<double>& ys, const char* colour);
   /// A dashed vertical (x) or horizontal (y) marker with a label ("" for none: say it in the
-  /// legend).
+  /// legend); a horizontal one's label has a white halo.
   void VerticalMarker(double x, const std::string& label, const char* colour);
   void HorizontalMarker(double y, const std::string& label, const char* colour);
   /// Text just above a data position (anchor "start", "middle", "end").
@@ -70,7 +71,8 @@ class SvgChart {
   void Strip(const std::vector<StripBar>& bars, const std::string& label, const char* colour);
   /// Text centred in the plot area (for a chart with nothing to draw).
   void Note(const std::string& text);
-  /// A legend entry (top right, one per call), a box or (dashed) a line.
+  /// A legend entry (top right, one per call), a box or (dashed) a line, on a white backing
+  /// so it reads over the data.
   void Legend(const std::string& text, const char* colour, bool dashed = false);
 
   /// The finished <svg> element.
