@@ -196,7 +196,7 @@ std::string FindOnPath(const std::string& program) {
   std::size_t begin = 0;
   while (begin <= dirs.size()) {
     const std::size_t end = std::min(dirs.find(':', begin), dirs.size());
-    const std::string candidate = dirs.substr(begin, end - begin) + "/" + program;
+    std::string candidate = dirs.substr(begin, end - begin) + "/" + program;
     if (access(candidate.c_str(), X_OK) == 0) return candidate;
     begin = end + 1;
   }
