@@ -28,31 +28,34 @@ void CheckWritten(const std::ofstream& out, const fs::path& path) {
   if (!out) throw PlotError("cannot write gnuplot's input " + path.string());
 }
 
-// Marker lines: the percentiles dashed; the deadline solid, so that it shows in front of a
-// dense band of 20,000 cycles and beside a p50 that falls on it.
+// Marker lines: the percentiles dashed; the deadline solid, so that it shows beside a p50
+// that falls on it. Every key is opaque and drawn after the plots, so no line crosses it.
 constexpr const char* kDashed = "dt 2 lw 1.5";
 constexpr const char* kSolid = "dt 1 lw 2";
 
-// A vertical line at x (first axis) in front of the data, named in the key by MarkerKey.
+// A vertical line at x (first axis), behind the (translucent) bars, named in the key by
+// MarkerKey.
 std::string Marker(double x_us, const char* colour, const char* style = kDashed) {
   return "set arrow from " + std::to_string(x_us) + ", graph 0 to " + std::to_string(x_us) +
-         ", graph 1 nohead front " + style + " lc rgb '" + colour + "'\n";
+         ", graph 1 nohead " + style + " lc rgb '" + colour + "'\n";
 }
 std::string MarkerKey(const std::string& label, const char* colour, const char* style = kDashed) {
   return ", NaN with lines " + std::string(style) + " lc rgb '" + colour + "' title " +
          GnuplotQuote(label);
 }
 
-// The deadline across the panel plotted next, at y (first axis), with its key entry.
-std::string DeadlineLine(const JitterReport& r) {
-  std::ostringstream line;
-  const double y_us = static_cast<double>(r.deadline_ns) / 1e3;
-  line << "set arrow from graph 0, first " << y_us << " to graph 1, first " << y_us
-       << " nohead front " << kSolid << " lc rgb '" << kDeadline << "'\n";
-  return line.str();
-}
 std::string DeadlineKey(const JitterReport& r) {
   return MarkerKey("deadline " + detail::FormatDuration(r.deadline_ns), kDeadline, kSolid);
+}
+
+// The deadline across a timeline panel: a constant plotted after the cycles, so that it shows
+// over a dense band of 20,000 of them (an arrow would cross the key).
+std::string DeadlinePlot(const JitterReport& r) {
+  std::ostringstream plot;
+  plot << ", " << static_cast<double>(r.deadline_ns) / 1e3 << " with lines " << kSolid
+       << " lc rgb '" << kDeadline << "' title "
+       << GnuplotQuote("deadline " + detail::FormatDuration(r.deadline_ns));
+  return plot.str();
 }
 
 void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::string& png) {
@@ -79,14 +82,15 @@ void HistogramPng(const JitterReport& r, const fs::path& scratch, const std::str
     gp << kTerminal << "set output " << GnuplotQuote(png) << "\n"
        << "set title " << GnuplotQuote("wake-up latency, " + std::to_string(s.count) + " cycles") << "\n"
        << "set logscale xy\nset grid\nset xlabel 'wake-up latency [us]'\n"
-       << "set ylabel 'cycles (log scale)'\nset yrange [0.5:*]\nset key top right\n"
+       << "set ylabel 'cycles (log scale)'\nset yrange [0.5:*]\nset key top right opaque\n"
        << "set xrange [" << x.Low() << ":" << x.High() << "]\n"
        << Marker(static_cast<double>(s.p50_ns) / 1e3, "#2ca02c")
        << Marker(static_cast<double>(s.p99_ns) / 1e3, "#ff7f0e")
        << Marker(static_cast<double>(s.p999_ns) / 1e3, "#d62728")
        << Marker(static_cast<double>(r.deadline_ns) / 1e3, kDeadline, kSolid)
        << "plot " << GnuplotQuote(data.string())
-       << " using (sqrt($1*$2)):3:1:2:(0.5):3 with boxxyerror fs solid 0.6 lc rgb '#1f77b4' "
+       << " using (sqrt($1*$2)):3:1:2:(0.5):3 with boxxyerror fs transparent solid 0.6 "
+       << "lc rgb '#1f77b4' "
        << "title 'cycles per bin'"
        << MarkerKey("p50 " + detail::FormatDuration(s.p50_ns), "#2ca02c")
        << MarkerKey("p99 " + detail::FormatDuration(s.p99_ns), "#ff7f0e")
@@ -171,9 +175,9 @@ std::string LogPanel(const detail::LogRange& range, const std::string& ylabel) {
 }
 
 std::string LatencyPanel(const JitterReport& r, const TimelineData& d) {
-  return PanelAt(0.82, 0.50) + LogPanel(d.latency, "wake-up latency [us]") + DeadlineLine(r) +
-         "plot " + GnuplotQuote(d.cycles.string()) + " using 1:2 with lines lc rgb '" +
-         detail::kBlue + "' title 'wake-up latency'" + DeadlineKey(r) + "\nunset arrow\n";
+  return PanelAt(0.82, 0.50) + LogPanel(d.latency, "wake-up latency [us]") + "plot " +
+         GnuplotQuote(d.cycles.string()) + " using 1:2 with lines lc rgb '" + detail::kBlue +
+         "' title 'wake-up latency'" + DeadlinePlot(r) + "\n";
 }
 
 // Response against the deadline, the misses marked at their response (or, when too many to
@@ -190,11 +194,10 @@ std::string ResponsePanel(const JitterReport& r, const TimelineData& d) {
   }
   return PanelAt(0.48, 0.09) +
          "set format x '% g'\nset xlabel 'time since the first release [s]'\n" +
-         LogPanel(d.response, "response and compute [us]") + DeadlineLine(r) +
-         "plot " + cycles + " using 1:4 with lines lc rgb '" + kPurple +
-         "' title 'response (release to end)', " + cycles +
-         " using 1:3 with lines lc rgb '" + detail::kGreen + "' title 'compute'" + misses +
-         DeadlineKey(r) + "\n";
+         LogPanel(d.response, "response and compute [us]") + "plot " + cycles +
+         " using 1:4 with lines lc rgb '" + kPurple + "' title 'response (release to end)', " +
+         cycles + " using 1:3 with lines lc rgb '" + detail::kGreen + "' title 'compute'" +
+         DeadlinePlot(r) + misses + "\n";
 }
 
 void TimelinePng(const JitterReport& r, const TimingTrace& trace, const fs::path& scratch,

@@ -366,8 +366,9 @@ TEST(JitterPictures, GnuplotTimelineHasTheDeadlineAndTheMissesInTheResponsePanel
     return p.find("set ylabel 'response") != std::string::npos;
   });
   ASSERT_NE(response, panels.end()) << script;
-  EXPECT_NE(response->find("first 50 to graph 1, first 50 nohead"), std::string::npos) << *response;
-  EXPECT_NE(response->find("title 'deadline 50 us'"), std::string::npos) << *response;
+  EXPECT_NE(response->find(", 50 with lines dt 1 lw 2 lc rgb '#000000' title 'deadline 50 us'"),
+            std::string::npos)
+      << *response;
   EXPECT_NE(response->find("misses.dat' using 1:2 with points"), std::string::npos) << *response;
   const std::vector<std::vector<std::string>> misses = Rows(gp->File("misses.dat"));
   ASSERT_EQ(misses.size(), 2u);
