@@ -45,16 +45,17 @@ const char* PolicyName(int policy) noexcept {
   }
 }
 
-namespace {
-
 PlotPoint PointOf(const scheduler::TimingSample& s, std::int64_t t0_ns) {
   PlotPoint p;
   p.t_s = static_cast<double>(s.release_ns - t0_ns) * 1e-9;
   p.latency_us = static_cast<double>(s.wake_ns - s.release_ns) * 1e-3;
   p.compute_us = static_cast<double>(s.end_ns - s.start_ns - s.io_ns) * 1e-3;
+  p.response_us = static_cast<double>(s.end_ns - s.release_ns) * 1e-3;
   p.missed = s.missed;
   return p;
 }
+
+namespace {
 
 // The rows of [begin, end) worth keeping, in time order.
 void KeepExtremes(const std::vector<TracedCycle>& cycles, std::size_t begin, std::size_t end,
@@ -64,19 +65,24 @@ void KeepExtremes(const std::vector<TracedCycle>& cycles, std::size_t begin, std
     const auto& s = cycles[i].sample;
     return s.end_ns - s.start_ns - s.io_ns;
   };
+  auto response = [&](std::size_t i) {
+    return cycles[i].sample.end_ns - cycles[i].sample.release_ns;
+  };
   std::size_t lo = begin;
   std::size_t hi = begin;
   std::size_t heavy = begin;
+  std::size_t slow = begin;
   std::size_t miss = end;
   for (std::size_t i = begin; i < end; ++i) {
     if (latency(i) < latency(lo)) lo = i;
     if (latency(i) > latency(hi)) hi = i;
     if (compute(i) > compute(heavy)) heavy = i;
+    if (response(i) > response(slow)) slow = i;
     if (miss == end && cycles[i].sample.missed) miss = i;
   }
-  std::size_t picked[4] = {lo, hi, heavy, miss};
+  std::size_t picked[5] = {lo, hi, heavy, slow, miss};
   std::sort(std::begin(picked), std::end(picked));
-  for (std::size_t i = 0; i < 4; ++i) {
+  for (std::size_t i = 0; i < 5; ++i) {
     if (picked[i] == end || (i > 0 && picked[i] == picked[i - 1])) continue;
     rows.push_back(picked[i]);
   }
@@ -94,7 +100,7 @@ std::vector<PlotPoint> ThinnedCycles(const TimingTrace& trace, std::size_t max_p
     for (const TracedCycle& c : trace.cycles) points.push_back(PointOf(c.sample, t0_ns));
     return points;
   }
-  const std::size_t buckets = max_points / 4;
+  const std::size_t buckets = max_points / 5;
   std::vector<std::size_t> rows;
   rows.reserve(max_points);
   for (std::size_t b = 0; b < buckets; ++b) {
@@ -129,13 +135,6 @@ std::vector<HistogramBin> LogDisplayBins(const Distribution& distribution, std::
     }
   }
   return out;
-}
-
-std::vector<CauseBar> CauseBars(const JitterReport& report) {
-  std::vector<CauseBar> bars;
-  if (!report.kernel_recorded) return bars;
-  for (const CauseCount& c : report.causes) bars.push_back({ToString(c.cause), c.cycles, c.misses});
-  return bars;
 }
 
 }  // namespace hiltwin::analysis::detail

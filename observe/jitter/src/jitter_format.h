@@ -27,12 +27,15 @@ struct PlotPoint {
   double t_s = 0.0;
   double latency_us = 0.0;
   double compute_us = 0.0;
+  double response_us = 0.0;  ///< release to end: what the deadline bounds
   bool missed = false;
 };
+/// `s` as a point, its time counted from the release `t0_ns`.
+[[nodiscard]] PlotPoint PointOf(const scheduler::TimingSample& s, std::int64_t t0_ns);
 
 /// The cycles to draw: all of them when there are at most `max_points`, else per bucket of
-/// consecutive cycles the ones with the smallest and largest latency, the largest compute and
-/// the first miss, in time order, so spikes and misses survive thinning.
+/// consecutive cycles the ones with the smallest and largest latency, the largest compute, the
+/// largest response and the first miss, in time order, so spikes and misses survive thinning.
 [[nodiscard]] std::vector<PlotPoint> ThinnedCycles(const TimingTrace& trace,
                                                    std::size_t max_points);
 
@@ -40,14 +43,6 @@ struct PlotPoint {
 /// exact range below 1 µs stay apart only as far as the scale allows), for drawing.
 [[nodiscard]] std::vector<HistogramBin> LogDisplayBins(const Distribution& distribution,
                                                        std::size_t max_bins);
-
-/// The classes a cause bar chart shows, most first: class name and notable cycles.
-struct CauseBar {
-  std::string label;
-  std::uint64_t cycles = 0;
-  std::uint64_t misses = 0;
-};
-[[nodiscard]] std::vector<CauseBar> CauseBars(const JitterReport& report);
 
 /// The line every output shows when the kernel was not recorded.
 inline constexpr const char* kCausesNotRecorded =

@@ -7,6 +7,7 @@
 
 #include "hiltwin/jitter/jitter_outputs.h"
 #include "jitter_format.h"
+#include "plot_series.h"
 #include "hiltwin/report_kit/svg_chart.h"
 #include "hiltwin/report_kit/time_units.h"
 
@@ -20,22 +21,30 @@ using detail::SvgChart;
 
 constexpr int kWidthPx = 900;
 constexpr int kHeightPx = 340;
+constexpr int kTimelineHeightPx = 380;  // the miss strip on top of the plot
+constexpr double kStripPx = 28.0;
+constexpr std::size_t kSvgStripBins = 200;  // about 4 px each
 constexpr std::size_t kMaxSvgPoints = 3000;
 constexpr std::size_t kMaxSvgBins = 120;
-constexpr const char* kBlue = "#1f77b4";
-constexpr const char* kGreen = "#2ca02c";
-constexpr const char* kOrange = "#ff7f0e";
-constexpr const char* kRed = "#d62728";
-
+constexpr std::size_t kCulpritChars = 24;  // fits a sixth of the chart's width
+using detail::kBlue;
+using detail::kGreen;
+using detail::kDeadline;
+using detail::kOrange;
+using detail::kPurple;
+using detail::kRed;
 
 std::string HistogramSvg(const JitterReport& r) {
   const std::vector<HistogramBin> bins = detail::LogDisplayBins(r.latency, kMaxSvgBins);
   std::uint64_t most = 1;
-  for (const HistogramBin& b : bins) most = std::max(most, b.count);
-  const double x_min = bins.empty() ? 1.0 : Us(std::max<std::int64_t>(bins.front().low_ns, 1));
-  const double x_max = bins.empty() ? 10.0 : Us(bins.back().high_ns);
-  SvgChart chart(kWidthPx, kHeightPx,
-                 {x_min / 1.5, std::max(x_max * 1.5, x_min * 10.0), true, "wake-up latency [us]"},
+  detail::LogRange x;
+  x.Add(Us(r.deadline_ns));
+  for (const HistogramBin& b : bins) {
+    most = std::max(most, b.count);
+    x.Add(Us(std::max<std::int64_t>(b.low_ns, 1)));
+    x.Add(Us(b.high_ns));
+  }
+  SvgChart chart(kWidthPx, kHeightPx, {x.Low(), x.High(), true, "wake-up latency [us]"},
                  {0.5, static_cast<double>(most) * 2.0, true, "cycles (log scale)"},
                  "wake-up latency histogram, " + std::to_string(r.latency.summary.count) + " cycles");
   chart.Axes();
@@ -47,44 +56,69 @@ std::string HistogramSvg(const JitterReport& r) {
   chart.VerticalMarker(Us(s.p50_ns), "", kGreen);
   chart.VerticalMarker(Us(s.p99_ns), "", kOrange);
   chart.VerticalMarker(Us(s.p999_ns), "", kRed);
+  chart.VerticalMarker(Us(r.deadline_ns), "", kDeadline);
   chart.Legend("cycles per bin", kBlue);
   chart.Legend("p50 " + detail::FormatDuration(s.p50_ns), kGreen, true);
   chart.Legend("p99 " + detail::FormatDuration(s.p99_ns), kOrange, true);
   chart.Legend("p99.9 " + detail::FormatDuration(s.p999_ns), kRed, true);
+  chart.Legend("deadline " + detail::FormatDuration(r.deadline_ns), kDeadline, true);
   return chart.Finish();
 }
 
+// The share of cycles missed per time bin, as the strip's bars.
+std::vector<detail::StripBar> MissStripBars(const TimingTrace& trace) {
+  std::vector<detail::StripBar> bars;
+  for (const detail::StripBin& b : detail::MissStrip(trace, kSvgStripBins)) {
+    if (b.cycles == 0) continue;
+    const double share = static_cast<double>(b.missed) / static_cast<double>(b.cycles);
+    bars.push_back({b.from_s, b.to_s, share});
+  }
+  return bars;
+}
+
+// Latency and response of every cycle (thinned) against the deadline; the misses as dots at
+// their response while they are few, and always as a strip of the share missed over time.
 std::string TimelineSvg(const JitterReport& r, const TimingTrace& trace) {
-  const std::vector<detail::PlotPoint> points = detail::ThinnedCycles(trace, kMaxSvgPoints);
-  std::vector<double> t, latency, compute, miss_t, miss_latency;
-  double lo = Us(r.deadline_ns);
-  double hi = lo;
-  for (const detail::PlotPoint& p : points) {
+  std::vector<double> t, latency, compute, response, miss_t, miss_response;
+  detail::LogRange y;
+  y.Add(Us(r.deadline_ns));
+  for (const detail::PlotPoint& p : detail::ThinnedCycles(trace, kMaxSvgPoints)) {
     t.push_back(p.t_s);
     latency.push_back(p.latency_us);
     compute.push_back(p.compute_us);
-    for (const double v : {p.latency_us, p.compute_us}) {
-      if (v > 0.0) lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-    if (p.missed) {
-      miss_t.push_back(p.t_s);
-      miss_latency.push_back(p.compute_us);
-    }
+    response.push_back(p.response_us);
+    for (const double v : {p.latency_us, p.compute_us, p.response_us}) y.Add(v);
   }
-  const double t_max = t.empty() ? 1.0 : std::max(t.back(), 1e-6);
-  SvgChart chart(kWidthPx, kHeightPx, {0.0, t_max, false, "time since the first release [s]"},
-                 {std::max(lo / 1.5, 1e-3), hi * 1.5, true, "[us] (log scale)"},
-                 "latency and compute of every cycle; misses in red");
+  for (const detail::PlotPoint& p : detail::MissMarkers(trace)) {
+    miss_t.push_back(p.t_s);
+    miss_response.push_back(p.response_us);
+  }
+  SvgChart chart(kWidthPx, kTimelineHeightPx,
+                 {0.0, std::max(detail::TraceSpanS(trace), 1e-6), false,
+                  "time since the first release [s]"},
+                 {y.Low(), y.High(), true, "[us] (log scale)"},
+                 "every cycle against the deadline; above: share of cycles missed", kStripPx);
   chart.Axes();
-  chart.Line(t, latency, kBlue);
+  chart.Strip(MissStripBars(trace), "missed", kRed);
   chart.Line(t, compute, kGreen);
-  chart.Dots(miss_t, miss_latency, kRed);
-  chart.HorizontalMarker(Us(r.deadline_ns), "deadline " + detail::FormatDuration(r.deadline_ns), "#7f7f7f");
+  chart.Line(t, response, kPurple);
+  chart.Line(t, latency, kBlue);  // over the response, which it is a part of
+  chart.Dots(miss_t, miss_response, kRed);
+  chart.HorizontalMarker(Us(r.deadline_ns), "deadline " + detail::FormatDuration(r.deadline_ns),
+                         kDeadline);
   chart.Legend("wake-up latency", kBlue);
   chart.Legend("compute", kGreen);
-  chart.Legend("deadline miss (at its compute)", kRed);
+  chart.Legend("response (release to end)", kPurple);
+  const bool too_many = miss_t.empty() && r.misses > 0;
+  chart.Legend(too_many ? "misses: too many to mark, see the strip"
+                        : "deadline miss (at its response)",
+               kRed);
   return chart.Finish();
+}
+
+// A culprit's name cut to fit its bar's width.
+std::string Fit(const std::string& name) {
+  return name.size() <= kCulpritChars ? name : name.substr(0, kCulpritChars - 3) + "...";
 }
 
 std::string CausesSvg(const JitterReport& r) {
@@ -92,9 +126,9 @@ std::string CausesSvg(const JitterReport& r) {
   std::uint64_t most = 1;
   for (const detail::CauseBar& b : bars) most = std::max(most, b.cycles);
   const auto n = static_cast<double>(std::max<std::size_t>(bars.size(), 1));
-  SvgChart chart(kWidthPx, kHeightPx, {0.0, n, false, "dominant cause", false},
+  SvgChart chart(kWidthPx, kHeightPx, {0.0, n, false, "", false},
                  {0.0, static_cast<double>(most) * 1.25, false, "notable cycles", true, true},
-                 "causes of the late cycles");
+                 "causes of the late cycles: the culprits of the most, and their class");
   if (!r.kernel_recorded || bars.empty()) {
     chart.Note(!r.kernel_recorded ? detail::kCausesNotRecorded
                                   : "no notable cycle: no miss and no wake-up above p99.9");
@@ -109,7 +143,10 @@ std::string CausesSvg(const JitterReport& r) {
                 "middle");
     chart.Label(x + 0.7, static_cast<double>(bars[i].misses), std::to_string(bars[i].misses),
                 "middle");
-    chart.XCategory(x + 0.5, bars[i].label);
+    const auto [name, pid] = detail::SplitCulprit(bars[i].label);
+    chart.XCategory(x + 0.5, Fit(name));
+    if (!pid.empty()) chart.XCategory(x + 0.5, pid, 1);
+    chart.XCategory(x + 0.5, bars[i].cause, pid.empty() ? 1 : 2);
   }
   chart.Legend("notable cycles", kBlue);
   chart.Legend("of them misses", kRed);

@@ -19,15 +19,25 @@ std::string TickText(double v) {
   return text;
 }
 
-// Tick positions: powers of ten on a log axis, 1-2-5 steps on a linear one.
+// Tick positions: powers of ten on a log axis (1-2-5 steps on a short one), 1-2-5 steps on a
+// linear one.
 std::vector<double> Ticks(const SvgAxis& axis) {
   std::vector<double> ticks;
   if (axis.log) {
+    // Powers of ten; 1-2-5 steps when fewer than three of them fall in the range, so an axis
+    // of one or two decades (2–75 us) still reads (and a marker at 50 sits on a tick).
     const double lo = std::floor(std::log10(std::max(axis.min, 1e-12)));
     const double hi = std::ceil(std::log10(std::max(axis.max, 1e-12)));
-    for (double e = lo; e <= hi; e += 1.0) {
-      const double v = std::pow(10.0, e);
-      if (v >= axis.min * 0.999 && v <= axis.max * 1.001) ticks.push_back(v);
+    for (const bool fine : {false, true}) {
+      ticks.clear();
+      for (double e = lo; e <= hi; e += 1.0) {
+        for (const double m : {1.0, 2.0, 5.0}) {
+          const double v = m * std::pow(10.0, e);
+          if (m != 1.0 && !fine) continue;
+          if (v >= axis.min * 0.999 && v <= axis.max * 1.001) ticks.push_back(v);
+        }
+      }
+      if (ticks.size() >= 3) break;
     }
     return ticks;
   }
@@ -75,8 +85,10 @@ std::string HtmlEscape(const std::string& text) {
   return out;
 }
 
-SvgChart::SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title)
-    : width_px_(width_px), height_px_(height_px), x_(std::move(x)), y_(std::move(y)) {
+SvgChart::SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title,
+                   double strip_px)
+    : width_px_(width_px), height_px_(height_px), x_(std::move(x)), y_(std::move(y)),
+      strip_px_(std::max(strip_px, 0.0)), top_(strip_px_ > 0.0 ? 30.0 + strip_px_ + 8.0 : 30.0) {
   body_ += "<text x=\"" + Num(width_px_ / 2.0) + "\" y=\"18\" text-anchor=\"middle\" class=\"title\">" +
            HtmlEscape(title) + "</text>\n";
 }
@@ -167,8 +179,8 @@ void SvgChart::HorizontalMarker(double y, const std::string& label, const char* 
   const std::string py = Num(Py(y));
   body_ += "<line class=\"marker\" stroke=\"" + std::string(colour) + "\" x1=\"" + Num(left_) +
            "\" y1=\"" + py + "\" x2=\"" + Num(width_px_ - right_) + "\" y2=\"" + py + "\"/>" +
-           "<text fill=\"" + colour + "\" x=\"" + Num(left_ + 4) + "\" y=\"" + Num(Py(y) - 4) +
-           "\">" + HtmlEscape(label) + "</text>\n";
+           "<text class=\"halo\" fill=\"" + colour + "\" x=\"" + Num(left_ + 4) + "\" y=\"" +
+           Num(Py(y) - 4) + "\">" + HtmlEscape(label) + "</text>\n";
 }
 
 void SvgChart::Label(double x, double y, const std::string& text, const char* anchor) {
@@ -181,14 +193,36 @@ void SvgChart::Note(const std::string& text) {
            "\" text-anchor=\"middle\" class=\"note\">" + HtmlEscape(text) + "</text>\n";
 }
 
-void SvgChart::XCategory(double x, const std::string& text) {
-  body_ += "<text x=\"" + Num(Px(x)) + "\" y=\"" + Num(height_px_ - bottom_ + 16.0) +
+void SvgChart::XCategory(double x, const std::string& text, int line) {
+  body_ += "<text x=\"" + Num(Px(x)) + "\" y=\"" + Num(height_px_ - bottom_ + 16.0 + 14.0 * line) +
            "\" text-anchor=\"middle\">" + HtmlEscape(text) + "</text>\n";
+}
+
+void SvgChart::Strip(const std::vector<StripBar>& bars, const std::string& label,
+                     const char* colour) {
+  if (!(strip_px_ > 0.0)) return;
+  const double bottom = top_ - 8.0;
+  body_ += "<rect class=\"frame\" x=\"" + Num(left_) + "\" y=\"" + Num(bottom - strip_px_) +
+           "\" width=\"" + Num(width_px_ - left_ - right_) + "\" height=\"" + Num(strip_px_) +
+           "\"/><text x=\"" + Num(left_ - 6) + "\" y=\"" + Num(bottom - strip_px_ / 2 + 4) +
+           "\" text-anchor=\"end\">" + HtmlEscape(label) + "</text>\n";
+  for (const StripBar& b : bars) {
+    if (!(b.fill > 0.0) || !Drawable(x_, b.x0) || !Drawable(x_, b.x1)) continue;
+    const double height = std::min(b.fill, 1.0) * strip_px_;
+    body_ += "<rect class=\"strip\" x=\"" + Num(Px(b.x0)) + "\" y=\"" + Num(bottom - height) +
+             "\" width=\"" + Num(std::max(Px(b.x1) - Px(b.x0), 1.0)) + "\" height=\"" +
+             Num(height) + "\" fill=\"" + colour + "\"/>\n";
+  }
 }
 
 void SvgChart::Legend(const std::string& text, const char* colour, bool dashed) {
   const double y = top_ + 14.0 + 16.0 * legend_entries_++;
   const double x = width_px_ - right_ - 10.0;
+  // A white backing, about as wide as the text (6.2 px a character at 11 px), so dense data
+  // under the legend does not cross it.
+  const double width = 6.2 * static_cast<double>(text.size()) + (dashed ? 24 : 14) + 6;
+  body_ += "<rect fill=\"#fff\" fill-opacity=\"0.85\" x=\"" + Num(x - width) + "\" y=\"" +
+           Num(y - 12) + "\" width=\"" + Num(width + 4) + "\" height=\"16\"/>";
   if (dashed) {
     body_ += "<line class=\"marker\" stroke=\"" + std::string(colour) + "\" x1=\"" + Num(x - 18) +
              "\" y1=\"" + Num(y - 4) + "\" x2=\"" + Num(x) + "\" y2=\"" + Num(y - 4) + "\"/>";

@@ -1,6 +1,14 @@
 #include "jitter_fixtures.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
+#include "hiltwin/qos/rules.h"
 
 namespace hiltwin::analysis::testing {
 
@@ -145,6 +153,54 @@ KernelTrace MakeKernel(const TimingTrace& trace, const std::map<std::uint64_t, S
     }
   }
   return script.Finish();
+}
+
+TracedRun MakeTracedRun() {
+  RunSpec spec;
+  spec.releases = 4'000;
+  spec.latency_ns = [](std::uint64_t k) { return 3'000 + static_cast<std::int64_t>(k % 5) * 100; };
+  spec.overrides[1000] = {3'000, 60'000};  // miss, one release skipped
+  spec.overrides[2000] = {25'000, 20'000};  // late wake-up, still met (45.1 µs)
+  spec.overrides[3000] = {3'000, 49'000};  // miss (response 52.1 µs), one release skipped
+  TracedRun run{MakeTrace(spec), {}};
+  run.trace.rules = {qos::MakeMkRule(3, 4)};
+  std::map<std::uint64_t, SpecialCycle> special;
+  special[1000] = [](KernelScript& k, const scheduler::TimingSample& s) {
+    NormalCycle(k, s);
+    k.Irq(s.start_ns + 1'000, s.start_ns + 41'000, kLoopCpu, 42, "eth0");
+  };
+  run.kernel = MakeKernel(run.trace, special);
+  return run;
+}
+
+TempDir::TempDir() {
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "hiltwin-jitter-test-XXXXXX").string();
+  if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+  path_ = pattern;
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  std::filesystem::remove_all(path_, ignored);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string FindOnPath(const std::string& program) {
+  const char* path = std::getenv("PATH");  // NOLINT(concurrency-mt-unsafe): test set-up
+  const std::string dirs = path != nullptr ? path : "";
+  std::size_t begin = 0;
+  while (begin <= dirs.size()) {
+    const std::size_t end = std::min(dirs.find(':', begin), dirs.size());
+    std::string candidate = dirs.substr(begin, end - begin) + "/" + program;
+    if (access(candidate.c_str(), X_OK) == 0) return candidate;
+    begin = end + 1;
+  }
+  return "";
 }
 
 }  // namespace hiltwin::analysis::testing

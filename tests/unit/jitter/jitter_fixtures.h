@@ -3,6 +3,7 @@
 // have timed them, and the kernel's events around them, with known answers.
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <set>
@@ -75,5 +76,34 @@ using SpecialCycle = std::function<void(KernelScript&, const scheduler::TimingSa
 
 /// Kernel events for every cycle of `trace`: NormalCycle, or the special one given for its k.
 KernelTrace MakeKernel(const TimingTrace& trace, const std::map<std::uint64_t, SpecialCycle>& special);
+
+/// A run with a known answer for every output: 4000 releases at 50 µs, two misses (k = 1000:
+/// response 63.1 µs, an interrupt "eth0" held the CPU 40 µs; k = 3000: response 52.1 µs with
+/// compute 49 µs, each skipping a release), one late wake-up (k = 2000, 25 µs, met); the
+/// kernel recorded; an (3,4)-firm rule.
+struct TracedRun {
+  TimingTrace trace;
+  KernelTrace kernel;
+};
+TracedRun MakeTracedRun();
+
+/// A fresh directory under the system's temporary one, removed with its contents at the end.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] std::string str() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// The whole file ("" when it cannot be read).
+std::string ReadFile(const std::string& path);
+
+/// `program`'s path as execvp finds it on PATH, or "" when it is not there.
+std::string FindOnPath(const std::string& program);
 
 }  // namespace hiltwin::analysis::testing

@@ -2,17 +2,12 @@
 // (parsed back), the PNGs (gnuplot) and the self-contained HTML page.
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "hiltwin/jitter/jitter_outputs.h"
-#include "hiltwin/qos/rules.h"
 #include "jitter_fixtures.h"
 
 namespace hiltwin::analysis {
@@ -20,65 +15,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// 4000 releases, two misses (one skipping a release), one late wake-up; the kernel recorded.
-struct TracedRun {
-  TimingTrace trace;
-  KernelTrace kernel;
-};
+using testing::MakeTracedRun;
+using testing::TracedRun;
+using testing::ReadFile;
+using testing::TempDir;
 
-TracedRun MakeTracedRun() {
-  testing::RunSpec spec;
-  spec.releases = 4'000;
-  spec.latency_ns = [](std::uint64_t k) { return 3'000 + static_cast<std::int64_t>(k % 5) * 100; };
-  spec.overrides[1000] = {3'000, 60'000};  // miss, one release skipped
-  spec.overrides[2000] = {25'000, 20'000};  // late wake-up, still met (45.1 µs)
-  spec.overrides[3000] = {3'000, 49'000};  // miss (response 52.1 µs), one release skipped
-  TracedRun run{testing::MakeTrace(spec), {}};
-  run.trace.rules = {qos::MakeMkRule(3, 4)};
-  std::map<std::uint64_t, testing::SpecialCycle> special;
-  special[1000] = [](testing::KernelScript& k, const scheduler::TimingSample& s) {
-    testing::NormalCycle(k, s);
-    k.Irq(s.start_ns + 1'000, s.start_ns + 41'000, testing::kLoopCpu, 42, "eth0");
-  };
-  run.kernel = testing::MakeKernel(run.trace, special);
-  return run;
-}
-
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "hiltwin-jitter-test-XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  [[nodiscard]] std::string str() const { return path_.string(); }
-
- private:
-  fs::path path_;
-};
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-bool GnuplotInstalled() {
-  const char* path = std::getenv("PATH");  // NOLINT(concurrency-mt-unsafe): test set-up
-  std::string dirs = path != nullptr ? path : "";
-  std::size_t begin = 0;
-  while (begin <= dirs.size()) {
-    const std::size_t end = std::min(dirs.find(':', begin), dirs.size());
-    if (access((dirs.substr(begin, end - begin) + "/gnuplot").c_str(), X_OK) == 0) return true;
-    begin = end + 1;
-  }
-  return false;
-}
+bool GnuplotInstalled() { return !testing::FindOnPath("gnuplot").empty(); }
 
 TEST(JitterOutputs, JsonHoldsEveryFigureUnderStableKeys) {
   const TracedRun run = MakeTracedRun();

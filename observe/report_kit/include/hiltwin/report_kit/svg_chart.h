@@ -18,6 +18,7 @@ inline constexpr const char* kPageStyle =
     "svg .grid{stroke:#eee}svg .frame{fill:none;stroke:#888}"
     "svg .marker{stroke-dasharray:4 3;stroke-width:1.5}"
     "svg .title{font-size:14px;font-weight:bold}svg .note{font-size:15px;fill:#666}"
+    "svg .halo{paint-order:stroke;stroke:#fff;stroke-width:3px;stroke-linejoin:round}"
     "pre{background:#f7f7f7;border:1px solid #e5e5e5;padding:12px;font-size:12px;overflow-x:auto}";
 
 /// Escapes &, <, >, " for HTML and SVG text.
@@ -33,10 +34,21 @@ struct SvgAxis {
   bool integer = false;  ///< counts: ticks at whole numbers only
 };
 
+/// One bar of a strip (SvgChart::Strip): an x range and the share of the strip's height it
+/// fills, 0 to 1.
+struct StripBar {
+  double x0 = 0.0;
+  double x1 = 0.0;
+  double fill = 0.0;
+};
+
 /// A chart area of a fixed pixel size; data coordinates map through the axes.
 class SvgChart {
  public:
-  SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title);
+  /// `strip_px` > 0 reserves a lane of that height between the title and the plot area, on
+  /// the same x axis (Strip).
+  SvgChart(int width_px, int height_px, SvgAxis x, SvgAxis y, const std::string& title,
+           double strip_px = 0.0);
 
   /// Grid, ticks, tick labels and axis labels.
   void Axes();
@@ -47,16 +59,20 @@ class SvgChart {
   /// A dot at each point.
   void Dots(const std::vector<double>& xs, const std::vector<double>& ys, const char* colour);
   /// A dashed vertical (x) or horizontal (y) marker with a label ("" for none: say it in the
-  /// legend).
+  /// legend); a horizontal one's label has a white halo.
   void VerticalMarker(double x, const std::string& label, const char* colour);
   void HorizontalMarker(double y, const std::string& label, const char* colour);
   /// Text just above a data position (anchor "start", "middle", "end").
   void Label(double x, double y, const std::string& text, const char* anchor);
-  /// A category's name under the x axis.
-  void XCategory(double x, const std::string& text);
+  /// A category's name under the x axis; `line` 1 is a second line under the first.
+  void XCategory(double x, const std::string& text, int line = 0);
+  /// Bars in the strip lane, from its bottom up (class "strip"), and its name left of it: a
+  /// density over x that stays readable where markers in the plot would cover it.
+  void Strip(const std::vector<StripBar>& bars, const std::string& label, const char* colour);
   /// Text centred in the plot area (for a chart with nothing to draw).
   void Note(const std::string& text);
-  /// A legend entry (top right, one per call), a box or (dashed) a line.
+  /// A legend entry (top right, one per call), a box or (dashed) a line, on a white backing
+  /// so it reads over the data.
   void Legend(const std::string& text, const char* colour, bool dashed = false);
 
   /// The finished <svg> element.
@@ -72,6 +88,7 @@ class SvgChart {
   SvgAxis y_;
   double left_ = 70.0;
   double right_ = 20.0;
+  double strip_px_ = 0.0;
   double top_ = 30.0;
   double bottom_ = 50.0;
   int legend_entries_ = 0;
