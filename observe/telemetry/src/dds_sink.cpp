@@ -130,7 +130,7 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
   timing_topic_ = dds::TopicName(ns, "timing");
   const std::string& timing = timing_topic_;
   timing_writer_ =
-      dds::Check(dds_create_writer(pp, dds::CreateTopic(pp, &hiltwin_msg_dds__Timing__desc, timing),
+      dds::Check(dds_create_writer(pp, dds::CreateTopic(pp, &hiltwin_msgs_msg_dds__Timing__desc, timing),
                                    latest.get(), nullptr),
                  "DDS writer " + timing);
   command_topic_ = dds::TopicName(ns, "command");
@@ -175,7 +175,7 @@ void DdsSink::PublishJoints(const runtime::TelemetryRecord& record) noexcept {
 }
 
 void DdsSink::PublishTiming(const runtime::TelemetryRecord& record) noexcept {
-  hiltwin_msg_dds__Timing_ msg{};
+  hiltwin_msgs_msg_dds__Timing_ msg{};
   msg.ns = ns_.data();
   msg.role = const_cast<char*>(record.role.c_str());
   msg.rate_hz = record.rate_hz;

@@ -16,7 +16,7 @@ namespace hiltwin::telemetry {
 
 /// `--telemetry dds[:DOMAIN]`: publishes rt/<ns>/pose (geometry_msgs::msg::dds_::Pose2D_),
 /// rt/<ns>/joint_states (sensor_msgs::msg::dds_::JointState_), rt/<ns>/timing
-/// (hiltwin::msg::dds_::Timing_) and reads rt/<ns>/command (std_msgs::msg::dds_::Int32_).
+/// (hiltwin_msgs::msg::dds_::Timing_) and reads rt/<ns>/command (std_msgs::msg::dds_::Int32_).
 /// Warns once on stderr when another task publishes under the same namespace.
 struct DdsEndpoint {
   std::uint32_t domain = 0;  ///< DDS domain id (0..232, as ROS_DOMAIN_ID)
