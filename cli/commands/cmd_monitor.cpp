@@ -19,8 +19,8 @@ namespace hiltwin::app {
 namespace {
 
 struct MonitorFlags {
-  MonitorRunOptions run;             ///< every flag but --command, typed by CLI11
-  std::vector<std::string> command;  // NS VERB
+  MonitorRunOptions run;                ///< every flag but --command, typed by CLI11
+  std::vector<std::string> command;     // NS VERB
   const CLI::Option* domain = nullptr;  // --domain; not given: ROS_DOMAIN_ID, as ROS 2 tools
 };
 

@@ -70,8 +70,8 @@ std::uint32_t DefaultDdsDomain(const std::string& flag) {
   if (!domain) {
     Bad("ROS_DOMAIN_ID='" + std::string(text) +
         "' (the DDS domain when none is given) is not a domain: set it to a whole number from 0 "
-        "to " + std::to_string(kMaxDomain) + ", unset it (domain 0), or give the domain with " +
-        flag);
+        "to " +
+        std::to_string(kMaxDomain) + ", unset it (domain 0), or give the domain with " + flag);
   }
   return *domain;
 }

@@ -39,8 +39,7 @@ double StampOf(const Json& stamp) {
 }
 
 double SystemNow() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 /// ROS_DOMAIN_ID for this process and every process it starts, until the scope ends.
@@ -312,8 +311,8 @@ TEST_F(TelemetryDds, RosDomainIdPicksTheDomainOfRunAndMonitor) {
   const auto watch = hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--json", "--wait", "0.1"});
   EXPECT_EQ(watch.exit_code, 2) << watch.out << watch.err;
   EXPECT_NE(watch.err.find("ROS_DOMAIN_ID='lab3'"), std::string::npos) << watch.err;
-  const auto flagged = hiltwin::test::Run(
-      {HILTWIN_BINARY, "monitor", "--json", "--wait", "0.1", "--domain", "227"});
+  const auto flagged =
+      hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--json", "--wait", "0.1", "--domain", "227"});
   EXPECT_EQ(flagged.exit_code, 0) << "--domain wins: " << flagged.err;
 }
 

@@ -79,14 +79,20 @@ Fields ParseIdlStruct(const std::string& idl, const std::string& module_name,
 
 // ROS 2's mapping of .msg field types onto IDL (design.ros2.org, "Interface definition").
 std::string IdlTypeOf(const std::string& msg_type) {
-  static const std::map<std::string, std::string> kPrimitive = {
-      {"bool", "boolean"},         {"byte", "octet"},
-      {"char", "uint8"},           {"float32", "float"},
-      {"float64", "double"},       {"int8", "int8"},
-      {"uint8", "uint8"},          {"int16", "short"},
-      {"uint16", "unsigned short"}, {"int32", "long"},
-      {"uint32", "unsigned long"}, {"int64", "long long"},
-      {"uint64", "unsigned long long"}, {"string", "string"}};
+  static const std::map<std::string, std::string> kPrimitive = {{"bool", "boolean"},
+                                                                {"byte", "octet"},
+                                                                {"char", "uint8"},
+                                                                {"float32", "float"},
+                                                                {"float64", "double"},
+                                                                {"int8", "int8"},
+                                                                {"uint8", "uint8"},
+                                                                {"int16", "short"},
+                                                                {"uint16", "unsigned short"},
+                                                                {"int32", "long"},
+                                                                {"uint32", "unsigned long"},
+                                                                {"int64", "long long"},
+                                                                {"uint64", "unsigned long long"},
+                                                                {"string", "string"}};
   if (msg_type.ends_with("[]")) {
     return "sequence<" + IdlTypeOf(msg_type.substr(0, msg_type.size() - 2)) + ">";
   }
@@ -150,8 +156,8 @@ std::map<std::string, long> EnumCodes(Name&& name, const std::string& prefix) {
 }
 
 std::map<std::string, long> AllCodes() {
-  std::map<std::string, long> codes = EnumCodes<qos::Verdict>(
-      [](qos::Verdict v) { return qos::ToString(v); }, "VERDICT_");
+  std::map<std::string, long> codes =
+      EnumCodes<qos::Verdict>([](qos::Verdict v) { return qos::ToString(v); }, "VERDICT_");
   const auto states = EnumCodes<lifecycle::State>(
       [](lifecycle::State s) { return lifecycle::ToString(s); }, "STATE_");
   codes.insert(states.begin(), states.end());

@@ -100,7 +100,9 @@ class RosReaders {
   void Take(Seen& seen) const {
     while (test::TakeOne<nav_msgs_msg_dds__Odometry_>(odom_, [&](const auto& s) {
       const auto& p = s.pose.pose;
-      seen.odom.push_back({Seconds(s.header.stamp), s.header.frame_id, s.child_frame_id,
+      seen.odom.push_back({Seconds(s.header.stamp),
+                           s.header.frame_id,
+                           s.child_frame_id,
                            {p.position.x, p.position.y, p.position.z},
                            {p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w}});
       seen.twist_vx.push_back(s.twist.twist.linear.x);
@@ -115,8 +117,11 @@ class RosReaders {
         const auto& t = s.transforms._buffer[i];
         const auto& v = t.transform.translation;
         const auto& q = t.transform.rotation;
-        seen.tf.push_back({Seconds(t.header.stamp), t.header.frame_id, t.child_frame_id,
-                           {v.x, v.y, v.z}, {q.x, q.y, q.z, q.w}});
+        seen.tf.push_back({Seconds(t.header.stamp),
+                           t.header.frame_id,
+                           t.child_frame_id,
+                           {v.x, v.y, v.z},
+                           {q.x, q.y, q.z, q.w}});
       }
     })) {
     }
@@ -168,8 +173,8 @@ TEST_F(DdsRosTopicsTest, OnTheVirtualClockOdometryTfAndClockCarryTheTasksTime) {
   const std::string ns = test::UniqueNamespace("twin");
   const auto sink = MakeDdsSink({kDomain});
   sink->Open(Shape(true), ns);
-  EXPECT_EQ(sink->Describe(), "DDS domain 213 rt/" + ns +
-                                  "/{odom,pose,joint_states,timing,command} rt/tf rt/clock");
+  EXPECT_EQ(sink->Describe(),
+            "DDS domain 213 rt/" + ns + "/{odom,pose,joint_states,timing,command} rt/tf rt/clock");
   const test::Peer peer(kDomain);
   const RosReaders readers(peer, ns);
   const Seen seen = PublishUntilSeen(*sink, readers, Record(ns), true);

@@ -101,13 +101,13 @@ TEST_F(DdsSinkTest, PublishesExactlyTheRecordsValues) {
           joints.position.assign(s.position._buffer, s.position._buffer + s.position._length);
           joints.velocity = s.velocity._length;
         });
-    got_timing =
-        got_timing || test::TakeOne<hiltwin_msgs_msg_dds__Timing_>(timing_reader, [&](const auto& s) {
-          timing = s;
-          role = s.role;
-          verdict = s.verdict;
-          state = s.state;
-        });
+    got_timing = got_timing ||
+                 test::TakeOne<hiltwin_msgs_msg_dds__Timing_>(timing_reader, [&](const auto& s) {
+                   timing = s;
+                   role = s.role;
+                   verdict = s.verdict;
+                   state = s.state;
+                 });
     return got_pose && got_joints && got_timing;
   }));
 
