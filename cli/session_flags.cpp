@@ -194,8 +194,10 @@ void AddSessionFlags(CLI::App& app, SessionFlags& o) {
 void AddTelemetryFlags(CLI::App& app, telemetry::TelemetryOptions& t) {
   app.add_option("--telemetry", t.specs,
                  "live telemetry out of the loop (repeatable): dds[:DOMAIN] publishes ROS 2 "
-                 "topics rt/NS/{pose,joint_states,timing} and takes commands on rt/NS/command; "
-                 "udp[:HOST:PORT] streams JSON to PlotJuggler (default 127.0.0.1:9870)");
+                 "topics rt/NS/{odom,pose,joint_states,timing}, rt/tf (and rt/clock on the "
+                 "virtual clock) on DOMAIN (default ROS_DOMAIN_ID, else 0) and takes commands on "
+                 "rt/NS/command; udp[:HOST:PORT] streams JSON to PlotJuggler (default "
+                 "127.0.0.1:9870)");
   app.add_option("--namespace", t.ns,
                  "telemetry namespace NS, one per task on a network (default: twin for run, "
                  "controller for ecs; hil publishes its sides under NS/twin and NS/controller, "

@@ -6,19 +6,22 @@
 #include <cctype>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "commands.h"
 #include "hiltwin/runs/monitor_run.h"
 #include "hiltwin/runtime/telemetry.h"
+#include "hiltwin/telemetry/sinks.h"
 
 namespace hiltwin::app {
 namespace {
 
 struct MonitorFlags {
-  MonitorRunOptions run;             ///< every flag but --command, typed by CLI11
-  std::vector<std::string> command;  // NS VERB
+  MonitorRunOptions run;                ///< every flag but --command, typed by CLI11
+  std::vector<std::string> command;     // NS VERB
+  const CLI::Option* domain = nullptr;  // --domain; not given: ROS_DOMAIN_ID, as ROS 2 tools
 };
 
 runtime::RemoteCommand ParseVerb(const std::string& ns, const std::string& text) {
@@ -37,6 +40,13 @@ runtime::RemoteCommand ParseVerb(const std::string& ns, const std::string& text)
 MonitorRunOptions MonitorRunOptionsOf(const MonitorFlags& flags) {
   MonitorRunOptions run = flags.run;
   CheckMonitorTimes(run);
+  if (flags.domain->count() == 0) {
+    try {
+      run.domain = telemetry::DefaultDdsDomain("--domain N");
+    } catch (const std::invalid_argument& e) {
+      ThrowUsage(e.what());
+    }
+  }
   if (!flags.command.empty()) {
     const std::string& ns = flags.command[0];
     run.command = MonitorCommand{ns, ParseVerb(ns, flags.command[1]), flags.command[1]};
@@ -49,9 +59,10 @@ Command AddMonitorCommand(CLI::App& parent) {
   MonitorRunOptions* o = &flags->run;
   CLI::App* app = parent.add_subcommand(
       "monitor", "Watch every twin and controller on a DDS domain, live; send them commands.");
-  app->add_option("--domain", o->domain,
-                  "DDS domain to watch: the DOMAIN of the tasks' --telemetry dds:DOMAIN (0..232)")
-      ->capture_default_str();
+  flags->domain = app->add_option(
+      "--domain", o->domain,
+      "DDS domain to watch: the DOMAIN of the tasks' --telemetry dds:DOMAIN (0..232; default "
+      "ROS_DOMAIN_ID, else 0)");
   app->add_option("--duration", o->duration_s,
                   "live view: stop after S seconds (default: until Ctrl-C or SIGTERM)");
   auto* json = app->add_flag("--json", o->json,

@@ -228,9 +228,12 @@ void RunSession::OpenTelemetry() {
   // Threads the sinks start as they open (HTTP workers) belong on the helper CPUs.
   const kernel_glue::ScopedThreadCpus on_helpers(
       kernel_glue::HelperCpus(allowed_cpus_, config_.rt.cpus));
+  TelemetryShape shape = task_.TelemetryShapeOf();
+  shape.virtual_clock = config_.clock == ClockKind::kVirtual;
+  shape.lockstep = config_.lockstep_clock != nullptr;
   try {
     telemetry_ = std::make_unique<TelemetryPublisher>(
-        config_.telemetry, task_.TelemetryShapeOf(), std::move(identity),
+        config_.telemetry, shape, std::move(identity),
         TelemetrySources{monitor_, executive_, lifecycle_},
         [this](SessionCommand command) { return runner_->Post(command); });
   } catch (const std::invalid_argument&) {

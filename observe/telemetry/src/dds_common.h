@@ -76,8 +76,8 @@ dds_entity_t CreateTopic(dds_entity_t participant, const dds_topic_descriptor_t*
 /// "rt/<ns>/<leaf>": ROS 2's mapping of topic /<ns>/<leaf> onto DDS.
 [[nodiscard]] std::string TopicName(const std::string& ns, const char* leaf);
 
-/// The ROS 2 type name of hiltwin's timing topic (module hiltwin::msg::dds_, struct Timing_).
-inline constexpr const char* kTimingTypeName = "hiltwin::msg::dds_::Timing_";
+/// The ROS 2 type name of hiltwin's timing topic (module hiltwin_msgs::msg::dds_, struct Timing_).
+inline constexpr const char* kTimingTypeName = "hiltwin_msgs::msg::dds_::Timing_";
 
 /// The user data of a task's command reader: whether it takes commands (--accept-commands).
 /// Discovery carries it to every writer that matches, so a sender learns of a refusal before

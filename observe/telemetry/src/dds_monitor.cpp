@@ -1,7 +1,7 @@
 // `hiltwin monitor`'s DDS side (dds_monitor.h). Tasks are found the way `ros2 topic list`
 // finds topics: through the built-in DCPSPublication topic, which lists every writer on the
 // domain with its topic and type name. A writer of `rt/<ns>/timing` typed
-// hiltwin::msg::dds_::Timing_ is a hiltwin task; the monitor then reads that topic
+// hiltwin_msgs::msg::dds_::Timing_ is a hiltwin task; the monitor then reads that topic
 // (transient-local, so the task's last record arrives at once).
 #include "hiltwin/telemetry/dds_monitor.h"
 
@@ -32,7 +32,7 @@ std::string NamespaceOfTimingTopic(std::string_view topic) {
   return std::string(topic.substr(kPrefix.size(), topic.size() - kPrefix.size() - kSuffix.size()));
 }
 
-MonitorEntry EntryOf(const std::string& ns, const hiltwin_msg_dds__Timing_& t) {
+MonitorEntry EntryOf(const std::string& ns, const hiltwin_msgs_msg_dds__Timing_& t) {
   MonitorEntry e;
   e.ns = ns;
   e.role = t.role != nullptr ? t.role : "";
@@ -98,7 +98,7 @@ void DdsMonitor::State::AddTask(const std::string& ns) {
   const dds_entity_t pp = participant.get();
   const std::string name = dds::TopicName(ns, "timing");
   const dds::QosPtr qos = dds::MakeQos(1, dds::Durability::kTransientLocal);
-  const dds_entity_t topic = dds::CreateTopic(pp, &hiltwin_msg_dds__Timing__desc, name);
+  const dds_entity_t topic = dds::CreateTopic(pp, &hiltwin_msgs_msg_dds__Timing__desc, name);
   tasks[ns].reader =
       dds::Check(dds_create_reader(pp, topic, qos.get(), nullptr), "DDS reader " + name);
 }
@@ -123,7 +123,7 @@ std::vector<MonitorEntry> DdsMonitor::Poll() {
   for (auto& item : state_->tasks) {
     const std::string& ns = item.first;
     State::Task& task = item.second;
-    dds::TakeAll<hiltwin_msg_dds__Timing_>(task.reader, [&](const auto& t, const auto&) {
+    dds::TakeAll<hiltwin_msgs_msg_dds__Timing_>(task.reader, [&](const auto& t, const auto&) {
       task.latest = EntryOf(ns, t);
       task.arrived = now;
     });

@@ -1,9 +1,11 @@
-// `--telemetry dds[:DOMAIN]`: one task's telemetry as ROS 2 topics (sinks.h). Every call after
-// Open comes from the telemetry thread, so the sink needs no lock; Publish and PollCommands
-// never throw and never wait on the network.
+// `--telemetry dds[:DOMAIN]`: one task's telemetry as ROS 2 topics (sinks.h), stamped in ROS
+// time (docs/telemetry.md, "Time stamps"). Every call after Open comes from the telemetry
+// thread, so the sink needs no lock; Publish and PollCommands never throw and never wait on the
+// network.
 // The trust boundary (docs/telemetry.md, "Who may command a task"): any participant on the
 // domain can write rt/<ns>/command, so commands reach the session only with --accept-commands,
 // and a task warns when another task publishes under its namespace.
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "dds_common.h"
+#include "hiltwin/telemetry/codes.h"
 #include "hiltwin/telemetry/sinks.h"
 #include "ros_types.h"
 
@@ -38,6 +41,18 @@ builtin_interfaces_msg_dds__Time_ StampOf(double time_s) noexcept {
     ns = 0.0;
   }
   return {static_cast<std::int32_t>(whole_s), static_cast<std::uint32_t>(ns)};
+}
+
+// ROS time on the real clock: system time, as a ROS 2 node without use_sim_time stamps.
+builtin_interfaces_msg_dds__Time_ SystemStamp() noexcept {
+  timespec now{};
+  if (clock_gettime(CLOCK_REALTIME, &now) != 0) return {0, 0};
+  return {static_cast<std::int32_t>(now.tv_sec), static_cast<std::uint32_t>(now.tv_nsec)};
+}
+
+// A heading about z as a unit quaternion (x, y, z, w).
+geometry_msgs_msg_dds__Quaternion_ YawQuaternion(double theta_rad) noexcept {
+  return {0.0, 0.0, std::sin(theta_rad / 2.0), std::cos(theta_rad / 2.0)};
 }
 
 // "hiltwin task pid=P host=H": the timing writer's user data, so a task that finds another one
@@ -71,7 +86,19 @@ class DdsSink final : public runtime::TelemetrySink {
   [[nodiscard]] std::string Describe() const override;
 
  private:
-  void PublishJoints(const runtime::TelemetryRecord& record) noexcept;
+  // Odometry's pose at a record's time, kept for the next record's twist.
+  struct PoseAt {
+    double time_s, x_m, y_m, theta_rad;
+  };
+
+  dds_entity_t MakeWriter(const dds_topic_descriptor_t* type, const std::string& name,
+                          const dds_qos_t* qos) const;
+  void OpenPoseWriters(const std::string& ns, const dds_qos_t* stream);
+  void PublishPose(const runtime::TelemetryRecord& record,
+                   const builtin_interfaces_msg_dds__Time_& stamp) noexcept;
+  geometry_msgs_msg_dds__Twist_ TwistSince(const runtime::TelemetryRecord& record) noexcept;
+  void PublishJoints(const runtime::TelemetryRecord& record,
+                     const builtin_interfaces_msg_dds__Time_& stamp) noexcept;
   void PublishTiming(const runtime::TelemetryRecord& record) noexcept;
   void Write(dds_entity_t writer, const void* sample, const char* leaf) noexcept;
   void Handle(std::int32_t code, const runtime::CommandPort& port) const noexcept;
@@ -82,10 +109,18 @@ class DdsSink final : public runtime::TelemetrySink {
   bool accept_commands_;
   dds::Entity participant_;  // owns every topic, writer and reader below
   bool has_pose_ = false;
+  bool virtual_clock_ = false;  // stamps: the task's time, else system time
+  bool publishes_clock_ = false;
   std::string ns_;
+  std::string odom_frame_;  // "<ns>/odom": several twins on one domain share rt/tf
+  std::string base_frame_;  // "<ns>/base_link"
+  std::optional<PoseAt> last_pose_;
   std::string timing_topic_;
   std::string command_topic_;
-  dds_entity_t pose_writer_ = 0;
+  dds_entity_t pose_writer_ = 0;  // geometry_msgs/Pose2D, deprecated for odom and tf
+  dds_entity_t odom_writer_ = 0;
+  dds_entity_t tf_writer_ = 0;
+  dds_entity_t clock_writer_ = 0;
   dds_entity_t joints_writer_ = 0;
   dds_entity_t timing_writer_ = 0;
   dds_entity_t command_reader_ = 0;
@@ -107,6 +142,7 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
   }
   const dds_entity_t pp = participant_.get();
   // Samples are the latest state: a slow reader loses old ones rather than slowing us down.
+  // Reliable, volatile, keep last 10: ROS 2's default, as odometry usually is.
   const dds::QosPtr stream = dds::MakeQos(10, dds::Durability::kVolatile);
   // Depth 1 and transient-local: a monitor that joins late sees every task at once.
   const dds::QosPtr latest = dds::MakeQos(1, dds::Durability::kTransientLocal);
@@ -115,24 +151,20 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
   dds::SetUserData(commands.get(),
                    accept_commands_ ? dds::kCommandsAccepted : dds::kCommandsRefused);
   has_pose_ = shape.has_pose;
-  if (has_pose_) {
-    const std::string name = dds::TopicName(ns, "pose");
-    pose_writer_ = dds::Check(
-        dds_create_writer(pp, dds::CreateTopic(pp, &geometry_msgs_msg_dds__Pose2D__desc, name),
-                          stream.get(), nullptr),
-        "DDS writer " + name);
+  if (has_pose_) OpenPoseWriters(ns, stream.get());
+  virtual_clock_ = shape.virtual_clock;
+  // One /clock per time base: a lockstep pair's controller shares its twin's.
+  publishes_clock_ = shape.virtual_clock && (!shape.lockstep || shape.role == "twin");
+  if (publishes_clock_) {
+    // Reliable keep last 1: matches rclcpp's ClockQoS subscribers (best effort) and reliable
+    // ones alike, and the final time reaches a matched reader.
+    clock_writer_ = MakeWriter(&rosgraph_msgs_msg_dds__Clock__desc, "rt/clock",
+                               dds::MakeQos(1, dds::Durability::kVolatile).get());
   }
-  const std::string joints = dds::TopicName(ns, "joint_states");
-  joints_writer_ = dds::Check(
-      dds_create_writer(pp, dds::CreateTopic(pp, &sensor_msgs_msg_dds__JointState__desc, joints),
-                        stream.get(), nullptr),
-      "DDS writer " + joints);
+  joints_writer_ = MakeWriter(&sensor_msgs_msg_dds__JointState__desc,
+                              dds::TopicName(ns, "joint_states"), stream.get());
   timing_topic_ = dds::TopicName(ns, "timing");
-  const std::string& timing = timing_topic_;
-  timing_writer_ =
-      dds::Check(dds_create_writer(pp, dds::CreateTopic(pp, &hiltwin_msg_dds__Timing__desc, timing),
-                                   latest.get(), nullptr),
-                 "DDS writer " + timing);
+  timing_writer_ = MakeWriter(&hiltwin_msgs_msg_dds__Timing__desc, timing_topic_, latest.get());
   command_topic_ = dds::TopicName(ns, "command");
   command_reader_ = dds::Check(
       dds_create_reader(pp, dds::CreateTopic(pp, &std_msgs_msg_dds__Int32__desc, command_topic_),
@@ -148,24 +180,89 @@ void DdsSink::Open(const runtime::TelemetryShape& shape, const std::string& ns) 
   ns_ = ns;
 }
 
+dds_entity_t DdsSink::MakeWriter(const dds_topic_descriptor_t* type, const std::string& name,
+                                 const dds_qos_t* qos) const {
+  const dds_entity_t pp = participant_.get();
+  return dds::Check(dds_create_writer(pp, dds::CreateTopic(pp, type, name), qos, nullptr),
+                    "DDS writer " + name);
+}
+
+// Odometry and tf for RViz and Foxglove, Pose2D beside them (deprecated: kept for subscribers
+// written against it). rt/tf is every node's, not namespaced, so the frames carry the namespace.
+void DdsSink::OpenPoseWriters(const std::string& ns, const dds_qos_t* stream) {
+  odom_frame_ = ns + "/odom";
+  base_frame_ = ns + "/base_link";
+  odom_writer_ = MakeWriter(&nav_msgs_msg_dds__Odometry__desc, dds::TopicName(ns, "odom"), stream);
+  pose_writer_ =
+      MakeWriter(&geometry_msgs_msg_dds__Pose2D__desc, dds::TopicName(ns, "pose"), stream);
+  // tf2_ros's broadcaster QoS: reliable, volatile, keep last 100.
+  tf_writer_ = MakeWriter(&tf2_msgs_msg_dds__TFMessage__desc, "rt/tf",
+                          dds::MakeQos(100, dds::Durability::kVolatile).get());
+}
+
 void DdsSink::Publish(const runtime::TelemetryRecord& record) noexcept {
   if (timing_writer_ <= 0) return;  // not open
-  if (has_pose_) {
-    const geometry_msgs_msg_dds__Pose2D_ pose{record.task.x_m, record.task.y_m,
-                                              record.task.theta_rad};
-    Write(pose_writer_, &pose, "pose");
+  // One stamp for every topic of the record, so tf and odometry agree.
+  const builtin_interfaces_msg_dds__Time_ stamp =
+      virtual_clock_ ? StampOf(record.time_s) : SystemStamp();
+  if (publishes_clock_) {
+    const rosgraph_msgs_msg_dds__Clock_ clock{stamp};
+    Write(clock_writer_, &clock, "clock");
   }
-  PublishJoints(record);
+  // Before the loop's first cycle the record holds no values yet (the mailbox's default): a
+  // subscriber's first sample would be an empty JointState and a pose of zeros.
+  if (has_pose_ && record.task.has_pose) PublishPose(record, stamp);
+  if (record.task.joint_count > 0 || joint_names_.empty()) PublishJoints(record, stamp);
   PublishTiming(record);
 }
 
-void DdsSink::PublishJoints(const runtime::TelemetryRecord& record) noexcept {
+void DdsSink::PublishPose(const runtime::TelemetryRecord& record,
+                          const builtin_interfaces_msg_dds__Time_& stamp) noexcept {
+  const runtime::TaskTelemetry& t = record.task;
+  const geometry_msgs_msg_dds__Pose2D_ pose{t.x_m, t.y_m, t.theta_rad};
+  Write(pose_writer_, &pose, "pose");
+  const geometry_msgs_msg_dds__Quaternion_ rotation = YawQuaternion(t.theta_rad);
+  nav_msgs_msg_dds__Odometry_ odom{};  // covariances 0: the twin's pose is the model's state
+  odom.header = {stamp, odom_frame_.data()};
+  odom.child_frame_id = base_frame_.data();
+  odom.pose.pose = {{t.x_m, t.y_m, 0.0}, rotation};
+  odom.twist.twist = TwistSince(record);
+  Write(odom_writer_, &odom, "odom");
+  geometry_msgs_msg_dds__TransformStamped_ transform{};
+  transform.header = odom.header;
+  transform.child_frame_id = base_frame_.data();
+  transform.transform = {{t.x_m, t.y_m, 0.0}, rotation};
+  const tf2_msgs_msg_dds__TFMessage_ tf{{1, 1, &transform, false}};
+  Write(tf_writer_, &tf, "tf");
+}
+
+// The body-frame velocity (base_link, as nav_msgs/Odometry's twist) from the pose's change since
+// the last record over the task time between them; the chord of an arc points along the
+// heading halfway through it. Zero on the first record and while the task time stands still.
+geometry_msgs_msg_dds__Twist_ DdsSink::TwistSince(const runtime::TelemetryRecord& r) noexcept {
+  geometry_msgs_msg_dds__Twist_ twist{};
+  const runtime::TaskTelemetry& t = r.task;
+  if (last_pose_ && r.time_s > last_pose_->time_s) {
+    const double dt = r.time_s - last_pose_->time_s;
+    const double dx = t.x_m - last_pose_->x_m;
+    const double dy = t.y_m - last_pose_->y_m;
+    const double heading = (t.theta_rad + last_pose_->theta_rad) / 2.0;
+    twist.linear.x = (std::cos(heading) * dx + std::sin(heading) * dy) / dt;
+    twist.linear.y = (-std::sin(heading) * dx + std::cos(heading) * dy) / dt;
+    twist.angular.z = (t.theta_rad - last_pose_->theta_rad) / dt;
+  }
+  last_pose_ = PoseAt{r.time_s, t.x_m, t.y_m, t.theta_rad};
+  return twist;
+}
+
+void DdsSink::PublishJoints(const runtime::TelemetryRecord& record,
+                            const builtin_interfaces_msg_dds__Time_& stamp) noexcept {
   static char empty[] = "";  // Cyclone's char* fields are not const; it only reads them
   std::array<double, runtime::kMaxTelemetryJoints> position_rad = record.task.joint_position_rad;
   const auto count = static_cast<std::uint32_t>(
       std::min<std::size_t>(record.task.joint_count, joint_name_ptrs_.size()));
   sensor_msgs_msg_dds__JointState_ msg{};
-  msg.header.stamp = StampOf(record.time_s);
+  msg.header.stamp = stamp;
   msg.header.frame_id = empty;
   msg.name = {count, count, joint_name_ptrs_.data(), false};
   msg.position = {count, count, position_rad.data(), false};
@@ -175,7 +272,7 @@ void DdsSink::PublishJoints(const runtime::TelemetryRecord& record) noexcept {
 }
 
 void DdsSink::PublishTiming(const runtime::TelemetryRecord& record) noexcept {
-  hiltwin_msg_dds__Timing_ msg{};
+  hiltwin_msgs_msg_dds__Timing_ msg{};
   msg.ns = ns_.data();
   msg.role = const_cast<char*>(record.role.c_str());
   msg.rate_hz = record.rate_hz;
@@ -190,6 +287,8 @@ void DdsSink::PublishTiming(const runtime::TelemetryRecord& record) noexcept {
   msg.verdict = const_cast<char*>(qos::ToString(record.verdict_so_far));
   msg.state = const_cast<char*>(lifecycle::ToString(record.state));
   msg.final = record.final;
+  msg.verdict_code = VerdictCode(record.verdict_so_far);
+  msg.state_code = StateCode(record.state);
   Write(timing_writer_, &msg, "timing");
 }
 
@@ -292,9 +391,11 @@ void DdsSink::Handle(std::int32_t code, const runtime::CommandPort& port) const 
 std::string DdsSink::Describe() const {
   std::string domain = "DDS domain " + std::to_string(domain_);
   // Before Open the namespace is not known yet; commands print the namespace next to this.
-  if (ns_.empty()) return domain + " rt/<namespace>/{pose,joint_states,timing,command}";
+  if (ns_.empty()) return domain + " rt/<namespace>/{odom,pose,joint_states,timing,command}";
   return domain + " rt/" + ns_ +
-         (has_pose_ ? "/{pose,joint_states,timing,command}" : "/{joint_states,timing,command}");
+         (has_pose_ ? "/{odom,pose,joint_states,timing,command} rt/tf"
+                    : "/{joint_states,timing,command}") +
+         (publishes_clock_ ? " rt/clock" : "");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <cstddef>
 
+#include "hiltwin/telemetry/codes.h"
+
 namespace hiltwin::telemetry {
 namespace {
 
@@ -25,6 +27,7 @@ nlohmann::ordered_json TimingJson(const runtime::TelemetryRecord& r) {
       {"latency_samples", r.latency_samples},
       {"distance_to_violation", nullptr},
       {"verdict", qos::ToString(r.verdict_so_far)},
+      {"verdict_code", VerdictCode(r.verdict_so_far)},  // PlotJuggler plots numbers only
   };
   if (r.distance_to_violation) timing["distance_to_violation"] = *r.distance_to_violation;
   return timing;
@@ -39,6 +42,7 @@ nlohmann::ordered_json ToJson(const runtime::TelemetryRecord& r) {
       {"role", r.role},
       {"cycle", r.cycle},
       {"state", lifecycle::ToString(r.state)},
+      {"state_code", StateCode(r.state)},
       {"final", r.final},
   };
   if (r.task.has_pose) {

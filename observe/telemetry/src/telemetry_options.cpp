@@ -1,6 +1,7 @@
 // The telemetry flags (sinks.h): parsed and checked before anything opens, then turned into
 // the session's TelemetryConfig. Every message names the flag, the value and the fix.
 #include <charconv>
+#include <cstdlib>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -46,6 +47,11 @@ bool IsKind(const std::string& spec, std::string_view kind) {
                           spec[kind.size()] == ':');
 }
 
+// Read once per call, on the control thread, before any helper thread of ours exists.
+const char* RosDomainIdText() {
+  return std::getenv("ROS_DOMAIN_ID");  // NOLINT(concurrency-mt-unsafe)
+}
+
 void CheckKinds(const std::vector<std::string>& specs) {
   for (const std::string& spec : specs) {
     if (!IsKind(spec, "dds") && !IsKind(spec, "udp")) {
@@ -56,6 +62,20 @@ void CheckKinds(const std::vector<std::string>& specs) {
 
 }  // namespace
 
+std::uint32_t DefaultDdsDomain(const std::string& flag) {
+  const char* text = RosDomainIdText();
+  // ROS 2 (rcutils) reads an empty variable as an unset one.
+  if (text == nullptr || *text == '\0') return 0;
+  const auto domain = ParseUint(text, 0, kMaxDomain);
+  if (!domain) {
+    Bad("ROS_DOMAIN_ID='" + std::string(text) +
+        "' (the DDS domain when none is given) is not a domain: set it to a whole number from 0 "
+        "to " +
+        std::to_string(kMaxDomain) + ", unset it (domain 0), or give the domain with " + flag);
+  }
+  return *domain;
+}
+
 std::vector<DdsEndpoint> ParseDdsSpecs(const std::vector<std::string>& specs) {
   CheckKinds(specs);
   std::vector<DdsEndpoint> endpoints;
@@ -63,7 +83,9 @@ std::vector<DdsEndpoint> ParseDdsSpecs(const std::vector<std::string>& specs) {
   for (const std::string& spec : specs) {
     if (!IsKind(spec, "dds")) continue;
     DdsEndpoint endpoint;
-    if (spec.size() > 3) {
+    if (spec.size() == 3) {
+      endpoint.domain = DefaultDdsDomain("--telemetry dds:N");
+    } else {
       const auto domain = ParseUint(std::string_view(spec).substr(4), 0, kMaxDomain);
       if (!domain) {
         Bad("--telemetry '" + spec + "': the DDS domain must be a whole number from 0 to " +
@@ -73,7 +95,7 @@ std::vector<DdsEndpoint> ParseDdsSpecs(const std::vector<std::string>& specs) {
     }
     if (!seen.insert(endpoint.domain).second) {
       Bad("--telemetry '" + spec + "': DDS domain " + std::to_string(endpoint.domain) +
-          " is given twice; give each domain once");
+          (spec.size() == 3 ? " (ROS_DOMAIN_ID)" : "") + " is given twice; give each domain once");
     }
     endpoints.push_back(endpoint);
   }

@@ -1,9 +1,10 @@
 // dds_probe: a DDS subscriber in its own process, as `ros2 topic echo` would be, for the
-// integration tests. It reads one namespace's pose, joint_states and timing and prints one
-// JSON line per event on stdout:
+// integration tests. It reads one namespace's pose, odom, joint_states and timing, and the
+// domain's tf and clock, and prints one JSON line per event on stdout:
 //   {"event":"ready"}                                   readers created
 //   {"event":"publication","topic":T,"type":N}          a writer of an rt/ topic was discovered
 //   {"topic":"pose","type":N,"x":..,"y":..,"theta":..}  one sample (type as discovered)
+//   {"topic":"odom",...}, {"topic":"tf",...} (one line per transform), {"topic":"clock",...},
 //   {"topic":"joint_states",...}, {"topic":"timing",...}
 //   {"event":"end","final":true|false}                  exit
 // It exits --after-final seconds after the task's final timing record, or after --duration.
@@ -56,10 +57,13 @@ void Emit(const Json& line) {
   std::fflush(stdout);
 }
 
+// A reader with ROS 2's subscription defaults (reliable; /clock: best effort, as rclcpp's
+// ClockQoS), keeping every sample for the test.
 dds_entity_t Reader(dds_entity_t pp, const dds_topic_descriptor_t* desc, const std::string& name,
-                    bool transient_local) {
+                    bool transient_local, bool best_effort = false) {
   dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_reliability(qos, best_effort ? DDS_RELIABILITY_BEST_EFFORT : DDS_RELIABILITY_RELIABLE,
+                       DDS_SECS(1));
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1000);
   if (transient_local) dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
   const dds_entity_t topic = dds_create_topic(pp, desc, name.c_str(), nullptr, nullptr);
@@ -94,7 +98,10 @@ class Probe {
 #pragma GCC diagnostic pop
     pose_ = Reader(pp, &geometry_msgs_msg_dds__Pose2D__desc, Topic("pose"), false);
     joints_ = Reader(pp, &sensor_msgs_msg_dds__JointState__desc, Topic("joint_states"), false);
-    timing_ = Reader(pp, &hiltwin_msg_dds__Timing__desc, Topic("timing"), true);
+    timing_ = Reader(pp, &hiltwin_msgs_msg_dds__Timing__desc, Topic("timing"), true);
+    odom_ = Reader(pp, &nav_msgs_msg_dds__Odometry__desc, Topic("odom"), false);
+    tf_ = Reader(pp, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf", false);
+    clock_ = Reader(pp, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", false, true);
   }
 
   [[nodiscard]] std::string Topic(const char* leaf) const { return "rt/" + args_.ns + "/" + leaf; }
@@ -121,7 +128,8 @@ class Probe {
             {"name", names},
             {"position", position}});
     });
-    TakeAll<hiltwin_msg_dds__Timing_>(timing_, [&](const auto& s) {
+    TakeRos();
+    TakeAll<hiltwin_msgs_msg_dds__Timing_>(timing_, [&](const auto& s) {
       Emit({{"topic", "timing"},
             {"type", types_[Topic("timing")]},
             {"ns", s.ns},
@@ -130,6 +138,8 @@ class Probe {
             {"time_s", s.time_s},
             {"verdict", s.verdict},
             {"state", s.state},
+            {"verdict_code", s.verdict_code},
+            {"state_code", s.state_code},
             {"final", s.final}});
       final_ = final_ || s.final;
     });
@@ -137,6 +147,48 @@ class Probe {
   }
 
  private:
+  static Json Stamp(const builtin_interfaces_msg_dds__Time_& t) {
+    return {{"sec", t.sec}, {"nanosec", t.nanosec}};
+  }
+
+  static Json Frame(const std_msgs_msg_dds__Header_& header, const char* child,
+                    const geometry_msgs_msg_dds__Vector3_& v,
+                    const geometry_msgs_msg_dds__Quaternion_& q) {
+    return {{"stamp", Stamp(header.stamp)},
+            {"frame_id", header.frame_id},
+            {"child_frame_id", child},
+            {"x", v.x},
+            {"y", v.y},
+            {"z", v.z},
+            {"q", {q.x, q.y, q.z, q.w}}};
+  }
+
+  // Odometry, every transform on rt/tf and the clock: what RViz and Foxglove read.
+  void TakeRos() {
+    TakeAll<nav_msgs_msg_dds__Odometry_>(odom_, [&](const auto& s) {
+      const auto& p = s.pose.pose.position;
+      Json line = Frame(s.header, s.child_frame_id, {p.x, p.y, p.z}, s.pose.pose.orientation);
+      line["topic"] = "odom";
+      line["type"] = types_[Topic("odom")];
+      line["vx"] = s.twist.twist.linear.x;
+      line["wz"] = s.twist.twist.angular.z;
+      Emit(line);
+    });
+    TakeAll<tf2_msgs_msg_dds__TFMessage_>(tf_, [&](const auto& s) {
+      for (std::uint32_t i = 0; i < s.transforms._length; ++i) {
+        const auto& t = s.transforms._buffer[i];
+        Json line = Frame(t.header, t.child_frame_id, t.transform.translation,
+                          t.transform.rotation);
+        line["topic"] = "tf";
+        line["type"] = types_["rt/tf"];
+        Emit(line);
+      }
+    });
+    TakeAll<rosgraph_msgs_msg_dds__Clock_>(clock_, [&](const auto& s) {
+      Emit({{"topic", "clock"}, {"type", types_["rt/clock"]}, {"clock", Stamp(s.clock)}});
+    });
+  }
+
   void Discover() {
     TakeAll<dds_builtintopic_endpoint_t>(publications_, [&](const auto& ep) {
       const std::string topic = ep.topic_name != nullptr ? ep.topic_name : "";
@@ -147,7 +199,8 @@ class Probe {
   }
 
   Args args_;
-  dds_entity_t publications_ = 0, pose_ = 0, joints_ = 0, timing_ = 0;
+  dds_entity_t publications_ = 0, pose_ = 0, joints_ = 0, timing_ = 0, odom_ = 0, tf_ = 0,
+               clock_ = 0;
   std::map<std::string, std::string> types_;  // topic -> type name, from DCPSPublication
   bool final_ = false;
 };

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -33,6 +34,25 @@ using hiltwin::kernel_glue::Process;
 using Json = nlohmann::json;
 
 constexpr auto kProcessTimeout = std::chrono::seconds(20);
+
+double StampOf(const Json& stamp) {
+  return stamp["sec"].get<double>() + stamp["nanosec"].get<double>() * 1e-9;
+}
+
+double SystemNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+/// ROS_DOMAIN_ID for this process and every process it starts, until the scope ends.
+class ScopedRosDomainId {
+ public:
+  explicit ScopedRosDomainId(const char* value) {
+    ::setenv("ROS_DOMAIN_ID", value, 1);  // NOLINT(concurrency-mt-unsafe): before any spawn
+  }
+  ~ScopedRosDomainId() { ::unsetenv("ROS_DOMAIN_ID"); }  // NOLINT(concurrency-mt-unsafe)
+  ScopedRosDomainId(const ScopedRosDomainId&) = delete;
+  ScopedRosDomainId& operator=(const ScopedRosDomainId&) = delete;
+};
 
 class TelemetryDds : public ::testing::Test {
  protected:
@@ -155,6 +175,30 @@ class TelemetryDds : public ::testing::Test {
     EXPECT_NEAR(poses.back()["theta"].get<double>(), row["theta_rad"].get<double>(), 1e-12);
   }
 
+  // The probe's odom and tf samples: frame ids under the namespace, the last pose the log's,
+  // stamps in ROS time (system time on the real clock), the types ROS 2 names.
+  void ExpectOdometryAndTf(const std::vector<Json>& lines, const std::string& ns,
+                           const std::string& csv, double started_s) const {
+    const auto row = LastCsvRow(Path(csv));
+    for (const std::string topic : {"odom", "tf"}) {
+      SCOPED_TRACE(topic);
+      const std::vector<Json> frames = Samples(lines, topic);
+      ASSERT_FALSE(frames.empty());
+      const Json& last = frames.back();
+      EXPECT_EQ(last["type"], topic == "odom" ? "nav_msgs::msg::dds_::Odometry_"
+                                              : "tf2_msgs::msg::dds_::TFMessage_");
+      EXPECT_EQ(last["frame_id"], ns + "/odom");
+      EXPECT_EQ(last["child_frame_id"], ns + "/base_link");
+      EXPECT_NEAR(last["x"].get<double>(), row["x_m"].get<double>(), 1e-12);
+      EXPECT_NEAR(last["y"].get<double>(), row["y_m"].get<double>(), 1e-12);
+      const double half = row["theta_rad"].get<double>() / 2.0;
+      EXPECT_NEAR(last["q"][2].get<double>(), std::sin(half), 1e-12);
+      EXPECT_NEAR(last["q"][3].get<double>(), std::cos(half), 1e-12);
+      EXPECT_GE(StampOf(frames.front()["stamp"]), started_s);
+      EXPECT_LE(StampOf(last["stamp"]), SystemNow());
+    }
+  }
+
   fs::path dir_;
 };
 
@@ -162,6 +206,7 @@ TEST_F(TelemetryDds, AProbeInAnotherProcessReadsTheTwinsTopicsWithRosTypeNames) 
   constexpr std::uint32_t kDomain = 220;
   const std::string ns = Ns("twin");
   Process probe = Probe(kDomain, ns, "probe.jsonl");
+  const double started_s = SystemNow();
   Process twin = hiltwin::test::Spawn(Twin(kDomain, ns, "2"), Path("twin.out"));
   ExpectCleanExit(twin, "twin");
   ASSERT_TRUE(probe.WaitFor(kProcessTimeout).has_value()) << "probe still running";
@@ -180,21 +225,96 @@ TEST_F(TelemetryDds, AProbeInAnotherProcessReadsTheTwinsTopicsWithRosTypeNames) 
   EXPECT_EQ(joints.back()["type"], "sensor_msgs::msg::dds_::JointState_");
   EXPECT_EQ(joints.back()["name"].size(), 2u);
   EXPECT_EQ(joints.back()["position"].size(), 2u);
-  const auto row = LastCsvRow(Path("twin.csv"));
-  const double stamp_s =
-      joints.back()["sec"].get<double>() + joints.back()["nanosec"].get<double>() * 1e-9;
-  // The log's first column is the task's time.
-  EXPECT_NEAR(stamp_s, row.begin().value().get<double>(), 1e-6) << row.begin().key();
+  // The first sample too: it was empty when sent before the loop's first cycle.
+  EXPECT_EQ(joints.front()["name"].size(), 2u) << joints.front().dump();
+  EXPECT_EQ(joints.front()["position"].size(), 2u) << joints.front().dump();
+  // On the real clock stamps are ROS time, system time, as a ROS 2 node's without sim time.
+  for (const Json& j : {joints.front(), joints.back()}) {
+    EXPECT_GE(j["sec"].get<double>() + j["nanosec"].get<double>() * 1e-9, started_s);
+    EXPECT_LE(j["sec"].get<double>() + j["nanosec"].get<double>() * 1e-9, SystemNow());
+  }
+  ExpectOdometryAndTf(lines, ns, "twin.csv", started_s);
+  EXPECT_TRUE(Samples(lines, "clock").empty()) << "/clock is the virtual clock's";
 
   const std::vector<Json> timing = Samples(lines, "timing");
   ASSERT_FALSE(timing.empty());
-  EXPECT_EQ(timing.back()["type"], "hiltwin::msg::dds_::Timing_");
+  EXPECT_EQ(timing.back()["type"], "hiltwin_msgs::msg::dds_::Timing_");
   EXPECT_EQ(timing.back()["ns"], ns);
   EXPECT_EQ(timing.back()["role"], "twin");
   EXPECT_TRUE(timing.back()["final"].get<bool>());
   const Json report = Json::parse(ReadText(Path("twin.json")));
   EXPECT_EQ(timing.back()["verdict"], report["verdict"]);
   EXPECT_EQ(timing.back()["cycle"], report["cycles_run"]);
+  // PlotJuggler's numbers (docs/telemetry.md's table): PASS 0, FLAGGED 1; stopped 5.
+  EXPECT_EQ(timing.back()["verdict_code"], report["verdict"] == "PASS" ? 0 : 1);
+  EXPECT_EQ(timing.back()["state"], "stopped");
+  EXPECT_EQ(timing.back()["state_code"], 5);
+}
+
+// On the virtual clock a ROS 2 node with use_sim_time follows the twin: it publishes its time
+// on /clock (rt/clock) and stamps with it, so the stamps are the log's time column.
+TEST_F(TelemetryDds, OnTheVirtualClockTheTwinPublishesClockAndStampsWithItsTime) {
+  constexpr std::uint32_t kDomain = 226;
+  const std::string ns = Ns("twin");
+  Process probe = Probe(kDomain, ns, "probe.jsonl");
+  std::vector<std::string> argv = Twin(kDomain, ns, "30");
+  argv.insert(argv.end(), {"--clock", "virtual"});
+  Process twin = hiltwin::test::Spawn(argv, Path("twin.out"));
+  ExpectCleanExit(twin, "twin");
+  ASSERT_TRUE(probe.WaitFor(kProcessTimeout).has_value()) << "probe still running";
+  const std::vector<Json> lines = ReadLines(Path("probe.jsonl"));
+  ASSERT_TRUE(lines.back()["final"].get<bool>()) << "no final timing record arrived";
+  const std::vector<Json> clock = Samples(lines, "clock");
+  ASSERT_FALSE(clock.empty()) << "no rt/clock sample";
+  EXPECT_EQ(clock.back()["type"], "rosgraph_msgs::msg::dds_::Clock_");
+  const double end_s = LastCsvRow(Path("twin.csv")).begin().value().get<double>();
+  EXPECT_NEAR(StampOf(clock.back()["clock"]), end_s, 1e-6);
+  const std::vector<Json> odom = Samples(lines, "odom");
+  ASSERT_FALSE(odom.empty());
+  EXPECT_NEAR(StampOf(odom.back()["stamp"]), end_s, 1e-6);
+  const std::vector<Json> joints = Samples(lines, "joint_states");
+  ASSERT_FALSE(joints.empty());
+  EXPECT_NEAR(joints.back()["sec"].get<double>() + joints.back()["nanosec"].get<double>() * 1e-9,
+              end_s, 1e-6);
+  // Every clock sample is a time the task reached: ROS time never runs back.
+  for (std::size_t i = 1; i < clock.size(); ++i) {
+    EXPECT_GE(StampOf(clock[i]["clock"]), StampOf(clock[i - 1]["clock"]));
+  }
+}
+
+// As every ROS 2 tool: ROS_DOMAIN_ID is the domain of a bare `--telemetry dds` and of
+// `monitor` without --domain; a flag's domain wins; an invalid value is an error naming it.
+TEST_F(TelemetryDds, RosDomainIdPicksTheDomainOfRunAndMonitor) {
+  constexpr std::uint32_t kDomain = 227;
+  const std::string ns = Ns("twin");
+  const ScopedRosDomainId env("227");
+  Process probe = Probe(kDomain, ns, "probe.jsonl");
+  std::vector<std::string> argv = Twin(kDomain, ns, "3");
+  std::replace(argv.begin(), argv.end(), std::string("dds:227"), std::string("dds"));
+  Process twin = hiltwin::test::Spawn(argv, Path("twin.out"));
+  const auto monitor = hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--json", "--wait", "2"});
+  ASSERT_EQ(monitor.exit_code, 0) << monitor.out << monitor.err;
+  const Json listed = Json::parse(monitor.out);
+  EXPECT_EQ(listed["domain"], kDomain);
+  ASSERT_EQ(listed["tasks"].size(), 1u) << monitor.out;
+  EXPECT_EQ(listed["tasks"][0]["ns"], ns);
+  ExpectCleanExit(twin, "twin");
+  ASSERT_TRUE(probe.WaitFor(kProcessTimeout).has_value());
+  EXPECT_TRUE(ReadLines(Path("probe.jsonl")).back()["final"].get<bool>());
+  EXPECT_NE(ReadText(Path("twin.out")).find("DDS domain 227"), std::string::npos)
+      << ReadText(Path("twin.out"));
+
+  const ScopedRosDomainId invalid("lab3");
+  argv.back() = Path("bad.json");
+  const auto run = hiltwin::test::Run(argv);
+  EXPECT_EQ(run.exit_code, 2) << run.out << run.err;
+  EXPECT_NE(run.err.find("ROS_DOMAIN_ID='lab3'"), std::string::npos) << run.err;
+  const auto watch = hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--json", "--wait", "0.1"});
+  EXPECT_EQ(watch.exit_code, 2) << watch.out << watch.err;
+  EXPECT_NE(watch.err.find("ROS_DOMAIN_ID='lab3'"), std::string::npos) << watch.err;
+  const auto flagged =
+      hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--json", "--wait", "0.1", "--domain", "227"});
+  EXPECT_EQ(flagged.exit_code, 0) << "--domain wins: " << flagged.err;
 }
 
 TEST_F(TelemetryDds, TwoTwinsOnOneDomainDoNotMixAndTheMonitorListsBoth) {

@@ -1,6 +1,8 @@
 // The telemetry flags: what each spec means, and what a mistake is told.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -21,7 +23,29 @@ std::string Refusal(F&& f) {
   return "";
 }
 
+/// Sets an environment variable for one scope (unset: nullptr), then restores it.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    const char* old = std::getenv(name);  // NOLINT(concurrency-mt-unsafe): tests, one thread
+    if (old != nullptr) old_ = old;
+    Set(value);
+  }
+  ~ScopedEnv() { Set(old_ ? old_->c_str() : nullptr); }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  void Set(const char* value) const {
+    // NOLINTNEXTLINE(concurrency-mt-unsafe): tests, one thread
+    value != nullptr ? ::setenv(name_, value, 1) : ::unsetenv(name_);
+  }
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
 TEST(TelemetryOptions, DdsSpecsTakeADomainOrDefaultToZero) {
+  const ScopedEnv env("ROS_DOMAIN_ID", nullptr);
   const auto dds = ParseDdsSpecs({"dds", "udp", "dds:7"});
   ASSERT_EQ(dds.size(), 2U);
   EXPECT_EQ(dds[0].domain, 0U);
@@ -34,6 +58,31 @@ TEST(TelemetryOptions, DdsSpecsTakeADomainOrDefaultToZero) {
               static_cast<void>(ParseDdsSpecs({"dds:3", "dds:3"}));
             }).find("twice"),
             std::string::npos);
+}
+
+// As for every ROS 2 tool, ROS_DOMAIN_ID is the domain when the flag names none.
+TEST(TelemetryOptions, RosDomainIdIsTheDefaultDomainAndTheFlagsDomainWins) {
+  const ScopedEnv env("ROS_DOMAIN_ID", "42");
+  const auto dds = ParseDdsSpecs({"dds", "dds:7"});
+  ASSERT_EQ(dds.size(), 2U);
+  EXPECT_EQ(dds[0].domain, 42U);
+  EXPECT_EQ(dds[1].domain, 7U);
+  const ScopedEnv empty("ROS_DOMAIN_ID", "");  // ROS 2 reads an empty variable as unset
+  EXPECT_EQ(ParseDdsSpecs({"dds"})[0].domain, 0U);
+}
+
+// Not silently 0: a domain the user did not mean would show nothing, with no word why.
+TEST(TelemetryOptions, AnInvalidRosDomainIdIsRefusedNamingTheVariable) {
+  for (const char* value : {"233", "abc", "-1", "4x", " 5", "99999999999"}) {
+    SCOPED_TRACE(value);
+    const ScopedEnv env("ROS_DOMAIN_ID", value);
+    const std::string why = Refusal([] { static_cast<void>(ParseDdsSpecs({"dds"})); });
+    EXPECT_NE(why.find("ROS_DOMAIN_ID='" + std::string(value) + "'"), std::string::npos) << why;
+    EXPECT_NE(why.find("0 to 232"), std::string::npos) << why;
+    EXPECT_NE(why.find("--telemetry dds"), std::string::npos) << why;
+    // A domain given with the flag does not read the variable.
+    EXPECT_EQ(ParseDdsSpecs({"dds:3"})[0].domain, 3U);
+  }
 }
 
 TEST(TelemetryOptions, UdpSpecsDefaultToPlotJugglersPort) {
@@ -129,10 +178,17 @@ TEST(RecordJson, HasEveryDocumentedKeyAndNullForADistanceThatCannotFail) {
   EXPECT_DOUBLE_EQ(j["wheels"]["wheel_left_joint"]["m"].get<double>(), 0.1);
   EXPECT_TRUE(j["timing"]["distance_to_violation"].is_null());
   EXPECT_EQ(j["timing"]["verdict"], "PASS");
+  // Numbers beside the strings, which PlotJuggler drops (codes.h; docs/telemetry.md's table).
+  EXPECT_EQ(j["state_code"], 2);
+  EXPECT_EQ(j["timing"]["verdict_code"], 0);
   EXPECT_DOUBLE_EQ(j["timing"]["latency_p99_us"].get<double>(), 12.5);
   r.distance_to_violation = 3;
   r.task.has_pose = false;
+  r.verdict_so_far = qos::Verdict::kFlagged;
+  r.state = lifecycle::State::kSafeStop;
   j = ToJson(r);
+  EXPECT_EQ(j["state_code"], 7);
+  EXPECT_EQ(j["timing"]["verdict_code"], 1);
   EXPECT_EQ(j["timing"]["distance_to_violation"], 3);
   EXPECT_FALSE(j.contains("pose"));  // a controller has none
 }

@@ -27,6 +27,7 @@ runtime::TelemetryShape TwinShape() {
   shape.role = "twin";
   shape.has_pose = true;
   shape.joint_names = {"left_wheel_joint", "right_wheel_joint"};
+  shape.virtual_clock = true;  // stamps: the task's time (dds_ros_topics_test: system time)
   return shape;
 }
 
@@ -69,19 +70,20 @@ TEST_F(DdsSinkTest, PublishesExactlyTheRecordsValues) {
   const std::string ns = test::UniqueNamespace("twin");
   const auto sink = MakeDdsSink({kDomain});
   sink->Open(TwinShape(), ns);
-  EXPECT_EQ(sink->Describe(), "DDS domain 201 rt/" + ns + "/{pose,joint_states,timing,command}");
+  EXPECT_EQ(sink->Describe(),
+            "DDS domain 201 rt/" + ns + "/{odom,pose,joint_states,timing,command} rt/tf rt/clock");
   test::Peer peer(kDomain);
   const dds_entity_t pose_reader =
       peer.Reader(&geometry_msgs_msg_dds__Pose2D__desc, "rt/" + ns + "/pose");
   const dds_entity_t joints_reader =
       peer.Reader(&sensor_msgs_msg_dds__JointState__desc, "rt/" + ns + "/joint_states");
   const dds_entity_t timing_reader =
-      peer.Reader(&hiltwin_msg_dds__Timing__desc, "rt/" + ns + "/timing", true);
+      peer.Reader(&hiltwin_msgs_msg_dds__Timing__desc, "rt/" + ns + "/timing", true);
   const runtime::TelemetryRecord record = TwinRecord(ns);
 
   geometry_msgs_msg_dds__Pose2D_ pose{};
   Joints joints;
-  hiltwin_msg_dds__Timing_ timing{};
+  hiltwin_msgs_msg_dds__Timing_ timing{};
   std::string role, verdict, state;
   bool got_pose = false, got_joints = false, got_timing = false;
   ASSERT_TRUE(WaitFor([&] {
@@ -99,13 +101,13 @@ TEST_F(DdsSinkTest, PublishesExactlyTheRecordsValues) {
           joints.position.assign(s.position._buffer, s.position._buffer + s.position._length);
           joints.velocity = s.velocity._length;
         });
-    got_timing =
-        got_timing || test::TakeOne<hiltwin_msg_dds__Timing_>(timing_reader, [&](const auto& s) {
-          timing = s;
-          role = s.role;
-          verdict = s.verdict;
-          state = s.state;
-        });
+    got_timing = got_timing ||
+                 test::TakeOne<hiltwin_msgs_msg_dds__Timing_>(timing_reader, [&](const auto& s) {
+                   timing = s;
+                   role = s.role;
+                   verdict = s.verdict;
+                   state = s.state;
+                 });
     return got_pose && got_joints && got_timing;
   }));
 
@@ -148,11 +150,11 @@ TEST_F(DdsSinkTest, TimingCarriesDistanceVerdictAndFinalToALateReader) {
 
   test::Peer peer(kDomain);
   const dds_entity_t timing_reader =
-      peer.Reader(&hiltwin_msg_dds__Timing__desc, "rt/" + ns + "/timing", true);
-  hiltwin_msg_dds__Timing_ timing{};
+      peer.Reader(&hiltwin_msgs_msg_dds__Timing__desc, "rt/" + ns + "/timing", true);
+  hiltwin_msgs_msg_dds__Timing_ timing{};
   std::string verdict;
   ASSERT_TRUE(WaitFor([&] {
-    return test::TakeOne<hiltwin_msg_dds__Timing_>(timing_reader, [&](const auto& s) {
+    return test::TakeOne<hiltwin_msgs_msg_dds__Timing_>(timing_reader, [&](const auto& s) {
       timing = s;
       verdict = s.verdict;
     });
@@ -296,7 +298,8 @@ TEST_F(DdsSinkTest, ADomainAbove232IsABadFlag) {
 
 TEST_F(DdsSinkTest, PublishBeforeOpenDoesNothing) {
   const auto sink = MakeDdsSink({206});
-  EXPECT_EQ(sink->Describe(), "DDS domain 206 rt/<namespace>/{pose,joint_states,timing,command}");
+  EXPECT_EQ(sink->Describe(),
+            "DDS domain 206 rt/<namespace>/{odom,pose,joint_states,timing,command}");
   sink->Publish(TwinRecord("x"));
   sink->PollCommands([](RemoteCommand, std::string&) { return true; });
 }

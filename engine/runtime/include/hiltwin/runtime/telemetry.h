@@ -40,6 +40,11 @@ struct TelemetryShape {
   std::string role = "task";  ///< "twin" or "controller": for the monitor
   bool has_pose = false;
   std::vector<std::string> joint_names;  ///< ROS joint names, one per joint (≤ 4)
+  /// Set by the session, not the task: on the virtual clock the DDS sink stamps with the task's
+  /// time and publishes it as ROS 2's /clock (but the controller of a lockstep pair, whose time
+  /// base is its twin's); on the real clock it stamps with system time.
+  bool virtual_clock = false;
+  bool lockstep = false;
 };
 
 /// The loop's part of a telemetry record: written every cycle, read at the telemetry rate.

@@ -16,10 +16,10 @@ namespace hiltwin::telemetry {
 
 /// `--telemetry dds[:DOMAIN]`: publishes rt/<ns>/pose (geometry_msgs::msg::dds_::Pose2D_),
 /// rt/<ns>/joint_states (sensor_msgs::msg::dds_::JointState_), rt/<ns>/timing
-/// (hiltwin::msg::dds_::Timing_) and reads rt/<ns>/command (std_msgs::msg::dds_::Int32_).
+/// (hiltwin_msgs::msg::dds_::Timing_) and reads rt/<ns>/command (std_msgs::msg::dds_::Int32_).
 /// Warns once on stderr when another task publishes under the same namespace.
 struct DdsEndpoint {
-  std::uint32_t domain = 0;  ///< DDS domain id (0..232, as ROS_DOMAIN_ID)
+  std::uint32_t domain = 0;  ///< DDS domain id (0..232; a bare `dds`: ROS_DOMAIN_ID)
   /// --accept-commands: commands on rt/<ns>/command reach the session. Off, the sink refuses
   /// them (it says so once on stderr, and the sender sees it in the reader's user data).
   bool accept_commands = false;
@@ -53,7 +53,13 @@ struct TelemetryOptions {
   bool accept_commands = false;    ///< --accept-commands (DDS only)
 };
 
-/// Parses the specs without opening anything; throws std::invalid_argument naming the flag.
+/// The DDS domain when a flag names none, as for every ROS 2 tool: ROS_DOMAIN_ID, or 0 when it
+/// is unset or empty. Throws std::invalid_argument naming the variable, its value and `flag`
+/// (how to give a domain instead, e.g. "--domain N") when it is not a whole number from 0 to
+/// 232: never a silent 0.
+[[nodiscard]] std::uint32_t DefaultDdsDomain(const std::string& flag);
+/// Parses the specs without opening anything (a bare `dds` is DefaultDdsDomain()); throws
+/// std::invalid_argument naming the flag.
 [[nodiscard]] std::vector<DdsEndpoint> ParseDdsSpecs(const std::vector<std::string>& specs);
 [[nodiscard]] std::vector<UdpEndpoint> ParseUdpSpecs(const std::vector<std::string>& specs);
 [[nodiscard]] WebEndpoint ParseWebSpec(const std::string& spec);
