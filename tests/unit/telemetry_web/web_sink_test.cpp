@@ -12,7 +12,9 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -215,6 +217,29 @@ TEST(WebSink, PageIsSelfContainedHtml) {
       R"((src|href)\s*=\s*["']?\s*(https?:)?//|url\(\s*["']?\s*(https?:)?//|@import)",
       std::regex::icase);
   EXPECT_FALSE(std::regex_search(res->body, external));
+}
+
+// The page's one script from outside the page is three.js, from this binary, at a relative
+// address; it is libjs-three's file byte for byte (or, built without it, a 404 that says so).
+TEST(WebSink, ServesThreeJsFromTheBinary) {
+  Served served;
+  const httplib::Result page = served.client.Get("/");
+  ASSERT_TRUE(page) << httplib::to_string(page.error());
+  EXPECT_NE(page->body.find("<script src=\"three.min.js\"></script>"), std::string::npos);
+  const httplib::Result res = served.client.Get("/three.min.js");
+  ASSERT_TRUE(res) << httplib::to_string(res.error());
+#ifdef HILTWIN_THREE_JS
+  EXPECT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Type"), "text/javascript; charset=utf-8");
+  std::ifstream file(HILTWIN_THREE_JS, std::ios::binary);
+  const std::string expected{std::istreambuf_iterator<char>(file), {}};
+  ASSERT_GT(expected.size(), 100'000U) << HILTWIN_THREE_JS;
+  EXPECT_TRUE(res->body == expected) << res->body.size() << " bytes, not the "
+                                     << expected.size() << " of " << HILTWIN_THREE_JS;
+#else
+  EXPECT_EQ(res->status, 404);
+  EXPECT_NE(res->body.find("-DHILTWIN_WEB_3D=OFF"), std::string::npos) << res->body;
+#endif
 }
 
 TEST(WebSink, RecordIs503BeforeTheFirstAndTheLatestAfter) {
