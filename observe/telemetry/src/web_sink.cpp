@@ -94,6 +94,9 @@ std::string BusyEvent() {
 
 // three.js for the page's 3D view (0.85 MB). Not cached, as the page is not: the next run on
 // this port may be another hiltwin with another three.js, and its page is written for that one.
+// Served as it is from the binary, through a content provider: httplib compresses a body set
+// with set_content per request (brotli, when the browser accepts it), which took 6 s for this
+// file on a loaded 2-core machine, and a 20 s run had ended before its page connected.
 void ServeThreeJs(httplib::Response& res) {
   const std::string_view script = web::ThreeJs();
   if (script.empty()) {
@@ -104,7 +107,11 @@ void ServeThreeJs(httplib::Response& res) {
     return;
   }
   res.set_header("Cache-Control", "no-store");
-  res.set_content(script.data(), script.size(), "text/javascript; charset=utf-8");
+  res.set_content_provider(script.size(), "text/javascript; charset=utf-8",
+                           [script](std::size_t offset, std::size_t length,
+                                    httplib::DataSink& sink) {
+                             return sink.write(script.data() + offset, length);
+                           });
 }
 
 bool WantsEventStream(const httplib::Request& req) {
