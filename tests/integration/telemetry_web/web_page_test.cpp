@@ -532,6 +532,7 @@ TEST(TelemetryWeb, Chromium3dViewDrawsTheRobotMoving) {
   const nlohmann::json probe = Probe(dom);
   ASSERT_TRUE(probe.is_object()) << "the page did not end its run: " << dom;
   const nlohmann::json& robot = probe["robot"];
+  RecordProperty("robot_pixels", robot.dump());  // --gtest_output=xml shows the figures
   ASSERT_EQ(robot.size(), 2U) << robot.dump();
   ASSERT_TRUE(robot[0].is_object() && robot[1].is_object()) << "no canvas: " << robot.dump();
   EXPECT_GE(robot[0]["n"].get<int>(), 100) << "no robot in the first frame: " << robot.dump();
