@@ -39,6 +39,7 @@ packages=(
   gnuplot-nox                                   # `hiltwin assess --plot`
   cyclonedds-dev cyclonedds-tools               # telemetry over DDS (idlc generates the types)
   libcpp-httplib-dev                            # the live web page (--web)
+  libjs-three                                   # three.js for the page's 3D view (embedded)
   chromium                                      # the web page test (headless)
   libzip-dev libxml2-dev                        # FMI 2.0 FMUs: unpacking, modelDescription.xml
   yosys nextpnr-ice40 fpga-icestorm verilator   # the IcoBoard gateware (board/fpga/, docs/fpga.md)

@@ -92,6 +92,28 @@ std::string BusyEvent() {
          "\n\n";
 }
 
+// three.js for the page's 3D view (0.85 MB). Not cached, as the page is not: the next run on
+// this port may be another hiltwin with another three.js, and its page is written for that one.
+// Served as it is from the binary, through a content provider: httplib compresses a body set
+// with set_content per request (brotli, when the browser accepts it), which took 6 s for this
+// file on a loaded 2-core machine, and a 20 s run had ended before its page connected.
+void ServeThreeJs(httplib::Response& res) {
+  const std::string_view script = web::ThreeJs();
+  if (script.empty()) {
+    res.status = 404;
+    res.set_content("this hiltwin was built without three.js (-DHILTWIN_WEB_3D=OFF): the page "
+                    "shows its 2D view only",
+                    "text/plain");
+    return;
+  }
+  res.set_header("Cache-Control", "no-store");
+  res.set_content_provider(script.size(), "text/javascript; charset=utf-8",
+                           [script](std::size_t offset, std::size_t length,
+                                    httplib::DataSink& sink) {
+                             return sink.write(script.data() + offset, length);
+                           });
+}
+
 bool WantsEventStream(const httplib::Request& req) {
   return req.get_header_value("Accept").find("text/event-stream") != std::string::npos;
 }
@@ -187,6 +209,9 @@ void WebSink::Configure() {
     const std::string_view page = web::PageHtml();
     res.set_header("Cache-Control", "no-store");
     res.set_content(page.data(), page.size(), "text/html; charset=utf-8");
+  });
+  server_.Get("/three.min.js", [](const httplib::Request&, httplib::Response& res) {
+    ServeThreeJs(res);
   });
   server_.Get("/record",
               [this](const httplib::Request&, httplib::Response& res) { ServeRecord(res); });

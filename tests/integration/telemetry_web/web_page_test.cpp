@@ -43,6 +43,8 @@
 
 #include "fakes/process.h"
 #include "fakes/test_paths.h"
+#include "hiltwin/telemetry/record_json.h"
+#include "hiltwin/telemetry/sinks.h"
 
 namespace hiltwin {
 namespace {
@@ -171,13 +173,17 @@ class HeldStream {
 };
 
 std::vector<std::string> ChromiumDumpDom(const fs::path& profile, int port,
-                                         int virtual_budget_ms = 1000) {
-  return {kChromium, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-          "--no-first-run", "--disable-background-networking", "--disable-component-update",
-          "--disable-sync", "--user-data-dir=" + profile.string(),
-          // Dumps once the stream has ended (see the top of this file).
-          "--virtual-time-budget=" + std::to_string(virtual_budget_ms), "--dump-dom",
-          "http://127.0.0.1:" + std::to_string(port) + "/"};
+                                         int virtual_budget_ms = 1000,
+                                         const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> argv = {
+      kChromium, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+      "--no-first-run", "--disable-background-networking", "--disable-component-update",
+      "--disable-sync", "--user-data-dir=" + profile.string(),
+      // Dumps once the stream has ended (see the top of this file).
+      "--virtual-time-budget=" + std::to_string(virtual_budget_ms), "--dump-dom"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  argv.push_back("http://127.0.0.1:" + std::to_string(port) + "/");
+  return argv;
 }
 
 /// The robot's group: its data attributes are the record's numbers, and its transform draws
@@ -313,6 +319,287 @@ TEST(TelemetryWeb, ChromiumAsSeventhPageSaysWhyItCannotConnectAndRetries) {
   EXPECT_GE(std::stoi("0" + Attribute(link, "data-attempts")), 2) << "no retry: " << link;
   EXPECT_EQ(Attribute(Tag(dom, "arena"), "data-samples"), "0") << "no record was shown";
   fs::remove_all(dir);
+}
+
+// ---- The page's drawing, measured in the browser. A page fed by a live twin receives
+// whichever records the stream had when it looked; these tests need exact ones. So the test
+// serves the page itself: the page and three.js exactly as the web sink serves them (fetched
+// from one), a finite /events stream of records the test wrote (telemetry::ToJson, as the sink
+// sends them), and, appended to the page, a probe script that measures what Chromium drew and
+// writes it into <pre id="probe"> for --dump-dom.
+
+// Measures, in screen pixels: every text of the 2D grid (axis labels and the scale bar's)
+// once the run has ended; and the 3D canvas's robot-coloured pixels (count and centroid) after
+// the first record and after the final one. The canvas keeps its last frame
+// (preserveDrawingBuffer), which the page draws synchronously for those two records.
+constexpr const char* kProbeScript = R"js(
+(() => {
+  const out = document.createElement("pre");
+  out.id = "probe";
+  document.body.appendChild(out);
+  const result = { robot: [] };
+  function robotPixels() {
+    const gl = document.querySelector("#view3d canvas");
+    if (!gl) return null;
+    const copy = document.createElement("canvas");
+    copy.width = gl.width; copy.height = gl.height;
+    const ctx = copy.getContext("2d");
+    ctx.drawImage(gl, 0, 0);
+    const px = ctx.getImageData(0, 0, copy.width, copy.height).data;
+    let n = 0, sx = 0, sy = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      const r = px[i], g = px[i + 1], b = px[i + 2];
+      if (b > 100 && b > r + 60 && b > g + 40) {  // the body's blue, lit or in shade
+        const p = i / 4; n += 1; sx += p % copy.width; sy += Math.floor(p / copy.width);
+      }
+    }
+    return { n, x: n ? sx / n : 0, y: n ? sy / n : 0 };
+  }
+  function labels() {
+    return [...document.querySelectorAll("#grid text")].map((t) => {
+      const r = t.getBoundingClientRect();
+      return { text: t.textContent, l: r.left, t: r.top, r: r.right, b: r.bottom };
+    });
+  }
+  new MutationObserver(() => {
+    const first = document.getElementById("arena").dataset.samples === "1";
+    if (first && result.robot.length === 0) result.robot.push(robotPixels());
+  }).observe(document.getElementById("arena"), { attributes: true });
+  new MutationObserver(() => {
+    if (document.getElementById("link").textContent !== "run ended") return;
+    const a = document.getElementById("arena").getBoundingClientRect();
+    result.arena = { l: a.left, t: a.top, r: a.right, b: a.bottom };
+    result.labels = labels();
+    result.robot.push(robotPixels());
+    out.textContent = JSON.stringify(result);
+  }).observe(document.getElementById("link"), { childList: true, characterData: true, subtree: true });
+})();
+)js";
+
+/// A twin's record at this pose and time; `final` ends the page's stream.
+runtime::TelemetryRecord PoseRecord(double x, double y, double theta, double t, bool final) {
+  runtime::TelemetryRecord r;
+  r.ns = "bench";
+  r.role = "twin";
+  r.rate_hz = 1000.0;
+  r.time_s = t;
+  r.cycle = static_cast<std::uint64_t>(t * 1000.0);
+  r.cycles_planned = 2000;
+  r.state = final ? lifecycle::State::kStopped : lifecycle::State::kRun;
+  r.final = final;
+  r.latency_samples = 1000;
+  r.task.has_pose = true;
+  r.task.x_m = x;
+  r.task.y_m = y;
+  r.task.theta_rad = theta;
+  r.task.joint_count = 2;
+  r.task.joint_position_m = {0.5 * t, 0.6 * t, 0.0, 0.0};
+  r.task.joint_position_rad = {0.5 * t / 0.04, 0.6 * t / 0.04, 0.0, 0.0};
+  r.joint_names = {"wheel_left_joint", "wheel_right_joint"};
+  return r;
+}
+
+/// The page, its three.js and `records` as one finite /events stream, with the probe.
+class ProbedPage {
+ public:
+  explicit ProbedPage(const std::vector<runtime::TelemetryRecord>& records) {
+    const std::shared_ptr<runtime::TelemetrySink> sink = telemetry::MakeWebSink({"127.0.0.1", 0});
+    sink->Open(runtime::TelemetryShape{}, "bench");
+    std::smatch m;
+    const std::string url = sink->Describe();
+    if (!std::regex_search(url, m, std::regex(R"(:(\d+)/)"))) throw std::runtime_error(url);
+    httplib::Client client("127.0.0.1", std::stoi(m[1].str()));
+    const httplib::Result page = client.Get("/");
+    const httplib::Result three = client.Get("/three.min.js");
+    if (!page || !three) throw std::runtime_error("the web sink did not serve the page");
+    page_ = page->body;
+    page_.insert(page_.rfind("</body>"), std::string("<script>") + kProbeScript + "</script>");
+    three_status_ = three->status;
+    three_ = three->body;
+    for (const runtime::TelemetryRecord& r : records) {
+      events_ += "data: " + telemetry::ToJson(r).dump() + "\n\n";
+    }
+    Serve();
+  }
+  ~ProbedPage() {
+    // stop() is a no-op until listen_after_bind has marked the server running.
+    while (!server_.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    server_.stop();
+    thread_.join();
+  }
+  ProbedPage(const ProbedPage&) = delete;
+  ProbedPage& operator=(const ProbedPage&) = delete;
+  [[nodiscard]] int port() const noexcept { return port_; }
+
+ private:
+  void Serve() {
+    server_.Get("/", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(page_, "text/html; charset=utf-8");
+    });
+    server_.Get("/three.min.js", [this](const httplib::Request&, httplib::Response& res) {
+      res.status = three_status_;
+      res.set_content(three_, "text/javascript; charset=utf-8");
+    });
+    server_.Get("/events", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(events_, "text/event-stream");
+    });
+    port_ = server_.bind_to_any_port("127.0.0.1");
+    // Bound is listening: a browser's connection waits in the backlog until the thread runs.
+    thread_ = std::thread([this] { server_.listen_after_bind(); });
+  }
+
+  std::string page_, three_, events_;
+  int three_status_ = 0;
+  httplib::Server server_;
+  int port_ = 0;
+  std::thread thread_;
+};
+
+/// What the probe wrote, as JSON (null when the page never ended its run).
+nlohmann::json Probe(const std::string& dom) {
+  const std::string open = "<pre id=\"probe\">";
+  const std::size_t start = dom.find(open);
+  const std::size_t end = dom.find("</pre>", start);
+  if (start == std::string::npos || end == std::string::npos) return {};
+  std::string text = dom.substr(start + open.size(), end - start - open.size());
+  for (const auto& [entity, c] : {std::pair{"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}}) {
+    for (std::size_t at = text.find(entity); at != std::string::npos; at = text.find(entity)) {
+      text.replace(at, std::string(entity).size(), c);
+    }
+  }
+  return text.empty() ? nlohmann::json() : nlohmann::json::parse(text);
+}
+
+/// Loads the page in Chromium (1280x800) and returns the dumped DOM.
+std::string LoadProbed(const char* name, const ProbedPage& page,
+                       const std::vector<std::string>& flags = {}) {
+  const fs::path dir = TempDir(name);
+  std::vector<std::string> extra = {"--window-size=1280,800"};
+  extra.insert(extra.end(), flags.begin(), flags.end());
+  const test::RunResult chromium =
+      test::Run(ChromiumDumpDom(dir / "profile", page.port(), 3000, extra), 120'000);
+  fs::remove_all(dir);
+  EXPECT_EQ(chromium.exit_code, 0) << chromium.status.Describe() << chromium.err;
+  return chromium.out;
+}
+
+struct Box {
+  std::string text;
+  double l, t, r, b;
+};
+
+/// The texts of the grid a user sees: those the arena does not clip away entirely.
+std::vector<Box> VisibleLabels(const nlohmann::json& probe, const Box& arena) {
+  std::vector<Box> boxes;
+  for (const auto& j : probe["labels"]) {
+    const Box b{j["text"].get<std::string>(), j["l"].get<double>(), j["t"].get<double>(),
+                j["r"].get<double>(), j["b"].get<double>()};
+    if (b.l < arena.r && arena.l < b.r && b.t < arena.b && arena.t < b.b) boxes.push_back(b);
+  }
+  return boxes;
+}
+
+std::string Describe(const Box& b) {
+  return "'" + b.text + "' at (" + std::to_string(b.l) + ", " + std::to_string(b.t) + ")-(" +
+         std::to_string(b.r) + ", " + std::to_string(b.b) + ")";
+}
+
+// The robot stands still at (0.28 m, 0.28 m): the view is then 1.6 m square from
+// (-0.52, -0.52), a grid line 0.02 m inside its bottom and its left edge, and the x label "-0.5"
+// and the y label "-0.5" were drawn over each other in the bottom-left corner. No two visible
+// texts of the grid may overlap, none may be cut by the arena's edge, and both axes keep labels.
+TEST(TelemetryWeb, ChromiumAxisLabelsDoNotOverlap) {
+  if (!fs::exists(kChromium)) {
+    GTEST_SKIP() << kChromium << " is missing (apt-get install chromium; scripts/setup.sh)";
+  }
+  std::vector<runtime::TelemetryRecord> records;
+  for (int i = 0; i <= 5; ++i) records.push_back(PoseRecord(0.28, 0.28, 0.3, 0.1 * i, i == 5));
+  const ProbedPage page(records);
+  const std::string dom = LoadProbed("labels", page);
+  const nlohmann::json probe = Probe(dom);
+  ASSERT_TRUE(probe.is_object()) << "the page did not end its run: " << dom;
+  const nlohmann::json& a = probe["arena"];
+  const Box arena{"arena", a["l"].get<double>(), a["t"].get<double>(), a["r"].get<double>(),
+                  a["b"].get<double>()};
+  const std::vector<Box> boxes = VisibleLabels(probe, arena);
+  int left_column = 0, bottom_row = 0;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const Box& b = boxes[i];
+    const bool inside = b.l >= arena.l - 0.5 && b.r <= arena.r + 0.5 && b.t >= arena.t - 0.5 &&
+                        b.b <= arena.b + 0.5;
+    EXPECT_TRUE(inside) << Describe(b) << " is cut by the arena's edge " << Describe(arena);
+    left_column += b.l < arena.l + 20.0 ? 1 : 0;
+    bottom_row += b.b > arena.b - 20.0 ? 1 : 0;
+    for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+      const Box& c = boxes[j];
+      EXPECT_FALSE(b.l < c.r && c.l < b.r && b.t < c.b && c.t < b.b)
+          << Describe(b) << " overlaps " << Describe(c);
+    }
+  }
+  EXPECT_GE(left_column, 2) << "y labels along the left edge: " << probe["labels"].dump();
+  EXPECT_GE(bottom_row, 2) << "x labels along the bottom edge: " << probe["labels"].dump();
+}
+
+/// The 3D view's attributes as numbers.
+double Data3d(const std::string& dom, const char* name) {
+  return std::stod("0" + Attribute(Tag(dom, "view3d"), name));
+}
+
+// Thesis §3.10 (Should 2), "3D visualisation": the robot drives 0.3 m forward while turning and
+// its wheels turn. Software WebGL (SwiftShader) draws in headless Chromium; the canvas shows the
+// robot's body after the first record and after the final one, moved across the picture, and
+// the 3D model's pose and wheel angles are the final record's.
+TEST(TelemetryWeb, Chromium3dViewDrawsTheRobotMoving) {
+  if (!fs::exists(kChromium)) {
+    GTEST_SKIP() << kChromium << " is missing (apt-get install chromium; scripts/setup.sh)";
+  }
+  std::vector<runtime::TelemetryRecord> records;
+  constexpr int kLast = 20;
+  for (int i = 0; i <= kLast; ++i) {
+    const double s = static_cast<double>(i) / kLast;
+    records.push_back(PoseRecord(0.3 * s, 0.05 * s, 0.4 * s, 2.0 * s, i == kLast));
+  }
+  const ProbedPage page(records);
+  const std::string dom = LoadProbed("3d", page, {"--enable-unsafe-swiftshader"});
+  const std::string view = Tag(dom, "view3d");
+  ASSERT_EQ(Attribute(view, "data-state"), "webgl") << Text(dom, "view3d-note") << view;
+  EXPECT_GE(Data3d(dom, "data-frames"), 2.0) << view;
+  const nlohmann::json last = telemetry::ToJson(records.back());
+  EXPECT_DOUBLE_EQ(Data3d(dom, "data-x"), last["pose"]["x"].get<double>()) << view;
+  EXPECT_DOUBLE_EQ(Data3d(dom, "data-y"), last["pose"]["y"].get<double>()) << view;
+  EXPECT_DOUBLE_EQ(Data3d(dom, "data-theta"), last["pose"]["theta"].get<double>()) << view;
+  EXPECT_DOUBLE_EQ(Data3d(dom, "data-wheel-left"),
+                   last["wheels"]["wheel_left_joint"]["rad"].get<double>()) << view;
+  EXPECT_DOUBLE_EQ(Data3d(dom, "data-wheel-right"),
+                   last["wheels"]["wheel_right_joint"]["rad"].get<double>()) << view;
+  const nlohmann::json probe = Probe(dom);
+  ASSERT_TRUE(probe.is_object()) << "the page did not end its run: " << dom;
+  const nlohmann::json& robot = probe["robot"];
+  RecordProperty("robot_pixels", robot.dump());  // --gtest_output=xml shows the figures
+  ASSERT_EQ(robot.size(), 2U) << robot.dump();
+  ASSERT_TRUE(robot[0].is_object() && robot[1].is_object()) << "no canvas: " << robot.dump();
+  EXPECT_GE(robot[0]["n"].get<int>(), 100) << "no robot in the first frame: " << robot.dump();
+  EXPECT_GE(robot[1]["n"].get<int>(), 100) << "no robot in the last frame: " << robot.dump();
+  const double moved = std::hypot(robot[1]["x"].get<double>() - robot[0]["x"].get<double>(),
+                                  robot[1]["y"].get<double>() - robot[0]["y"].get<double>());
+  EXPECT_GE(moved, 30.0) << "the robot did not move across the picture: " << robot.dump();
+}
+
+// Without WebGL the page says so where the 3D view would be, and the 2D view works as before.
+TEST(TelemetryWeb, ChromiumWithoutWebglSaysSoAndDrawsIn2d) {
+  if (!fs::exists(kChromium)) {
+    GTEST_SKIP() << kChromium << " is missing (apt-get install chromium; scripts/setup.sh)";
+  }
+  std::vector<runtime::TelemetryRecord> records;
+  for (int i = 0; i <= 4; ++i) records.push_back(PoseRecord(0.1 * i, 0.0, 0.0, 0.5 * i, i == 4));
+  const ProbedPage page(records);
+  const std::string dom = LoadProbed("nowebgl", page, {"--disable-webgl"});
+  EXPECT_EQ(Attribute(Tag(dom, "view3d"), "data-state"), "no-webgl") << Tag(dom, "view3d");
+  const std::string note = Text(dom, "view3d-note");
+  EXPECT_NE(note.find("no WebGL"), std::string::npos) << note;
+  EXPECT_NE(note.find("the 2D view shows the pose"), std::string::npos) << note;
+  EXPECT_EQ(Attribute(Tag(dom, "arena"), "data-samples"), "5") << dom;
+  ExpectRobotDrawnAt(dom, telemetry::ToJson(records.back())["pose"]);
 }
 
 // "0" is 0.0.0.0 to the resolver: the start-up line names the address really bound, and says

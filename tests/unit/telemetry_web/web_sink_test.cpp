@@ -12,7 +12,9 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -215,6 +217,36 @@ TEST(WebSink, PageIsSelfContainedHtml) {
       R"((src|href)\s*=\s*["']?\s*(https?:)?//|url\(\s*["']?\s*(https?:)?//|@import)",
       std::regex::icase);
   EXPECT_FALSE(std::regex_search(res->body, external));
+}
+
+// The page's one script from outside the page is three.js, from this binary, at a relative
+// address; it is libjs-three's file byte for byte (or, built without it, a 404 that says so),
+// not compressed per request even when the browser accepts brotli or gzip: httplib's brotli
+// of 0.85 MB took seconds on a loaded machine, and a short run ended before its page connected.
+TEST(WebSink, ServesThreeJsFromTheBinary) {
+  Served served;
+  served.client.set_decompress(false);
+  const httplib::Headers accept = {{"Accept-Encoding", "gzip, deflate, br"}};
+  const httplib::Result page = served.client.Get("/");
+  ASSERT_TRUE(page) << httplib::to_string(page.error());
+  EXPECT_NE(page->body.find("<script src=\"three.min.js\"></script>"), std::string::npos);
+  const httplib::Result res = served.client.Get("/three.min.js", accept);
+  ASSERT_TRUE(res) << httplib::to_string(res.error());
+#ifdef HILTWIN_THREE_JS
+  EXPECT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Encoding"), "");
+  EXPECT_EQ(res->get_header_value("Content-Type"), "text/javascript; charset=utf-8");
+  std::ifstream file(HILTWIN_THREE_JS, std::ios::binary);
+  const std::string expected{std::istreambuf_iterator<char>(file), {}};
+  ASSERT_GT(expected.size(), 100'000U) << HILTWIN_THREE_JS;
+  EXPECT_TRUE(res->body == expected) << res->body.size() << " bytes, not the "
+                                     << expected.size() << " of " << HILTWIN_THREE_JS;
+#else
+  EXPECT_EQ(res->status, 404);
+  const httplib::Result plain = served.client.Get("/three.min.js");  // the message, uncompressed
+  ASSERT_TRUE(plain) << httplib::to_string(plain.error());
+  EXPECT_NE(plain->body.find("-DHILTWIN_WEB_3D=OFF"), std::string::npos) << plain->body;
+#endif
 }
 
 TEST(WebSink, RecordIs503BeforeTheFirstAndTheLatestAfter) {
