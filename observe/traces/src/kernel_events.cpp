@@ -26,6 +26,8 @@ constexpr const char* kEventsFile = "kernel_events.csv";
 constexpr const char* kTasksFile = "kernel_tasks.csv";
 constexpr std::string_view kCommentPrefix = "# hiltwin kernel events ";
 constexpr std::string_view kFormatVersion = "1";
+constexpr std::string_view kPreemptionPrefix = "# preemption ";
+constexpr std::string_view kPreemptionSeparator = " | ";
 constexpr std::array<std::string_view, 14> kEventColumns = {
     "time_ns",   "cpu",       "event",      "pid",        "comm", "prio", "next_pid",
     "next_comm", "next_prio", "prev_state", "target_cpu", "irq",  "name", "address"};
@@ -154,6 +156,20 @@ std::string CommentLine(const KernelTrace& trace) {
   return line;
 }
 
+// "# preemption PREEMPT_NONE | kernel config", or nothing when the model was not recorded.
+std::string PreemptionLine(const KernelTrace& trace) {
+  if (trace.preemption_model.empty()) return {};
+  std::string line(kPreemptionPrefix);
+  const auto append = [&line](std::string_view text) {
+    for (char c : text) line += (c == '|' || c == '\n' || c == '\r') ? '_' : c;
+  };
+  append(trace.preemption_model);
+  line += kPreemptionSeparator;
+  append(trace.preemption_source);
+  line += '\n';
+  return line;
+}
+
 // An output file that reports a failed open or write by name.
 class OutputFile {
  public:
@@ -194,6 +210,7 @@ std::vector<std::size_t> IndicesByTime(const std::vector<KernelEvent>& events) {
 void WriteEvents(const fs::path& path, const KernelTrace& trace) {
   OutputFile out(path);
   out.Write(CommentLine(trace));
+  out.Write(PreemptionLine(trace));
   out.Write(EventsHeader() + "\n");
   std::string line;
   for (std::size_t index : IndicesByTime(trace.events)) {
@@ -351,12 +368,29 @@ void ExpectHeader(EventsFileLines& reader, std::string& line, const std::string&
   if (line != header) reader.Fail("missing the header row '" + header + "'");
 }
 
+// "# preemption <model> | <source>" into the trace; false when `line` is not that line.
+bool ParsePreemptionLine(const EventsFileLines& reader, std::string_view line,
+                         KernelTrace& trace) {
+  if (!line.starts_with(kPreemptionPrefix)) return false;
+  line.remove_prefix(kPreemptionPrefix.size());
+  const std::size_t separator = line.find(kPreemptionSeparator);
+  if (separator == std::string_view::npos || separator == 0) {
+    reader.Fail("the preemption line needs '" + std::string(kPreemptionPrefix) + "<model>" +
+                std::string(kPreemptionSeparator) + "<how it was told>'");
+  }
+  trace.preemption_model = line.substr(0, separator);
+  trace.preemption_source = line.substr(separator + kPreemptionSeparator.size());
+  return true;
+}
+
 void ReadEvents(const fs::path& path, KernelTrace& trace) {
   EventsFileLines reader(path);
   std::string line;
   reader.Expect(line, "the comment line");
   ParseCommentLine(reader, line, trace);
-  ExpectHeader(reader, line, EventsHeader());
+  reader.Expect(line, "the header row");
+  if (ParsePreemptionLine(reader, line, trace)) reader.Expect(line, "the header row");
+  if (line != EventsHeader()) reader.Fail("missing the header row '" + EventsHeader() + "'");
   while (reader.Next(line)) trace.events.push_back(ParseEventRow(reader, line));
   const auto earlier = [](const KernelEvent& a, const KernelEvent& b) {
     return a.time_ns < b.time_ns;

@@ -157,7 +157,8 @@ KernelTrace MakeKernel(const TimingTrace& trace, const std::map<std::uint64_t, S
       continue;
     }
     const bool behind = i > 0 && cycles[i - 1].sample.end_ns > s.release_ns;
-    const bool sleeps_after = i + 1 == cycles.size() || cycles[i + 1].sample.release_ns >= s.end_ns;
+    const bool sleeps_after =
+        i + 1 == cycles.size() || cycles[i + 1].sample.release_ns >= s.end_ns;
     if (!behind) ArriveFromIdle(script, s);
     if (sleeps_after) script.LoopOutToIdle(s.end_ns + 500);
   }

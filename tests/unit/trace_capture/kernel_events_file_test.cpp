@@ -84,6 +84,8 @@ KernelTrace EveryKind() {
   KernelTrace trace;
   trace.cpus = {0, 1};
   trace.lost_events = 12;
+  trace.preemption_model = "PREEMPT_NONE";
+  trace.preemption_source = "PREEMPT_DYNAMIC, kernel config default; debugfs not mounted";
   KernelEvent preempted =
       Task(Event(1'000'500, 0, KernelEventKind::kSchedSwitch), 7, "cap-victim", 120);
   preempted.next_pid = 8;
@@ -141,15 +143,34 @@ TEST_F(KernelEventsFileTest, TheFileSaysWhatTheHeaderPromises) {
   WriteKernelTrace(dir_.string(), EveryKind());
   std::ifstream in(EventsPath());
   std::string comment;
+  std::string preemption;
   std::string header;
   std::string first;
   std::getline(in, comment);
+  std::getline(in, preemption);
   std::getline(in, header);
   std::getline(in, first);
   EXPECT_EQ(comment, "# hiltwin kernel events 1 cpus=0,1 lost=12");
+  EXPECT_EQ(preemption,
+            "# preemption PREEMPT_NONE | PREEMPT_DYNAMIC, kernel config default; debugfs not "
+            "mounted");
   EXPECT_EQ(header + "\n", kHeader);
   // A wakeup fills pid, comm, prio and target_cpu; the rest stays empty.
   EXPECT_EQ(first, "1000000,1,sched_wakeup,8,cap-hog,9,,,,,0,,,");
+}
+
+// Recordings made before the preemption model was recorded have no such line: it is not known.
+TEST_F(KernelEventsFileTest, ARecordingWithoutThePreemptionLineReadsWithTheModelUnknown) {
+  WriteFile("kernel_events.csv",
+            std::string(kComment) + kHeader + "5,0,local_timer_entry,,,,,,,,,,,\n");
+  WriteFile("kernel_tasks.csv", kTasks);
+  const KernelTrace read = ReadKernelTrace(dir_.string());
+  EXPECT_EQ(read.events.size(), 1U);
+  EXPECT_EQ(read.preemption_model, "");
+  EXPECT_EQ(read.preemption_source, "");
+  // One that has it but not in its shape is refused with its line.
+  WriteFile("kernel_events.csv", std::string(kComment) + "# preemption PREEMPT_NONE\n" + kHeader);
+  EXPECT_THAT(ReadError(), HasSubstr("kernel_events.csv:2: the preemption line needs"));
 }
 
 TEST_F(KernelEventsFileTest, CommasAndLineBreaksInNamesBecomeUnderscores) {
