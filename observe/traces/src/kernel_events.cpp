@@ -25,7 +25,9 @@ namespace fs = std::filesystem;
 constexpr const char* kEventsFile = "kernel_events.csv";
 constexpr const char* kTasksFile = "kernel_tasks.csv";
 constexpr std::string_view kCommentPrefix = "# hiltwin kernel events ";
-constexpr std::string_view kFormatVersion = "1";
+// Version 2 added the preemption line; version 1 files (no such line) still read.
+constexpr std::string_view kFormatVersion = "2";
+constexpr std::array<std::string_view, 2> kReadableVersions = {"1", "2"};
 constexpr std::string_view kPreemptionPrefix = "# preemption ";
 constexpr std::string_view kPreemptionSeparator = " | ";
 constexpr std::array<std::string_view, 14> kEventColumns = {
@@ -342,14 +344,19 @@ KernelEvent ParseEventRow(const EventsFileLines& reader, std::string_view line) 
   return event;
 }
 
-// "# hiltwin kernel events 1 cpus=0,1 lost=0" into trace.cpus and trace.lost_events.
+// "# hiltwin kernel events 2 cpus=0,1 lost=0" into trace.cpus and trace.lost_events.
 void ParseCommentLine(const EventsFileLines& reader, std::string_view line, KernelTrace& trace) {
-  const std::string expected = std::string(kCommentPrefix) + std::string(kFormatVersion) + " ";
-  if (!line.starts_with(expected)) {
-    reader.Fail("missing the comment line '" + expected + "cpus=<list> lost=<count>' (found '" +
+  const std::string prefix(kCommentPrefix);
+  const auto version = std::find_if(
+      kReadableVersions.begin(), kReadableVersions.end(), [&](std::string_view v) {
+        return line.starts_with(prefix + std::string(v) + " ");
+      });
+  if (version == kReadableVersions.end()) {
+    reader.Fail("missing the comment line '" + prefix + std::string(kFormatVersion) +
+                " cpus=<list> lost=<count>' (versions 1 and 2 are read; found '" +
                 std::string(line.substr(0, 60)) + "')");
   }
-  line.remove_prefix(expected.size());
+  line.remove_prefix(prefix.size() + version->size() + 1);
   const std::size_t lost_at = line.find(" lost=");
   if (!line.starts_with("cpus=") || lost_at == std::string_view::npos) {
     reader.Fail("the comment line needs 'cpus=<list> lost=<count>'");

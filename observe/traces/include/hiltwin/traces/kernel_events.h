@@ -13,10 +13,11 @@
 /// and DIR/kernel_tasks.csv, the threads seen, with their policy when it could be read:
 ///   pid,comm,policy,rt_priority
 /// The first line of kernel_events.csv is a comment
-///   "# hiltwin kernel events 1 cpus=<comma list> lost=<count>",
-/// optionally followed by the kernel's preemption model at record time (absent in older
-/// recordings: the model is then not known; '|' and line breaks in either part become '_')
-///   "# preemption <model> | <how it was told>".
+///   "# hiltwin kernel events 2 cpus=<comma list> lost=<count>",
+/// then (version 2, when the recorder knew it) the kernel's preemption model at record time
+///   "# preemption <model> | <how it was told>"
+/// ('|' and line breaks in either part become '_'). Version 1 files, without that line, are
+/// still read (the model is then not known).
 
 #include <cstdint>
 #include <string>
