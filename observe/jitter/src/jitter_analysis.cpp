@@ -309,8 +309,6 @@ JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel) 
   r.clusters = detail::ClusterMisses(trace);
   CountReleases(trace, r);
   r.feasibility = JudgeFeasibility(r);
-  // First among the warnings too: `hiltwin trace` prints them last, after the long report.
-  if (!r.feasibility.feasible) r.warnings.push_back(r.feasibility.verdict);
   TraceWarnings(trace, stats, r);
 
   const std::vector<std::size_t> notable = NotableIndices(trace, stats, r.latency.summary.p999_ns);

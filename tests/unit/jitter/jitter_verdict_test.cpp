@@ -47,9 +47,6 @@ TEST(JitterVerdict, AnInfeasibleRateIsTheReportsFirstLine) {
   EXPECT_EQ(f["deadline_ns"], 50'000);
   EXPECT_EQ(f["advice"], "hiltwin tune --cpu 1 --priority 80");
   EXPECT_EQ(f["verdict"], first);
-  // The console shows it last too, among the warnings `hiltwin trace` prints.
-  ASSERT_FALSE(r.warnings.empty());
-  EXPECT_EQ(r.warnings.front(), first);
 }
 
 TEST(JitterVerdict, AFeasibleRateKeepsTheUsualFirstLine) {
