@@ -190,7 +190,7 @@ class CycleCauses {
     const scheduler::TimingSample& p = Sample(i - 1);
     return p.cycle + 1 + p.releases_skipped == Sample(i).cycle && p.end_ns > Sample(i).release_ns;
   }
-  // Its predecessor's cause is known.
+  // Cycle i's cause over its whole window; Of() has found its predecessor's already.
   Cause Resolve(std::size_t i) {
     detail::CauseWindow w = WindowOf(Sample(i), false, r_);
     if (!Behind(i)) return attributor_.Attribute(w);

@@ -47,18 +47,31 @@ ordered_json ClustersJson(const MissClusters& c) {
 // and inherited: null unless a backlog).
 ordered_json CauseJson(const Cause& c) {
   ordered_json behind = c.behind_cycle ? ordered_json(*c.behind_cycle) : ordered_json(nullptr);
-  ordered_json inherited = c.inherited ? ordered_json(ToString(*c.inherited)) : ordered_json(nullptr);
-  return {{"class", ToString(c.cause)}, {"duration_ns", c.duration_ns}, {"cpu", c.cpu},
-          {"behind_cycle", std::move(behind)}, {"inherited", std::move(inherited)},
-          {"thread", c.thread},         {"pid", c.pid},                 {"policy", c.policy},
-          {"priority", c.priority},     {"interrupt", c.interrupt},     {"irq", c.irq},
-          {"faults", c.faults},         {"address", c.address},         {"evidence", c.evidence}};
+  ordered_json inherited =
+      c.inherited ? ordered_json(ToString(*c.inherited)) : ordered_json(nullptr);
+  return {{"class", ToString(c.cause)},
+          {"duration_ns", c.duration_ns},
+          {"cpu", c.cpu},
+          {"behind_cycle", std::move(behind)},
+          {"inherited", std::move(inherited)},
+          {"thread", c.thread},
+          {"pid", c.pid},
+          {"policy", c.policy},
+          {"priority", c.priority},
+          {"interrupt", c.interrupt},
+          {"irq", c.irq},
+          {"faults", c.faults},
+          {"address", c.address},
+          {"evidence", c.evidence}};
 }
 
 ordered_json FeasibilityJson(const Feasibility& f) {
-  return {{"feasible", f.feasible},         {"latency_p50_ns", f.latency_p50_ns},
-          {"compute_p50_ns", f.compute_p50_ns}, {"deadline_ns", f.deadline_ns},
-          {"max_rate_hz", f.max_rate_hz},   {"verdict", f.verdict},
+  return {{"feasible", f.feasible},
+          {"latency_p50_ns", f.latency_p50_ns},
+          {"compute_p50_ns", f.compute_p50_ns},
+          {"deadline_ns", f.deadline_ns},
+          {"max_rate_hz", f.max_rate_hz},
+          {"verdict", f.verdict},
           {"advice", f.advice}};
 }
 
