@@ -131,6 +131,13 @@ void WriteOutputs(const analysis::JitterReport& report, const analysis::TimingTr
   std::fflush(stdout);
 }
 
+/// After the report and its files: the warnings, and last of all an infeasible rate (also the
+/// report's first line), so the console ends with the cause a user must act on first.
+void PrintWarnings(const analysis::JitterReport& report) {
+  for (const std::string& warning : report.warnings) spdlog::warn("{}", warning);
+  if (!report.feasibility.feasible) spdlog::warn("{}", report.feasibility.verdict);
+}
+
 analysis::JitterReport Analyze(const analysis::TimingTrace& trace,
                                const analysis::KernelTrace* kernel) {
   spdlog::info("analysing {} cycles{}", trace.cycles.size(),
@@ -218,7 +225,7 @@ int TraceTwin(const TraceOptions& o) {
       report.warnings.push_back("the trace disagrees with the run report: " + line);
     }
     WriteOutputs(report, trace, kernel ? &*kernel : nullptr, o.output_dir);
-    for (const std::string& warning : report.warnings) spdlog::warn("{}", warning);
+    PrintWarnings(report);
   } catch (const std::exception& e) {
     // The run happened and its report stands; the trace of it is what failed.
     std::fprintf(stderr, "hiltwin trace: the run ended, but its trace could not be made: %s\n",
@@ -246,7 +253,7 @@ int AnalyzeTrace(const TraceOptions& o) {
     fs::create_directories(dir, ec);
     if (ec) ThrowUsage("--output " + dir + ": cannot create the folder: " + ec.message());
     WriteOutputs(report, trace, kernel ? &*kernel : nullptr, dir);
-    for (const std::string& warning : report.warnings) spdlog::warn("{}", warning);
+    PrintWarnings(report);
   } catch (const analysis::TraceReadError& e) {
     ThrowUsage(e.what());
   }

@@ -326,6 +326,45 @@ PreemptMode FindPreemptMode(const Machine& machine, const std::optional<std::str
   return found;
 }
 
+// What the kernel tells of its preemption: PREEMPT_RT (and from where), PREEMPT_DYNAMIC, and
+// otherwise the mode and where it was read.
+struct PreemptionFacts {
+  std::string rt_source;  // empty: not PREEMPT_RT
+  bool dynamic = false;
+  PreemptMode found;
+  bool nothing_to_read = false;  // no uname -v and no kernel config
+};
+
+PreemptionFacts ReadPreemption(const Machine& machine) {
+  const auto realtime = machine.ReadTrimmed("sys/kernel/realtime");
+  const auto version = machine.KernelVersion();
+  const auto config = machine.KernelConfig();
+  PreemptionFacts facts;
+  if (realtime && *realtime == "1") {
+    facts.rt_source = "/sys/kernel/realtime";
+  } else if (version && HasWord(*version, "PREEMPT_RT")) {
+    facts.rt_source = "uname -v";
+  } else if (ConfigHas(config, "CONFIG_PREEMPT_RT=y")) {
+    facts.rt_source = "kernel config";
+  }
+  if (!facts.rt_source.empty()) return facts;
+  facts.dynamic = (version && HasWord(*version, "PREEMPT_DYNAMIC")) ||
+                  ConfigHas(config, "CONFIG_PREEMPT_DYNAMIC=y");
+  facts.found = FindPreemptMode(machine, version, config, facts.dynamic);
+  facts.nothing_to_read = !version && !config;
+  return facts;
+}
+
+// The kernel config's name of a mode: "none" is PREEMPT_NONE, "full" is PREEMPT.
+std::string ConfigName(const std::string& mode) {
+  if (mode == "none") return "PREEMPT_NONE";
+  if (mode == "voluntary") return "PREEMPT_VOLUNTARY";
+  if (mode == "full") return "PREEMPT";
+  if (mode == "lazy") return "PREEMPT_LAZY";
+  if (mode == "none or voluntary") return "PREEMPT_NONE or PREEMPT_VOLUNTARY";
+  return "preempt=" + mode;  // a boot option this code does not know yet: as given
+}
+
 ProbeCheck CheckPreemption(const Machine& machine) {
   const std::string id = "preemption";
   const std::string name = "preemption model";
@@ -333,22 +372,17 @@ ProbeCheck CheckPreemption(const Machine& machine) {
   const std::string rt_advice =
       "for wake-up latency in tens of microseconds use a PREEMPT_RT kernel (" + platform.rt_kernel +
       ")";
-  const auto realtime = machine.ReadTrimmed("sys/kernel/realtime");
-  const auto version = machine.KernelVersion();
-  const auto config = machine.KernelConfig();
-
-  const bool rt = (realtime && *realtime == "1") || (version && HasWord(*version, "PREEMPT_RT")) ||
-                  ConfigHas(config, "CONFIG_PREEMPT_RT=y");
-  if (rt) {
+  const PreemptionFacts facts = ReadPreemption(machine);
+  if (!facts.rt_source.empty()) {
     return Make(id, name, "PREEMPT_RT (fully preemptible kernel)", CheckStatus::kOk);
   }
-
-  const bool dynamic = (version && HasWord(*version, "PREEMPT_DYNAMIC")) ||
-                       ConfigHas(config, "CONFIG_PREEMPT_DYNAMIC=y");
-  const PreemptMode found = FindPreemptMode(machine, version, config, dynamic);
+  const bool dynamic = facts.dynamic;
+  const PreemptMode& found = facts.found;
   const std::string prefix = dynamic ? "PREEMPT_DYNAMIC, mode " : "";
   if (found.mode.empty()) {
-    if (!version && !config) return Unknown(id, name, "no uname -v, no kernel config", rt_advice);
+    if (facts.nothing_to_read) {
+      return Unknown(id, name, "no uname -v, no kernel config", rt_advice);
+    }
     return Make(id, name, prefix + "unknown (debugfs not mounted, no kernel config)",
                 CheckStatus::kWarn,
                 "see the live mode with `sudo mount -t debugfs none /sys/kernel/debug` and `cat "
@@ -855,6 +889,20 @@ ProbeReport RunRtProbe(const ProbeOptions& options, const OsCalls& os) {
   report.checks.push_back(
       AssessSteal(steal_start, steal_start, steal_end, static_cast<int>(window_ms)));
   return report;
+}
+
+KernelPreemption FindKernelPreemption(const ProbeOptions& options) {
+  const Machine machine(options);
+  const PreemptionFacts facts = ReadPreemption(machine);
+  if (!facts.rt_source.empty()) return {"PREEMPT_RT", facts.rt_source};
+  const std::string dynamic = facts.dynamic ? "PREEMPT_DYNAMIC, " : "";
+  if (facts.found.mode.empty()) {
+    return {"unknown", facts.nothing_to_read
+                           ? "no uname -v, no kernel config"
+                           : dynamic + "debugfs not mounted, no preempt= boot option, no kernel "
+                                       "config"};
+  }
+  return {ConfigName(facts.found.mode), dynamic + facts.found.source};
 }
 
 }  // namespace hiltwin::kernel_glue

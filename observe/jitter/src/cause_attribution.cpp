@@ -74,6 +74,10 @@ std::string SoftirqName(const KernelEvent& e) {
 struct KernelIndex {
   int tid = 0;
   int home_cpu = -1;
+  // The loop's kernel prio when it is real-time (99 - rt priority); -1 for SCHED_OTHER, which
+  // outranks nothing: every thread may preempt it.
+  int loop_kernel_prio = -1;
+  std::string preemption_model;  // as recorded; "" when the recording does not say
   std::int64_t first_ns = 0;
   std::int64_t last_ns = 0;
   std::vector<int> recorded_cpus;  // as the recorder listed them; empty: those with events
@@ -363,6 +367,7 @@ class WindowQuery {
 
  private:
   void AddRuns(int cpu, std::int64_t lo, std::int64_t hi, bool credit_threads);
+  static std::int64_t IrqTime(const CpuIndex& cpu, std::int64_t a, std::int64_t b);
   void AddInterrupts(int cpu, std::int64_t lo, std::int64_t hi);
   void AddFaults();
   std::int64_t FaultCharge(const Fault& f) const;
@@ -408,8 +413,12 @@ void WindowQuery::AddRuns(int cpu_number, std::int64_t lo, std::int64_t hi, bool
   auto r = std::partition_point(cpu->runs.begin(), cpu->runs.end(),
                                 [&](const RunSegment& s) { return s.end_ns <= lo; });
   for (; r != cpu->runs.end() && r->begin_ns < hi; ++r) {
-    const std::int64_t ov = Overlap(r->begin_ns, r->end_ns, lo, hi);
-    if (ov <= 0 || r->pid == ix_.tid) continue;
+    const std::int64_t a = std::max(r->begin_ns, lo);
+    const std::int64_t b = std::min(r->end_ns, hi);
+    if (b <= a || r->pid == ix_.tid) continue;
+    // An interrupt taken while the thread was current held the CPU, not the thread: its time
+    // is the interrupt's (AddInterrupts), never both.
+    const std::int64_t ov = b - a - IrqTime(*cpu, a, b);
     if (r->pid == 0) {
       t_.idle_ns += ov;
       continue;
@@ -420,8 +429,27 @@ void WindowQuery::AddRuns(int cpu_number, std::int64_t lo, std::int64_t hi, bool
     th.prio = r->prio;
     th.comm = r->comm;
     th.cpu = cpu_number;
-    t_.in_step_ns += InStep(std::max(r->begin_ns, lo), std::min(r->end_ns, hi));
+    const std::int64_t step_a = std::max(a, w_.step_begin_ns);
+    const std::int64_t step_b = std::min(b, w_.step_end_ns);
+    if (step_b > step_a) t_.in_step_ns += step_b - step_a - IrqTime(*cpu, step_a, step_b);
   }
+}
+
+// How long interrupt handlers ran on `cpu` inside [a, b): nested ones counted once.
+std::int64_t WindowQuery::IrqTime(const CpuIndex& cpu, std::int64_t a, std::int64_t b) {
+  auto r = std::partition_point(cpu.irqs.begin(), cpu.irqs.end(), [&](const IrqSegment& s) {
+    return s.begin_ns < a - cpu.longest_irq_ns;
+  });
+  std::int64_t covered_until = a;
+  std::int64_t total = 0;
+  for (; r != cpu.irqs.end() && r->begin_ns < b; ++r) {
+    const std::int64_t from = std::max(r->begin_ns, covered_until);
+    const std::int64_t to = std::min(r->end_ns, b);
+    if (to <= from) continue;
+    total += to - from;
+    covered_until = to;
+  }
+  return total;
 }
 
 void WindowQuery::AddInterrupts(int cpu_number, std::int64_t lo, std::int64_t hi) {
@@ -500,14 +528,25 @@ struct Decision {
   std::int64_t invisible_ns = 0;
 };
 
-Decision Decide(const Tally& t, const CauseWindow& w) {
+// Whether a thread that held the loop's CPU ranks below the loop (kernel prio: lower is
+// higher; < 0 is SCHED_DEADLINE, 100 and above SCHED_OTHER). The scheduler would have
+// preempted it for the loop at once, unless the kernel did not let it.
+bool BelowTheLoop(const KernelIndex& ix, int prio) {
+  return ix.loop_kernel_prio >= 0 && prio > ix.loop_kernel_prio;
+}
+
+Decision Decide(const KernelIndex& ix, const Tally& t, const CauseWindow& w) {
   Decision d;
   std::int64_t explained = 0;
   auto offer = [&](const Choice& c) {
     explained += c.ns;
     if (c.ns > d.best.ns) d.best = c;
   };
-  for (const auto& [pid, th] : t.threads) offer({CauseClass::kPreempted, th.ns, pid, 0});
+  for (const auto& [pid, th] : t.threads) {
+    const CauseClass cls =
+        BelowTheLoop(ix, th.prio) ? CauseClass::kNonPreemptible : CauseClass::kPreempted;
+    offer({cls, th.ns, pid, 0});
+  }
   for (const auto& [name, x] : t.irqs) offer({CauseClass::kInterrupt, x.ns, 0, name});
   if (t.faults > 0) offer({CauseClass::kPageFault, t.fault_ns, 0, 0});
   if (!w.wake_only && w.compute_ns > w.compute_p999_ns) {
@@ -560,8 +599,17 @@ void DescribePreemption(const KernelIndex& ix, const Choice& c, const Tally& t, 
     out.policy = "SCHED_OTHER";
   }
   const std::string policy = PolicyText(out.policy, out.priority);
-  out.evidence = "preempted by " + out.thread + " (pid " + std::to_string(out.pid) +
-                 (policy.empty() ? "" : ", " + policy) + ") for " + FormatDuration(c.ns);
+  const std::string who =
+      out.thread + " (pid " + std::to_string(out.pid) + (policy.empty() ? "" : ", " + policy) + ")";
+  if (c.cause == CauseClass::kPreempted) {
+    out.evidence = "preempted by " + who + " for " + FormatDuration(c.ns);
+    return;
+  }
+  const std::string model = ix.preemption_model.empty() || ix.preemption_model == "unknown"
+                                ? "preemption model unknown"
+                                : ix.preemption_model + " kernel";
+  out.evidence = "kernel non-preemptible section while " + who + " ran for " +
+                 FormatDuration(c.ns) + " (" + model + ")";
 }
 
 void DescribeInterrupt(const KernelIndex& ix, const Choice& c, const Tally& t, Cause& out) {
@@ -610,7 +658,8 @@ Cause MakeCause(const KernelIndex& ix, const Decision& d, const Tally& t, const 
   out.duration_ns = d.best.ns;
   out.cpu = BusiestCpu(t, ix.home_cpu);
   switch (out.cause) {
-    case CauseClass::kPreempted: DescribePreemption(ix, d.best, t, out); break;
+    case CauseClass::kPreempted:
+    case CauseClass::kNonPreemptible: DescribePreemption(ix, d.best, t, out); break;
     case CauseClass::kInterrupt: DescribeInterrupt(ix, d.best, t, out); break;
     case CauseClass::kPageFault: DescribeFaults(t, out); break;
     case CauseClass::kOwnCompute:
@@ -620,6 +669,7 @@ Cause MakeCause(const KernelIndex& ix, const Decision& d, const Tally& t, const 
                      " more than usual with nothing else running";
       break;
     case CauseClass::kInvisible: DescribeInvisible(t, w, out); break;
+    case CauseClass::kBacklog:  // decided from the cycles, not the kernel (BacklogBehind)
     case CauseClass::kNotRecorded: break;
   }
   return out;
@@ -638,6 +688,9 @@ CauseAttributor::CauseAttributor(const KernelTrace& kernel, const LoopThread& lo
   auto ix = std::make_unique<KernelIndex>();
   ix->tid = loop.tid;
   ix->home_cpu = loop.cpu;
+  const bool rt = loop.policy == 1 || loop.policy == 2;  // SCHED_FIFO, SCHED_RR
+  ix->loop_kernel_prio = rt ? 99 - loop.priority : -1;
+  ix->preemption_model = kernel.preemption_model;
   ix->recorded_cpus = kernel.cpus;
   for (const KernelTask& task : kernel.tasks) ix->tasks[task.pid] = task;
   const auto [lo, hi] = std::minmax_element(
@@ -669,7 +722,7 @@ Cause CauseAttributor::Attribute(const CauseWindow& window) const {
                            : "CPU " + std::to_string(tally.missing_cpu) +
                                  ", where the loop was, was not recorded");
   }
-  return MakeCause(ix, Decide(tally, window), tally, window);
+  return MakeCause(ix, Decide(ix, tally, window), tally, window);
 }
 
 std::vector<std::string> CauseAttributor::Warnings() const {
@@ -701,15 +754,28 @@ std::vector<std::string> CauseAttributor::Warnings() const {
 }
 
 std::string CulpritName(const Cause& cause) {
-  switch (cause.cause) {
-    case CauseClass::kPreempted: return cause.thread + " (pid " + std::to_string(cause.pid) + ")";
+  switch (cause.RankedAs()) {
+    case CauseClass::kPreempted:
+    case CauseClass::kNonPreemptible:
+      return cause.thread + " (pid " + std::to_string(cause.pid) + ")";
     case CauseClass::kInterrupt: return cause.interrupt;
     case CauseClass::kPageFault: return "loop thread";
     case CauseClass::kOwnCompute: return "the step";
     case CauseClass::kInvisible: return "CPU " + std::to_string(cause.cpu);
+    case CauseClass::kBacklog:  // RankedAs() is never a backlog: it names the stall's class
     case CauseClass::kNotRecorded: return "";
   }
   return "";
+}
+
+Cause BacklogBehind(const Cause& stall, std::uint64_t stall_k, std::int64_t waited_ns) {
+  Cause out = stall;
+  out.cause = CauseClass::kBacklog;
+  out.inherited = stall.cause;
+  out.behind_cycle = stall_k;
+  out.duration_ns = waited_ns;
+  out.evidence = "backlog behind k=" + std::to_string(stall_k) + " (" + stall.evidence + ")";
+  return out;
 }
 
 std::vector<CauseCount> RankCauses(const std::vector<NotableCycle>& notable) {
@@ -717,12 +783,14 @@ std::vector<CauseCount> RankCauses(const std::vector<NotableCycle>& notable) {
   std::map<CauseClass, CauseCount> by_class;
   std::map<CauseClass, std::map<std::string, std::uint64_t>> culprits;
   for (const NotableCycle& n : notable) {
-    CauseCount& c = by_class[n.cause.cause];
-    c.cause = n.cause.cause;
+    const CauseClass cls = n.cause.RankedAs();
+    CauseCount& c = by_class[cls];
+    c.cause = cls;
     ++c.cycles;
     if (n.missed) ++c.misses;
+    if (n.cause.cause == CauseClass::kBacklog) ++c.backlog;
     const std::string name = CulpritName(n.cause);
-    if (!name.empty()) ++culprits[n.cause.cause][name];
+    if (!name.empty()) ++culprits[cls][name];
   }
   std::vector<CauseCount> ranked;
   for (auto& [cls, c] : by_class) {

@@ -14,9 +14,15 @@
 //    I/O wait): the sleep it is in at the release is the wait for this release, so a late
 //    wake-up is part of the delay.
 //  * preempted: another thread (not pid 0, not the loop) ran on the loop's CPU while the loop
-//    was runnable; duration = that overlap, summed per thread. Policy and rt priority from
-//    kernel_tasks.csv, else from the prio of its sched_switch (< 0: SCHED_DEADLINE; < 100:
-//    "SCHED_FIFO/RR" with rt priority 99 − prio; otherwise SCHED_OTHER).
+//    was runnable; duration = that overlap less the interrupts taken meanwhile (theirs, not
+//    the thread's), summed per thread. Policy and rt priority from kernel_tasks.csv, else
+//    from the prio of its sched_switch (< 0: SCHED_DEADLINE; < 100: "SCHED_FIFO/RR" with rt
+//    priority 99 − prio; otherwise SCHED_OTHER).
+//  * non_preemptible: the same, for a thread whose prio at its sched_switch ranks below a
+//    real-time loop's (SCHED_OTHER, or a lower rt priority): the scheduler would have
+//    preempted it at the wake-up, so it held the CPU in a kernel section that could not be
+//    preempted (all of the kernel on PREEMPT_NONE). The evidence names the kernel's
+//    preemption model as recorded (KernelTrace::preemption_model).
 //  * interrupt: irq_handler, local_timer and softirq entry→exit on the loop's CPU while the
 //    loop wanted it; duration = overlap, summed per name (handler, "local_timer", vector).
 //    Entries or exits without their partner are dropped and counted in the warnings.
@@ -32,6 +38,11 @@
 //    invisible to the guest (hypervisor steal, SMI; below 100 µs on an idle CPU the evidence
 //    also names a deep idle state's exit); duration = excess − explained.
 //  * Dominant cause = the candidate with the largest duration (ties: the order above).
+//  * backlog (decided by the caller from the cycles, BacklogBehind): a cycle released before
+//    its predecessor's end waited that long behind it. Its own part, [predecessor's end, end]
+//    with excess = excess − wait, is attributed as above; unless that cause outlasts the
+//    wait, the cycle is the backlog of the stall its predecessor was (or was behind), and
+//    carries that stall's k, class and culprit.
 //  * not_recorded: the window lies outside the kernel recording, or on a CPU it did not record.
 
 #include <cstdint>
@@ -80,7 +91,13 @@ class CauseAttributor {
   std::unique_ptr<const KernelIndex> index_;
 };
 
-/// Per class, the notable cycles it is dominant in and the misses among them; most first.
+/// A cycle that waited `waited_ns` behind its predecessor, whose delay was the stall of cycle
+/// `stall_k` with the cause `stall` (never itself a backlog).
+[[nodiscard]] Cause BacklogBehind(const Cause& stall, std::uint64_t stall_k,
+                                  std::int64_t waited_ns);
+
+/// Per class, the notable cycles it is dominant in and the misses among them, a backlog
+/// cycle under its stall's class and culprit; most first.
 [[nodiscard]] std::vector<CauseCount> RankCauses(const std::vector<NotableCycle>& notable);
 
 /// How a culprit is named in the ranking: "rt-hog (pid 4242)", "local_timer", "CPU 1".

@@ -1,6 +1,8 @@
 #include <algorithm>
+#include <cstdio>
 #include <iterator>
 #include <memory>
+#include <unordered_map>
 
 #include "cause_attribution.h"
 #include "hiltwin/jitter/jitter_report.h"
@@ -13,6 +15,8 @@ const char* ToString(CauseClass cause) noexcept {
   switch (cause) {
     case CauseClass::kPreempted:
       return "preempted";
+    case CauseClass::kNonPreemptible:
+      return "non_preemptible";
     case CauseClass::kInterrupt:
       return "interrupt";
     case CauseClass::kPageFault:
@@ -21,6 +25,8 @@ const char* ToString(CauseClass cause) noexcept {
       return "own_compute";
     case CauseClass::kInvisible:
       return "invisible";
+    case CauseClass::kBacklog:
+      return "backlog";
     case CauseClass::kNotRecorded:
       return "not_recorded";
   }
@@ -194,6 +200,13 @@ void TraceWarnings(const TimingTrace& trace, const detail::CycleStats& stats, Ji
 
 namespace {
 
+PreemptionModel PreemptionOf(const KernelTrace& kernel) {
+  if (kernel.preemption_model.empty()) {
+    return {"unknown", "the recording does not name it"};
+  }
+  return {kernel.preemption_model, kernel.preemption_source};
+}
+
 // Why kernel events cannot explain this trace's cycles, or "" when they can.
 std::string WhyNoCauses(const TimingTrace& trace) {
   if (trace.source == TraceSource::kTimingLog) {
@@ -206,6 +219,59 @@ std::string WhyNoCauses(const TimingTrace& trace) {
   }
   return "";
 }
+
+// The causes of cycles, each found once: a catch-up cycle's needs its predecessor's, and so
+// on back to the stall that began the backlog (cause_attribution.h, "backlog").
+class CycleCauses {
+ public:
+  CycleCauses(const TimingTrace& trace, const detail::CauseAttributor& attributor,
+              const JitterReport& r)
+      : cycles_(trace.cycles), attributor_(attributor), r_(r) {}
+
+  // Cycle i's cause; `wake_only`: only its wake-up is notable (not for a catch-up cycle).
+  Cause Of(std::size_t i, bool wake_only) {
+    if (wake_only && !Behind(i)) return attributor_.Attribute(WindowOf(Sample(i), true, r_));
+    std::size_t j = i;  // back to a cycle already known, or to the start of the backlog
+    while (!known_.contains(j) && Behind(j)) --j;
+    for (; j <= i; ++j) {
+      if (!known_.contains(j)) known_.emplace(j, Resolve(j));
+    }
+    return known_.at(i);
+  }
+
+ private:
+  [[nodiscard]] const scheduler::TimingSample& Sample(std::size_t i) const {
+    return cycles_[i].sample;
+  }
+  // Released while its predecessor (the release before it, in the trace) still ran.
+  [[nodiscard]] bool Behind(std::size_t i) const {
+    if (i == 0) return false;
+    const scheduler::TimingSample& p = Sample(i - 1);
+    return p.cycle + 1 + p.releases_skipped == Sample(i).cycle && p.end_ns > Sample(i).release_ns;
+  }
+  // Cycle i's cause over its whole window; Of() has found its predecessor's already.
+  Cause Resolve(std::size_t i) {
+    detail::CauseWindow w = WindowOf(Sample(i), false, r_);
+    if (!Behind(i)) return attributor_.Attribute(w);
+    const std::int64_t waited_ns = Sample(i - 1).end_ns - Sample(i).release_ns;
+    w.begin_ns = Sample(i - 1).end_ns;
+    w.excess_ns -= waited_ns;
+    if (w.excess_ns > 0) {
+      Cause own = attributor_.Attribute(w);
+      if (own.cause != CauseClass::kNotRecorded && own.duration_ns > waited_ns) return own;
+    }
+    const auto stall = stall_of_.find(i - 1);
+    const std::size_t s = stall != stall_of_.end() ? stall->second : i - 1;
+    stall_of_[i] = s;
+    return detail::BacklogBehind(known_.at(s), Sample(s).cycle, waited_ns);
+  }
+
+  const std::vector<TracedCycle>& cycles_;
+  const detail::CauseAttributor& attributor_;
+  const JitterReport& r_;
+  std::unordered_map<std::size_t, Cause> known_;        // full-window causes, by index
+  std::unordered_map<std::size_t, std::size_t> stall_of_;  // a backlog cycle's stall
+};
 
 void AttributeCauses(const TimingTrace& trace, const KernelTrace* kernel,
                      const std::vector<std::size_t>& notable, const std::vector<std::size_t>& worst,
@@ -225,16 +291,54 @@ void AttributeCauses(const TimingTrace& trace, const KernelTrace* kernel,
   }
   const detail::CauseAttributor attributor(*kernel, *trace.loop);
   for (std::string& w : attributor.Warnings()) r.warnings.push_back(std::move(w));
+  r.kernel_preemption = PreemptionOf(*kernel);
+  CycleCauses causes(trace, attributor, r);
   auto attribute = [&](std::size_t i, NotableCycle& n) {
     const TracedCycle& c = trace.cycles[i];
     // A cycle that is notable only for its wake-up (no miss) is explained up to the wake.
     const bool wake_only =
         !(c.judged && c.sample.missed) && n.response_ns <= r.response.summary.p999_ns;
-    n.cause = attributor.Attribute(WindowOf(c.sample, wake_only, r));
+    n.cause = causes.Of(i, wake_only);
   };
   for (std::size_t j = 0; j < notable.size(); ++j) attribute(notable[j], r.notable[j]);
   for (std::size_t j = 0; j < worst.size(); ++j) attribute(worst[j], r.worst[j]);
   r.causes = detail::RankCauses(r.notable);
+}
+
+// The command that finds the rate this machine holds, on the loop's CPU and priority.
+std::string TuneAdvice(const std::optional<LoopThread>& loop) {
+  std::string advice = "hiltwin tune";
+  if (!loop) return advice;
+  if (loop->cpu >= 0) advice += " --cpu " + std::to_string(loop->cpu);
+  const bool rt = loop->policy == 1 || loop->policy == 2;  // SCHED_FIFO, SCHED_RR
+  return advice + " --priority " + std::to_string(rt ? loop->priority : 0);
+}
+
+// Whether the median cycle fits its deadline; when not, the verdict the report opens with.
+Feasibility JudgeFeasibility(const JitterReport& r) {
+  Feasibility f;
+  f.latency_p50_ns = r.latency.summary.p50_ns;
+  f.compute_p50_ns = r.compute.summary.p50_ns;
+  f.deadline_ns = r.deadline_ns;
+  const std::int64_t median_ns = f.latency_p50_ns + f.compute_p50_ns;
+  if (r.deadline_ns <= 0 || r.period_ns <= 0 || r.latency.summary.count == 0 || median_ns <= 0) {
+    return f;  // no deadline known (a trace begun after loop_start), or no latency recorded
+  }
+  f.max_rate_hz = 1'000'000'000 / median_ns;
+  f.advice = TuneAdvice(r.loop);
+  if (median_ns <= r.deadline_ns) return f;
+  f.feasible = false;
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%g Hz", 1e9 / static_cast<double>(r.period_ns));
+  f.verdict = "INFEASIBLE HERE: the median wake-up latency (" +
+              detail::FormatDuration(f.latency_p50_ns) + ") plus the median compute (" +
+              detail::FormatDuration(f.compute_p50_ns) + ") is " +
+              detail::FormatDuration(median_ns) + ", above the " +
+              detail::FormatDuration(f.deadline_ns) + " deadline: " + rate +
+              " cannot be kept on this machine (its medians allow at most " +
+              std::to_string(f.max_rate_hz) + " Hz); find the rate it holds with `" + f.advice +
+              "`";
+  return f;
 }
 
 }  // namespace
@@ -263,6 +367,7 @@ JitterReport AnalyzeJitter(const TimingTrace& trace, const KernelTrace* kernel) 
   r.response = detail::MakeDistribution("response", stats.response);
   r.clusters = detail::ClusterMisses(trace);
   CountReleases(trace, r);
+  r.feasibility = JudgeFeasibility(r);
   TraceWarnings(trace, stats, r);
 
   const std::vector<Stall> stalls = LateStalls(trace, r.response.summary.p999_ns);

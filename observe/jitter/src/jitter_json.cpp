@@ -43,12 +43,36 @@ ordered_json ClustersJson(const MissClusters& c) {
           {"windows", std::move(windows)}};
 }
 
-// Every field of every class, so a reader finds the same keys on every cause.
+// Every field of every class, so a reader finds the same keys on every cause (behind_cycle
+// and inherited: null unless a backlog).
 ordered_json CauseJson(const Cause& c) {
-  return {{"class", ToString(c.cause)}, {"duration_ns", c.duration_ns}, {"cpu", c.cpu},
-          {"thread", c.thread},         {"pid", c.pid},                 {"policy", c.policy},
-          {"priority", c.priority},     {"interrupt", c.interrupt},     {"irq", c.irq},
-          {"faults", c.faults},         {"address", c.address},         {"evidence", c.evidence}};
+  ordered_json behind = c.behind_cycle ? ordered_json(*c.behind_cycle) : ordered_json(nullptr);
+  ordered_json inherited =
+      c.inherited ? ordered_json(ToString(*c.inherited)) : ordered_json(nullptr);
+  return {{"class", ToString(c.cause)},
+          {"duration_ns", c.duration_ns},
+          {"cpu", c.cpu},
+          {"behind_cycle", std::move(behind)},
+          {"inherited", std::move(inherited)},
+          {"thread", c.thread},
+          {"pid", c.pid},
+          {"policy", c.policy},
+          {"priority", c.priority},
+          {"interrupt", c.interrupt},
+          {"irq", c.irq},
+          {"faults", c.faults},
+          {"address", c.address},
+          {"evidence", c.evidence}};
+}
+
+ordered_json FeasibilityJson(const Feasibility& f) {
+  return {{"feasible", f.feasible},
+          {"latency_p50_ns", f.latency_p50_ns},
+          {"compute_p50_ns", f.compute_p50_ns},
+          {"deadline_ns", f.deadline_ns},
+          {"max_rate_hz", f.max_rate_hz},
+          {"verdict", f.verdict},
+          {"advice", f.advice}};
 }
 
 ordered_json BurstJson(const Burst& b) {
@@ -84,6 +108,7 @@ ordered_json CausesJson(const std::vector<CauseCount>& causes) {
     out.push_back({{"class", ToString(c.cause)},
                    {"cycles", c.cycles},
                    {"misses", c.misses},
+                   {"backlog_cycles", c.backlog},
                    {"culprits", std::move(culprits)}});
   }
   return out;
@@ -99,6 +124,7 @@ ordered_json LoopJson(const std::optional<LoopThread>& loop) {
 
 ordered_json JitterToJson(const JitterReport& r) {
   ordered_json out;
+  out["feasibility"] = FeasibilityJson(r.feasibility);  // first, as the text's first line
   out["source"] = detail::SourceName(r.source);
   out["path"] = r.path;
   out["period_ns"] = r.period_ns;
@@ -113,6 +139,8 @@ ordered_json JitterToJson(const JitterReport& r) {
   out["discarded_events"] = r.discarded_events;
   out["kernel_recorded"] = r.kernel_recorded;
   out["kernel_lost_events"] = r.kernel_lost_events;
+  out["kernel_preemption"] = {{"model", r.kernel_preemption.model},
+                              {"source", r.kernel_preemption.source}};
   out["loop"] = LoopJson(r.loop);
   out["latency_ns"] = DistributionJson(r.latency);
   out["period_jitter_ns"] = DistributionJson(r.period_jitter);

@@ -18,6 +18,7 @@ using detail::Format;
 
 
 void Header(const JitterReport& r, std::string& out) {
+  if (!r.feasibility.feasible) out += r.feasibility.verdict + "\n";  // before any cause
   out += "hiltwin jitter report: " + r.path + " (" + detail::SourceName(r.source) + ")\n";
   out += Format("period %s, deadline %s; %llu cycles (%llu judged), %llu releases skipped\n",
                 detail::FormatDuration(r.period_ns).c_str(),
@@ -39,7 +40,12 @@ void Header(const JitterReport& r, std::string& out) {
                   detail::PolicyName(r.loop->policy));
     out += rt ? Format(" %d)", r.loop->priority) : std::string(")");
   }
-  out += "\n\n";
+  out += "\n";
+  if (r.kernel_recorded) {
+    out += "kernel preemption model: " + r.kernel_preemption.model + " (" +
+           r.kernel_preemption.source + ")\n";
+  }
+  out += "\n";
 }
 
 void Table(const JitterReport& r, std::string& out) {
@@ -182,15 +188,17 @@ void Causes(const JitterReport& r, std::string& out) {
   out += Format("causes of the %zu notable cycles (every miss, every wake-up above p99.9 = %s):\n",
                 r.notable.size(), detail::FormatDuration(r.latency.summary.p999_ns).c_str());
   if (r.causes.empty()) out += "  none: no cycle missed and no wake-up was above p99.9\n";
-  if (!r.causes.empty()) out += "  cause          cycles  misses  top culprits\n";
+  // A stall's catch-up cycles count with it ("of them backlog"), under its class and culprit.
+  if (!r.causes.empty()) out += "  cause            cycles  misses  backlog  top culprits\n";
   for (const CauseCount& c : r.causes) {
     std::string culprits;
     for (const auto& [name, cycles] : c.culprits) {
       culprits += (culprits.empty() ? "" : ", ") + name + Format(" x%llu", static_cast<unsigned long long>(cycles));
     }
-    out += Format("  %-13s %7llu %7llu  %s\n", ToString(c.cause),
+    out += Format("  %-15s %7llu %7llu  %7llu  %s\n", ToString(c.cause),
                   static_cast<unsigned long long>(c.cycles),
-                  static_cast<unsigned long long>(c.misses), culprits.c_str());
+                  static_cast<unsigned long long>(c.misses),
+                  static_cast<unsigned long long>(c.backlog), culprits.c_str());
   }
   out += "\n";
 }

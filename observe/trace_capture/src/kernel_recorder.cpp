@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "hiltwin/kernel_glue/rt_probe.h"
 #include "hiltwin/trace_capture/capture_error.h"
 #include "hiltwin/trace_capture/tracefs_access.h"
 #include "kernel_collector.h"
@@ -87,6 +88,11 @@ KernelRecorder::KernelRecorder(const KernelRecorderConfig& config) {
   if (!refused.empty()) throw CaptureError("cannot record the kernel's events: " + refused);
   std::filesystem::create_directories(config.output_dir);
   auto state = std::make_unique<State>(config, CpusToRecord(config.cpus));
+  // Named now, as the kernel runs during the recording: whether a thread the loop outranks
+  // could have been preempted in the kernel depends on it (cause_attribution.h).
+  const kernel_glue::KernelPreemption preemption = kernel_glue::FindKernelPreemption();
+  state->trace.preemption_model = preemption.model;
+  state->trace.preemption_source = preemption.source;
   state->instance.Configure(state->cpus, config.buffer_kb_per_cpu);
   state->instance.EnableEvents();
   state->tep = LoadFormats();

@@ -25,7 +25,11 @@ namespace fs = std::filesystem;
 constexpr const char* kEventsFile = "kernel_events.csv";
 constexpr const char* kTasksFile = "kernel_tasks.csv";
 constexpr std::string_view kCommentPrefix = "# hiltwin kernel events ";
-constexpr std::string_view kFormatVersion = "1";
+// Version 2 added the preemption line; version 1 files (no such line) still read.
+constexpr std::string_view kFormatVersion = "2";
+constexpr std::array<std::string_view, 2> kReadableVersions = {"1", "2"};
+constexpr std::string_view kPreemptionPrefix = "# preemption ";
+constexpr std::string_view kPreemptionSeparator = " | ";
 constexpr std::array<std::string_view, 14> kEventColumns = {
     "time_ns",   "cpu",       "event",      "pid",        "comm", "prio", "next_pid",
     "next_comm", "next_prio", "prev_state", "target_cpu", "irq",  "name", "address"};
@@ -154,6 +158,20 @@ std::string CommentLine(const KernelTrace& trace) {
   return line;
 }
 
+// "# preemption PREEMPT_NONE | kernel config", or nothing when the model was not recorded.
+std::string PreemptionLine(const KernelTrace& trace) {
+  if (trace.preemption_model.empty()) return {};
+  std::string line(kPreemptionPrefix);
+  const auto append = [&line](std::string_view text) {
+    for (char c : text) line += (c == '|' || c == '\n' || c == '\r') ? '_' : c;
+  };
+  append(trace.preemption_model);
+  line += kPreemptionSeparator;
+  append(trace.preemption_source);
+  line += '\n';
+  return line;
+}
+
 // An output file that reports a failed open or write by name.
 class OutputFile {
  public:
@@ -194,6 +212,7 @@ std::vector<std::size_t> IndicesByTime(const std::vector<KernelEvent>& events) {
 void WriteEvents(const fs::path& path, const KernelTrace& trace) {
   OutputFile out(path);
   out.Write(CommentLine(trace));
+  out.Write(PreemptionLine(trace));
   out.Write(EventsHeader() + "\n");
   std::string line;
   for (std::size_t index : IndicesByTime(trace.events)) {
@@ -325,14 +344,19 @@ KernelEvent ParseEventRow(const EventsFileLines& reader, std::string_view line) 
   return event;
 }
 
-// "# hiltwin kernel events 1 cpus=0,1 lost=0" into trace.cpus and trace.lost_events.
+// "# hiltwin kernel events 2 cpus=0,1 lost=0" into trace.cpus and trace.lost_events.
 void ParseCommentLine(const EventsFileLines& reader, std::string_view line, KernelTrace& trace) {
-  const std::string expected = std::string(kCommentPrefix) + std::string(kFormatVersion) + " ";
-  if (!line.starts_with(expected)) {
-    reader.Fail("missing the comment line '" + expected + "cpus=<list> lost=<count>' (found '" +
+  const std::string prefix(kCommentPrefix);
+  const auto version = std::find_if(
+      kReadableVersions.begin(), kReadableVersions.end(), [&](std::string_view v) {
+        return line.starts_with(prefix + std::string(v) + " ");
+      });
+  if (version == kReadableVersions.end()) {
+    reader.Fail("missing the comment line '" + prefix + std::string(kFormatVersion) +
+                " cpus=<list> lost=<count>' (versions 1 and 2 are read; found '" +
                 std::string(line.substr(0, 60)) + "')");
   }
-  line.remove_prefix(expected.size());
+  line.remove_prefix(prefix.size() + version->size() + 1);
   const std::size_t lost_at = line.find(" lost=");
   if (!line.starts_with("cpus=") || lost_at == std::string_view::npos) {
     reader.Fail("the comment line needs 'cpus=<list> lost=<count>'");
@@ -351,12 +375,29 @@ void ExpectHeader(EventsFileLines& reader, std::string& line, const std::string&
   if (line != header) reader.Fail("missing the header row '" + header + "'");
 }
 
+// "# preemption <model> | <source>" into the trace; false when `line` is not that line.
+bool ParsePreemptionLine(const EventsFileLines& reader, std::string_view line,
+                         KernelTrace& trace) {
+  if (!line.starts_with(kPreemptionPrefix)) return false;
+  line.remove_prefix(kPreemptionPrefix.size());
+  const std::size_t separator = line.find(kPreemptionSeparator);
+  if (separator == std::string_view::npos || separator == 0) {
+    reader.Fail("the preemption line needs '" + std::string(kPreemptionPrefix) + "<model>" +
+                std::string(kPreemptionSeparator) + "<how it was told>'");
+  }
+  trace.preemption_model = line.substr(0, separator);
+  trace.preemption_source = line.substr(separator + kPreemptionSeparator.size());
+  return true;
+}
+
 void ReadEvents(const fs::path& path, KernelTrace& trace) {
   EventsFileLines reader(path);
   std::string line;
   reader.Expect(line, "the comment line");
   ParseCommentLine(reader, line, trace);
-  ExpectHeader(reader, line, EventsHeader());
+  reader.Expect(line, "the header row");
+  if (ParsePreemptionLine(reader, line, trace)) reader.Expect(line, "the header row");
+  if (line != EventsHeader()) reader.Fail("missing the header row '" + EventsHeader() + "'");
   while (reader.Next(line)) trace.events.push_back(ParseEventRow(reader, line));
   const auto earlier = [](const KernelEvent& a, const KernelEvent& b) {
     return a.time_ns < b.time_ns;

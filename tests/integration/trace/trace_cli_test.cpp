@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstddef>
@@ -184,12 +185,24 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   const json jitter = ReadJson(out + "/jitter_report.json");
   EXPECT_TRUE(jitter["kernel_recorded"].get<bool>());
   ASSERT_FALSE(jitter["causes"].empty()) << jitter.dump(2);
-  // The hog is the first culprit of the "preempted" class and outweighs every other named
-  // culprit of every class. Not "the top class": the cycles the loop catches up after each
-  // burst are still classed "invisible" (CPU 1, no event in their window), and on a slower
-  // machine they outnumber the burst's own (CI, stop 40: 321 against 232). Issue 35 makes them
-  // inherit the burst's cause ("backlog behind k=N"); until then the class order is the
-  // machine's, not the classifier's.
+  // "preempted" is the top class, and the hog its first culprit, outweighing every other named
+  // culprit of every class. The cycles the loop catches up after each burst (on a slower
+  // machine more than the burst's own: CI, stop 40, 321 against 232) count with the burst
+  // ("backlog behind k=N (preempted by hiltwin-hog ...)"), not as "invisible". Unless the
+  // guest itself lost its CPU for longer than a burst (hypervisor steal: one 27 ms stall at
+  // 4 kHz leaves 108 catch-up cycles behind it, seen beside five other helpers' builds): then
+  // the class order is the host's.
+  std::int64_t longest_invisible_ns = 0;
+  for (const json& cycle : jitter["notable"]) {
+    if (cycle["cause"]["class"] != "invisible") continue;
+    longest_invisible_ns =
+        std::max(longest_invisible_ns, cycle["cause"]["duration_ns"].get<std::int64_t>());
+  }
+  if (longest_invisible_ns <= std::int64_t{kSpinMs} * 1'000'000) {
+    EXPECT_EQ(jitter["causes"][0]["class"], "preempted") << jitter["causes"].dump(2);
+  } else {
+    RecordProperty("top_class_unchecked_invisible_stall_ns", std::to_string(longest_invisible_ns));
+  }
   // The cycles the bursts cover: 2 s at 4 kHz, 3 ms in every 100 ms (240).
   const std::size_t expected_cycles = std::size_t{kTraceSeconds} * kRateHz * kSpinMs /
                                       (kSpinMs + kSleepMs);
@@ -215,8 +228,14 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   // The misses the competitor caused name it, with its policy and priority (other threads,
   // kernel workers say, may preempt the loop too on a busy machine).
   int named = 0;
+  int backlog = 0;
   for (const json& cycle : jitter["notable"]) {
     const json& cause = cycle["cause"];
+    if (cause["class"] == "backlog" && cause["inherited"] == "preempted" &&
+        cause["thread"] == "hiltwin-hog") {
+      ++backlog;
+      EXPECT_LT(cause["behind_cycle"].get<std::uint64_t>(), cycle["k"].get<std::uint64_t>());
+    }
     if (cause["class"] != "preempted" || cause["thread"] != "hiltwin-hog") continue;
     EXPECT_EQ(cause["policy"], "SCHED_FIFO");
     EXPECT_EQ(cause["priority"], 95);
@@ -224,6 +243,7 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
     ++named;
   }
   EXPECT_GT(named, 0);
+  EXPECT_GT(backlog, 0);  // each 3 ms burst leaves a dozen releases (at 4 kHz) to catch up
 }
 
 TEST_F(TraceCli, KernelWithoutThePermissionExitsFiveWithTheReasonAndTheFix) {
@@ -259,6 +279,32 @@ TEST_F(TraceCli, ATimingLogGivesTheSameReportWithoutLttng) {
   ExpectAgreement(ReadJson(Path("run.json")),
                   ReadJson(Path("timing.csv.jitter") + "/jitter_report.json"));
   EXPECT_NE(analysis.out.find("causes were not recorded"), std::string::npos);
+}
+
+// Issue 35, point 3: a rate the median cycle cannot hold is the cause of the misses, said
+// first on the console (the report's first line) and last (a warning after the report). Every
+// cycle's step takes 1.2 ms at 1 kHz, so the median compute alone is above the deadline.
+TEST_F(TraceCli, AnInfeasibleRateIsSaidFirstAndLastOnTheConsole) {
+  const auto run = Hiltwin({"run", "--duration", "0.3", "--rate", "1000", "--priority", "0",
+                            "--overrun-policy", "skip", "--inject-overrun", "every=1,extra-us=1200",
+                            "--no-progress", "--timing-log", Path("timing.csv")});
+  ASSERT_LE(run.exit_code, 3) << run.err;
+  const auto analysis = Hiltwin({"trace", "--analyze", Path("timing.csv")});
+  ASSERT_EQ(analysis.exit_code, 0) << analysis.err;
+  const std::string first = analysis.out.substr(0, analysis.out.find('\n'));
+  EXPECT_EQ(first.rfind("INFEASIBLE HERE: the median wake-up latency (", 0), 0U) << analysis.out;
+  EXPECT_NE(first.find("above the 1.00 ms deadline: 1000 Hz cannot be kept on this machine"),
+            std::string::npos)
+      << first;
+  EXPECT_NE(first.find("find the rate it holds with `hiltwin tune`"), std::string::npos) << first;
+  // The console's last line.
+  const std::string last_warning = "warning: " + first + "\n";
+  ASSERT_GE(analysis.err.size(), last_warning.size()) << analysis.err;
+  EXPECT_EQ(analysis.err.substr(analysis.err.size() - last_warning.size()), last_warning)
+      << analysis.err;
+  const json report = ReadJson(Path("timing.csv.jitter") + "/jitter_report.json");
+  EXPECT_FALSE(report["feasibility"]["feasible"].get<bool>());
+  EXPECT_GT(report["feasibility"]["compute_p50_ns"].get<std::int64_t>(), 1'000'000);
 }
 
 TEST_F(TraceCli, BadInputExitsTwoNamingTheFileAndThePlace) {

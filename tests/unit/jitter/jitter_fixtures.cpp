@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+#include <vector>
 
 #include "hiltwin/qos/rules.h"
 
@@ -23,6 +24,7 @@ TimingTrace MakeTrace(const RunSpec& spec) {
   trace.pid = kLoopPid;
   trace.complete = true;
   std::uint64_t k = 0;
+  std::int64_t previous_end_ns = 0;
   while (k < spec.releases) {
     std::int64_t latency = spec.latency_ns(k);
     std::int64_t compute = spec.compute_ns(k);
@@ -34,15 +36,21 @@ TimingTrace MakeTrace(const RunSpec& spec) {
     s.cycle = k;
     s.release_ns = spec.t0_ns + static_cast<std::int64_t>(k) * spec.period_ns;
     s.wake_ns = s.release_ns + latency;
+    if (spec.catch_up && k > 0 && previous_end_ns > s.release_ns) {
+      s.wake_ns = previous_end_ns + kCatchUpWakeNs;
+    }
     s.start_ns = s.wake_ns + kWakeToStartNs;
     s.io_ns = spec.io_ns;
     s.end_ns = s.start_ns + compute + spec.io_ns;
     s.missed = s.end_ns > s.release_ns + spec.deadline_ns;
     const auto first_not_passed =
         static_cast<std::uint64_t>((s.end_ns - spec.t0_ns + spec.period_ns - 1) / spec.period_ns);
-    const std::uint64_t next = std::min(std::max(first_not_passed, k + 1), std::max(spec.releases, k + 1));
+    const std::uint64_t next =
+        spec.catch_up ? k + 1
+                      : std::min(std::max(first_not_passed, k + 1), std::max(spec.releases, k + 1));
     s.releases_skipped = static_cast<std::uint32_t>(next - k - 1);
     trace.cycles.push_back({s, spec.unjudged.count(k) == 0});
+    previous_end_ns = s.end_ns;
     k = next;
   }
   return trace;
@@ -135,22 +143,32 @@ KernelTrace KernelScript::Finish() {
   return trace_;
 }
 
-void NormalCycle(KernelScript& script, const scheduler::TimingSample& s) {
+void ArriveFromIdle(KernelScript& script, const scheduler::TimingSample& s) {
   script.LocalTimer(s.wake_ns - 2'000, s.wake_ns - 1'200, kLoopCpu);
   script.LoopWakeup(s.wake_ns - 1'100);
   script.LoopIn(s.wake_ns - 500);
+}
+
+void NormalCycle(KernelScript& script, const scheduler::TimingSample& s) {
+  ArriveFromIdle(script, s);
   script.LoopOutToIdle(s.end_ns + 500);
 }
 
 KernelTrace MakeKernel(const TimingTrace& trace, const std::map<std::uint64_t, SpecialCycle>& special) {
   KernelScript script;
-  for (const TracedCycle& c : trace.cycles) {
-    const auto it = special.find(c.sample.cycle);
+  const std::vector<TracedCycle>& cycles = trace.cycles;
+  for (std::size_t i = 0; i < cycles.size(); ++i) {
+    const scheduler::TimingSample& s = cycles[i].sample;
+    const auto it = special.find(s.cycle);
     if (it != special.end()) {
-      it->second(script, c.sample);
-    } else {
-      NormalCycle(script, c.sample);
+      it->second(script, s);
+      continue;
     }
+    const bool behind = i > 0 && cycles[i - 1].sample.end_ns > s.release_ns;
+    const bool sleeps_after =
+        i + 1 == cycles.size() || cycles[i + 1].sample.release_ns >= s.end_ns;
+    if (!behind) ArriveFromIdle(script, s);
+    if (sleeps_after) script.LoopOutToIdle(s.end_ns + 500);
   }
   return script.Finish();
 }

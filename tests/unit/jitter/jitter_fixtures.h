@@ -36,11 +36,17 @@ struct RunSpec {
   std::function<std::int64_t(std::uint64_t)> compute_ns = [](std::uint64_t) { return 20'000; };
   std::map<std::uint64_t, CycleOverride> overrides;
   std::set<std::uint64_t> unjudged;  ///< releases the QoS ledger did not count (paused)
+  /// The catch-up policy instead of skip: every release runs; one that passed while its
+  /// predecessor still ran wakes kCatchUpWakeNs after the predecessor's end (the sleep returns
+  /// at once), whatever its latency says.
+  bool catch_up = false;
 };
 
-/// The cycles the executive would have run under the skip policy: release on the grid, wake
-/// after the latency, start 100 ns later, end after compute + io; releases passed during a
-/// long cycle are skipped.
+inline constexpr std::int64_t kCatchUpWakeNs = 300;
+
+/// The cycles the executive would have run under the skip policy (or catch-up, see RunSpec):
+/// release on the grid, wake after the latency, start 100 ns later, end after compute + io;
+/// releases passed during a long cycle are skipped.
 TimingTrace MakeTrace(const RunSpec& spec);
 
 /// Builds a KernelTrace event by event (sorted by time when finished).
@@ -69,12 +75,15 @@ class KernelScript {
 };
 
 /// What the kernel does in an ordinary cycle: the timer interrupt, the wake-up, the switch in
-/// from idle before `wake`, the switch out to idle after `end`.
+/// from idle before `wake` (ArriveFromIdle), the switch out to idle after `end`.
 void NormalCycle(KernelScript& script, const scheduler::TimingSample& s);
+void ArriveFromIdle(KernelScript& script, const scheduler::TimingSample& s);
 
 using SpecialCycle = std::function<void(KernelScript&, const scheduler::TimingSample&)>;
 
 /// Kernel events for every cycle of `trace`: NormalCycle, or the special one given for its k.
+/// Catch-up cycles (released before their predecessor's end) add no event: the loop runs on;
+/// a cycle followed by one does not switch out to idle.
 KernelTrace MakeKernel(const TimingTrace& trace, const std::map<std::uint64_t, SpecialCycle>& special);
 
 /// A run with a known answer for every output: 4000 releases at 50 µs, two misses (k = 1000:

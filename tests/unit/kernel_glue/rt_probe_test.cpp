@@ -195,6 +195,26 @@ TEST_F(FakeRoot, DynamicWithoutConfigOrDebugfsSaysHowToFindOut) {
   EXPECT_TRUE(Contains(check.advice, "/sys/kernel/debug/sched/preempt"));
 }
 
+// What `hiltwin trace --kernel` records beside the kernel's events (issue 35): the model by
+// the kernel config's name, and how it was told.
+TEST_F(FakeRoot, KernelPreemptionNamesTheModelAndHowItWasTold) {
+  const KernelPreemption none = FindKernelPreemption(Options());
+  EXPECT_EQ(none.model, "unknown");
+  EXPECT_EQ(none.source, "no uname -v, no kernel config");
+  WriteKvmGuest();
+  const KernelPreemption guest = FindKernelPreemption(Options());
+  EXPECT_EQ(guest.model, "PREEMPT_NONE");
+  EXPECT_EQ(guest.source, "PREEMPT_DYNAMIC, kernel config default; debugfs not mounted");
+  Write("sys/kernel/debug/sched/preempt", "none voluntary (full) lazy\n");
+  const KernelPreemption live = FindKernelPreemption(Options());
+  EXPECT_EQ(live.model, "PREEMPT");
+  EXPECT_EQ(live.source, "PREEMPT_DYNAMIC, debugfs sched/preempt");
+  Write("proc/sys/kernel/version", "#1 SMP PREEMPT_RT Debian 6.1.90-1\n");
+  const KernelPreemption rt = FindKernelPreemption(Options());
+  EXPECT_EQ(rt.model, "PREEMPT_RT");
+  EXPECT_EQ(rt.source, "uname -v");
+}
+
 TEST_F(FakeRoot, StaticKernelsFromUname) {
   Write("proc/sys/kernel/version", "#1 SMP PREEMPT Fri Jan 1\n");
   EXPECT_EQ(Check(RunRtProbe(Options(false), os_), "preemption").value, "full (uname -v)");

@@ -84,6 +84,8 @@ KernelTrace EveryKind() {
   KernelTrace trace;
   trace.cpus = {0, 1};
   trace.lost_events = 12;
+  trace.preemption_model = "PREEMPT_NONE";
+  trace.preemption_source = "PREEMPT_DYNAMIC, kernel config default; debugfs not mounted";
   KernelEvent preempted =
       Task(Event(1'000'500, 0, KernelEventKind::kSchedSwitch), 7, "cap-victim", 120);
   preempted.next_pid = 8;
@@ -141,15 +143,37 @@ TEST_F(KernelEventsFileTest, TheFileSaysWhatTheHeaderPromises) {
   WriteKernelTrace(dir_.string(), EveryKind());
   std::ifstream in(EventsPath());
   std::string comment;
+  std::string preemption;
   std::string header;
   std::string first;
   std::getline(in, comment);
+  std::getline(in, preemption);
   std::getline(in, header);
   std::getline(in, first);
-  EXPECT_EQ(comment, "# hiltwin kernel events 1 cpus=0,1 lost=12");
+  EXPECT_EQ(comment, "# hiltwin kernel events 2 cpus=0,1 lost=12");
+  EXPECT_EQ(preemption,
+            "# preemption PREEMPT_NONE | PREEMPT_DYNAMIC, kernel config default; debugfs not "
+            "mounted");
   EXPECT_EQ(header + "\n", kHeader);
   // A wakeup fills pid, comm, prio and target_cpu; the rest stays empty.
   EXPECT_EQ(first, "1000000,1,sched_wakeup,8,cap-hog,9,,,,,0,,,");
+}
+
+// Recordings made before the preemption model was recorded (version 1) have no such line: it
+// is not known. kComment is such a file's first line.
+TEST_F(KernelEventsFileTest, ARecordingWithoutThePreemptionLineReadsWithTheModelUnknown) {
+  WriteFile("kernel_events.csv",
+            std::string(kComment) + kHeader + "5,0,local_timer_entry,,,,,,,,,,,\n");
+  WriteFile("kernel_tasks.csv", kTasks);
+  const KernelTrace read = ReadKernelTrace(dir_.string());
+  EXPECT_EQ(read.events.size(), 1U);
+  EXPECT_EQ(read.preemption_model, "");
+  EXPECT_EQ(read.preemption_source, "");
+  // One that has it but not in its shape is refused with its line.
+  WriteFile("kernel_events.csv",
+            "# hiltwin kernel events 2 cpus=0 lost=0\n# preemption PREEMPT_NONE\n" +
+                std::string(kHeader));
+  EXPECT_THAT(ReadError(), HasSubstr("kernel_events.csv:2: the preemption line needs"));
 }
 
 TEST_F(KernelEventsFileTest, CommasAndLineBreaksInNamesBecomeUnderscores) {
@@ -204,6 +228,11 @@ TEST_F(KernelEventsFileTest, AMissingCommentOrHeaderLineIsRefused) {
   EXPECT_THAT(ReadError(), HasSubstr(EventsPath() + ":2: missing the header row"));
   WriteFile("kernel_events.csv", "");
   EXPECT_THAT(ReadError(), HasSubstr(EventsPath() + ":1: missing the comment line"));
+  // A version this reader does not know (a newer recorder's) is named, with those it reads.
+  WriteFile("kernel_events.csv",
+            "# hiltwin kernel events 3 cpus=0 lost=0\n" + std::string(kHeader));
+  EXPECT_THAT(ReadError(),
+              HasSubstr("versions 1 and 2 are read; found '# hiltwin kernel events 3"));
 }
 
 TEST_F(KernelEventsFileTest, AMissingFileIsRefusedByName) {

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "hiltwin/kernel_glue/rt_probe.h"
 #include "hiltwin/kernel_glue/thread.h"
 #include "hiltwin/traces/kernel_events.h"
 
@@ -149,6 +150,12 @@ TEST_F(KernelRecorderTest, SeesTheFifoThreadPreemptTheOtherOnCpu0) {
   EXPECT_EQ(hiltwin::analysis::ReadKernelTrace(dir_.string()), trace);
   EXPECT_EQ(trace.cpus, std::vector<int>{0});
   EXPECT_EQ(trace.lost_events, 0U);
+  // The kernel's preemption model, as `hiltwin doctor` finds it, and how it was told.
+  const hiltwin::kernel_glue::KernelPreemption preemption =
+      hiltwin::kernel_glue::FindKernelPreemption();
+  EXPECT_EQ(trace.preemption_model, preemption.model);
+  EXPECT_EQ(trace.preemption_source, preemption.source);
+  EXPECT_FALSE(trace.preemption_source.empty());
 
   const auto into_hog = SwitchesInto(trace, "cap-hog");
   EXPECT_GE(into_hog.size(), static_cast<std::size_t>(kHogBursts));

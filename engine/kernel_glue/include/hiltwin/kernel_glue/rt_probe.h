@@ -57,6 +57,21 @@ struct ProbeReport {
 [[nodiscard]] ProbeReport RunRtProbe(const ProbeOptions& options = {},
                                      const OsCalls& os = RealOsCalls());
 
+/// The kernel's preemption model, found as the "preemption" check finds it (the live mode of
+/// a PREEMPT_DYNAMIC kernel from debugfs or the boot option, else the kernel config, else
+/// uname -v), named as the kernel config names it.
+struct KernelPreemption {
+  /// "PREEMPT_RT", "PREEMPT" (full), "PREEMPT_LAZY", "PREEMPT_VOLUNTARY", "PREEMPT_NONE",
+  /// "PREEMPT_NONE or PREEMPT_VOLUNTARY" (uname -v cannot tell them apart) or "unknown"
+  std::string model;
+  /// How it was told, e.g. "PREEMPT_DYNAMIC, kernel config default; debugfs not mounted", or
+  /// why it is unknown
+  std::string source;
+};
+/// Reads it below `options.root` (runs gzip for /proc/config.gz when `options.run_tools`).
+/// Never throws for missing files.
+[[nodiscard]] KernelPreemption FindKernelPreemption(const ProbeOptions& options = {});
+
 /// Cumulative CPU time from the aggregate "cpu" line of /proc/stat, in clock ticks.
 struct CpuTicks {
   std::uint64_t total = 0;

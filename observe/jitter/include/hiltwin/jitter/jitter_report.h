@@ -56,22 +56,36 @@ struct MissClusters {
 
 /// Why a cycle was late.
 enum class CauseClass : std::uint8_t {
-  kPreempted,     ///< another thread ran on the loop's CPU while the loop was runnable
-  kInterrupt,     ///< a hard interrupt (or the local timer, or softirq) held the CPU
-  kPageFault,     ///< the loop thread faulted
-  kOwnCompute,    ///< the step itself ran long (compute above its p99.9)
-  kInvisible,     ///< nothing in the guest explains it: hypervisor steal or SMI
-  kNotRecorded,   ///< the kernel was not recorded (no --kernel)
+  kPreempted,       ///< a thread above the loop's priority ran on its CPU while it was runnable
+  /// A thread the loop's priority outranks held its CPU while the loop was runnable: the
+  /// kernel did not preempt it (a non-preemptible section; PREEMPT_NONE does not preempt in
+  /// the kernel at all)
+  kNonPreemptible,
+  kInterrupt,       ///< a hard interrupt (or the local timer, or softirq) held the CPU
+  kPageFault,       ///< the loop thread faulted
+  kOwnCompute,      ///< the step itself ran long (compute above its p99.9)
+  kInvisible,       ///< nothing in the guest explains it: hypervisor steal or SMI
+  /// Released while its predecessor still ran (catch-up): late because of the stall it is
+  /// behind, whose cause it carries (Cause::behind_cycle, Cause::inherited)
+  kBacklog,
+  kNotRecorded,     ///< the kernel was not recorded (no --kernel)
 };
-/// "preempted", "interrupt", "page_fault", "own_compute", "invisible", "not_recorded".
+/// "preempted", "non_preemptible", "interrupt", "page_fault", "own_compute", "invisible",
+/// "backlog", "not_recorded".
 [[nodiscard]] const char* ToString(CauseClass cause) noexcept;
 
 /// The evidence for one cause.
 struct Cause {
   CauseClass cause = CauseClass::kNotRecorded;
-  std::int64_t duration_ns = 0;  ///< how long the culprit held the CPU inside the window
+  /// How long the culprit held the CPU inside the window (kBacklog: how long the cycle
+  /// waited behind its predecessor)
+  std::int64_t duration_ns = 0;
   int cpu = -1;                  ///< the loop's CPU where it happened (-1: not recorded)
-  // kPreempted: the thread that ran instead.
+  // kBacklog: the stall this cycle is behind, and that stall's class; the fields below are
+  // the stall's (its thread, interrupt, ...).
+  std::optional<std::uint64_t> behind_cycle;
+  std::optional<CauseClass> inherited;
+  // kPreempted, kNonPreemptible: the thread that ran instead.
   std::string thread;            ///< comm
   int pid = 0;
   std::string policy;            ///< "SCHED_FIFO", ... ("" when unknown)
@@ -84,6 +98,9 @@ struct Cause {
   std::uint64_t address = 0;
   /// One line a person reads, e.g. "preempted by rt-hog (pid 4242, SCHED_FIFO 95) for 2.10 ms".
   std::string evidence;
+
+  /// The class a summary counts this cause under: a backlog's stall's, else its own.
+  [[nodiscard]] CauseClass RankedAs() const noexcept { return inherited.value_or(cause); }
 };
 
 /// A stall: a run of consecutive late cycles (missed, or response above the response p99.9;
@@ -109,16 +126,39 @@ struct NotableCycle {
   Burst burst;  ///< the stall this cycle belongs to
 };
 
-/// Ranked causes: how many notable cycles each explains, most first.
+/// Ranked causes: how many notable cycles each explains, most first. A backlog cycle counts
+/// with the stall it is behind (its class and culprit), so a stall and its catch-up cycles
+/// are one line.
 struct CauseCount {
   CauseClass cause = CauseClass::kNotRecorded;
-  std::uint64_t cycles = 0;   ///< notable cycles this cause is dominant in
+  std::uint64_t cycles = 0;   ///< notable cycles this cause is dominant in, backlog included
   std::uint64_t misses = 0;   ///< of them, misses
+  std::uint64_t backlog = 0;  ///< of them, catch-up cycles behind a stall of this class
   /// The top culprits within the class ("rt-hog (pid 4242)", "local_timer"), most first.
   std::vector<std::pair<std::string, std::uint64_t>> culprits;
 };
 
+/// Whether the run's rate can be held here at all: the median wake-up latency plus the median
+/// compute against the deadline. When not, that is the cause of the misses, before any
+/// per-cycle one, and the report says so first.
+struct Feasibility {
+  bool feasible = true;
+  std::int64_t latency_p50_ns = 0;
+  std::int64_t compute_p50_ns = 0;
+  std::int64_t deadline_ns = 0;
+  std::int64_t max_rate_hz = 0;  ///< the highest rate the medians allow (0: not judged)
+  std::string verdict;           ///< the report's first line ("" when feasible)
+  std::string advice;            ///< the command that finds the rate this machine holds
+};
+
+/// The kernel's preemption model as the recording named it (kernel_events.h).
+struct PreemptionModel {
+  std::string model = "unknown";  ///< "PREEMPT_NONE", "PREEMPT", "PREEMPT_RT", ..., "unknown"
+  std::string source;             ///< how it was told, or why it is unknown
+};
+
 struct JitterReport {
+  Feasibility feasibility;
   TraceSource source = TraceSource::kLttng;
   std::string path;
   std::int64_t period_ns = 0;
@@ -136,6 +176,7 @@ struct JitterReport {
   /// response (ties: earlier k first), with its cause like a notable cycle's; longest first.
   std::vector<NotableCycle> worst;
   bool kernel_recorded = false;
+  PreemptionModel kernel_preemption;  ///< with the kernel recorded
   /// Every judged miss (those `misses` counts) and every wake-up strictly above the latency
   /// p99.9 (of cycles whose latency was recorded), in order of k.
   std::vector<NotableCycle> notable;

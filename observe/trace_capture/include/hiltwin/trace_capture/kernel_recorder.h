@@ -4,7 +4,8 @@
 /// loop's own time stamps, in a tracefs instance of its own (the system's top-level tracing
 /// settings are left alone). A collector thread (SCHED_OTHER, on CPUs the loop does not use)
 /// drains the per-CPU buffers while the run goes on; Stop() writes DIR/kernel_events.csv and
-/// DIR/kernel_tasks.csv (traces/kernel_events.h). Control side only.
+/// DIR/kernel_tasks.csv (traces/kernel_events.h), with the kernel's preemption model as it was
+/// found at the start (kernel_glue::FindKernelPreemption). Control side only.
 
 #include <string>
 #include <vector>

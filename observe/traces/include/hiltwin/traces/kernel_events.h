@@ -13,7 +13,11 @@
 /// and DIR/kernel_tasks.csv, the threads seen, with their policy when it could be read:
 ///   pid,comm,policy,rt_priority
 /// The first line of kernel_events.csv is a comment
-///   "# hiltwin kernel events 1 cpus=<comma list> lost=<count>".
+///   "# hiltwin kernel events 2 cpus=<comma list> lost=<count>",
+/// then (version 2, when the recorder knew it) the kernel's preemption model at record time
+///   "# preemption <model> | <how it was told>"
+/// ('|' and line breaks in either part become '_'). Version 1 files, without that line, are
+/// still read (the model is then not known).
 
 #include <cstdint>
 #include <string>
@@ -71,6 +75,11 @@ struct KernelTrace {
   std::vector<KernelEvent> events;  ///< in time order
   std::vector<KernelTask> tasks;  ///< by pid; not pid 0 (the idle task is no thread to ask)
   std::uint64_t lost_events = 0;    ///< the ring buffer's overruns, when the recorder knew
+  /// The kernel's preemption model when recorded ("PREEMPT_NONE", "PREEMPT", "PREEMPT_RT",
+  /// ..., "unknown"), and how it was told (kernel_glue::FindPreemptionModel); both empty
+  /// when the recording does not say.
+  std::string preemption_model;
+  std::string preemption_source;
 
   friend bool operator==(const KernelTrace&, const KernelTrace&) = default;
 };
