@@ -186,7 +186,8 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   ASSERT_LE(r.exit_code, 4) << r.out << r.err;
   // Still spinning when the trace ended, so it competed for the whole recorded run.
   ASSERT_FALSE(hog.WaitFor(std::chrono::milliseconds(0)).has_value())
-      << "the hog ended before the trace did: " << hog.err();
+      << "the hog ended before the trace did: "
+      << hiltwin::test::ReadOutput(Path("hog.out.err"));
   hog.Kill(SIGKILL);
   const json jitter = ReadJson(out + "/jitter_report.json");
   EXPECT_TRUE(jitter["kernel_recorded"].get<bool>());
