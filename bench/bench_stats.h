@@ -39,11 +39,12 @@ inline Spread SpreadOf(const std::vector<double>& values) {
   return {Median(values), MinOf(values), *std::max_element(values.begin(), values.end())};
 }
 
-/// "112.6 ns (98.1-140.2)": the median, then the minimum and maximum, `decimals` after the point.
+/// "112.6 ns (98.1 to 140.2)": the median, then the minimum and maximum, `decimals` after the
+/// point ("to", since either may be negative).
 inline std::string FormatSpread(const Spread& spread, const char* unit, int decimals = 1) {
   char text[96];
-  std::snprintf(text, sizeof text, "%.*f %s (%.*f-%.*f)", decimals, spread.median, unit, decimals,
-                spread.min, decimals, spread.max);
+  std::snprintf(text, sizeof text, "%.*f %s (%.*f to %.*f)", decimals, spread.median, unit,
+                decimals, spread.min, decimals, spread.max);
   return text;
 }
 

@@ -18,8 +18,9 @@ TEST(BenchSpread, IsTheMedianAndTheRange) {
   EXPECT_DOUBLE_EQ(spread.median, 112.0);
   EXPECT_DOUBLE_EQ(spread.min, 98.5);
   EXPECT_DOUBLE_EQ(spread.max, 140.25);
-  EXPECT_EQ(FormatSpread(spread, "ns"), "112.0 ns (98.5-140.2)");
-  EXPECT_EQ(FormatSpread(SpreadOf({7.0}), "instructions", 0), "7 instructions (7-7)");
+  EXPECT_EQ(FormatSpread(spread, "ns"), "112.0 ns (98.5 to 140.2)");
+  EXPECT_EQ(FormatSpread(SpreadOf({7.0}), "instructions", 0), "7 instructions (7 to 7)");
+  EXPECT_EQ(FormatSpread(SpreadOf({-35.5, 27.0, 77.7}), "ns"), "27.0 ns (-35.5 to 77.7)");
 }
 
 TEST(BenchSpread, OfNothingIsAnError) {
