@@ -60,15 +60,23 @@ TEST(InstructionsPerItem, CancelsWhatBothRunsShare) {
                std::invalid_argument);
 }
 
-bool HaveValgrind() {
-  return kernel_glue::RunProcess({"sh", "-c", "command -v valgrind"},
-                                 {.out = kernel_glue::OutputTarget::Discard(),
-                                  .err = kernel_glue::OutputTarget::Discard()})
-      .status.Success();
+/// Why callgrind cannot count the probe here; empty when it can.
+std::string WhyNoCallgrind() {
+#if defined(HILTWIN_UNDER_SANITIZER)
+  return "a sanitizer's runtime and valgrind do not run in one process";
+#elif defined(HILTWIN_UNDER_EMULATOR)
+  return "the probe is built for another architecture (run under an emulator)";
+#else
+  const bool found = kernel_glue::RunProcess({"sh", "-c", "command -v valgrind"},
+                                             {.out = kernel_glue::OutputTarget::Discard(),
+                                              .err = kernel_glue::OutputTarget::Discard()})
+                         .status.Success();
+  return found ? "" : "valgrind is not installed (apt-get install valgrind)";
+#endif
 }
 
 TEST(CountInstructions, CountsTheBracketOfTheCallingThreadOnly) {
-  if (!HaveValgrind()) GTEST_SKIP() << "valgrind is not installed (apt-get install valgrind)";
+  if (const std::string why = WhyNoCallgrind(); !why.empty()) GTEST_SKIP() << why;
   const std::string probe = test::BesideTest(HILTWIN_COUNT_PROBE);
   const std::uint64_t few = CountInstructions({probe, "100000"});
   const std::uint64_t many = CountInstructions({probe, "300000"});
@@ -85,7 +93,7 @@ TEST(CountInstructions, CountsTheBracketOfTheCallingThreadOnly) {
 }
 
 TEST(CountInstructions, SaysSoWhenNothingWasBracketed) {
-  if (!HaveValgrind()) GTEST_SKIP() << "valgrind is not installed (apt-get install valgrind)";
+  if (const std::string why = WhyNoCallgrind(); !why.empty()) GTEST_SKIP() << why;
   const std::string probe = test::BesideTest(HILTWIN_COUNT_PROBE);
   try {
     static_cast<void>(CountInstructions({probe, "1000", "none"}));
