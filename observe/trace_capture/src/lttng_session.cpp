@@ -141,7 +141,7 @@ void EnableChannel(const Handle& handle, const LttngChannelSize& size) {
 
 // The events, with one context: vpid, by which the trace's reader picks one process's run out
 // of several (ReadCtfTrace). Not vtid, which nothing reads (loop_start names the loop thread):
-// it cost the tracing thread about 125 of an event's 1,695 instructions (callgrind,
+// it cost the tracing thread 130 of an event's 1,695 instructions (callgrind,
 // bench/trace), and 4 bytes.
 void EnableEventsAndContext(const Handle& handle) {
   const std::unique_ptr<lttng_event, decltype(&lttng_event_destroy)> event(lttng_event_create(),
