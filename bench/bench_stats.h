@@ -1,7 +1,7 @@
 #pragma once
-// Figures the benchmarks share: the median and the minimum over rounds (rounds alternate
-// between a figure and its peer, so both see the same machine), nanoseconds per item, and the
-// step benchmarks' two arguments. The RELbot's openloop duties and the timed RELbot step loop
+// Figures the benchmarks share: the median, the minimum and the spread over rounds (rounds
+// alternate between a figure and its peer, so both see the same machine), nanoseconds per item,
+// and the step benchmarks' two arguments. The RELbot's openloop duties and the timed RELbot step loop
 // are in relbot_duty_samples.h.
 
 #include <algorithm>
@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace hiltwin::bench {
@@ -21,6 +23,29 @@ inline double Median(std::vector<double> values) {
 
 inline double MinOf(const std::vector<double>& values) {
   return *std::min_element(values.begin(), values.end());
+}
+
+/// A figure over rounds: its median and the range it moved in, so a reader sees how far one
+/// round's figure can be trusted on a busy machine.
+struct Spread {
+  double median = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+};
+
+/// The spread of `values`; throws std::invalid_argument when there are none.
+inline Spread SpreadOf(const std::vector<double>& values) {
+  if (values.empty()) throw std::invalid_argument("SpreadOf: no values");
+  return {Median(values), MinOf(values), *std::max_element(values.begin(), values.end())};
+}
+
+/// "112.6 ns (98.1 to 140.2)": the median, then the minimum and maximum, `decimals` after the
+/// point ("to", since either may be negative).
+inline std::string FormatSpread(const Spread& spread, const char* unit, int decimals = 1) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%.*f %s (%.*f to %.*f)", decimals, spread.median, unit,
+                decimals, spread.min, decimals, spread.max);
+  return text;
 }
 
 using BenchClock = std::chrono::steady_clock;

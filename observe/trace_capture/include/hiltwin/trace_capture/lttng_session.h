@@ -2,7 +2,7 @@
 /// An LTTng recording session for the `hiltwin` provider, driven through liblttng-ctl (the
 /// library the `lttng` command is built on; no shell-outs): a reachable session daemon (started
 /// when none answers and the user may), a session writing CTF into a folder, a user-space
-/// channel sized for the loop's rate, the hiltwin:* events with vpid/vtid context. Control side
+/// channel sized for the loop's rate, the hiltwin:* events with the vpid context. Control side
 /// only: it allocates and blocks freely, never on the loop thread.
 
 #include <cstdint>
@@ -43,7 +43,8 @@ struct LttngChannelSize {
   std::uint32_t switch_timer_us = 0;  ///< a sub-buffer goes to the consumer at least this often
 };
 
-/// Bytes of one hiltwin:cycle event in the channel: payload, header and vpid/vtid context.
+/// Bytes of one hiltwin:cycle event in the channel, rounded up: payload, header and the vpid
+/// context.
 inline constexpr std::uint64_t kCycleEventBytes = 80;
 
 /// The channel for a loop at `rate_hz` (one hiltwin:cycle per cycle; the rarer events are a
