@@ -84,12 +84,16 @@ TEST(CountInstructions, CountsTheBracketOfTheCallingThreadOnly) {
   // An empty loop is an increment, a compare and a branch (maybe unrolled): a few instructions.
   EXPECT_GE(per_iteration, 1.0);
   EXPECT_LE(per_iteration, 5.0);
-  // The same loop while another thread spins outside the bracket (at least one turn of 1000
-  // iterations, a few thousand instructions, while the bracket is open): the spinner is not
+  // The same loop while another thread spins outside the bracket: the spinner is not
   // counted, since the count is per thread, which lets a benchmark count its loop thread
-  // alone. (A handful of instructions differ: the yield's path in the C library.)
+  // alone. A counted spinner would add at least one turn of its loop (1000 iterations, some
+  // 3000 instructions). The bracketed thread's own count moves a little: its yield's path in
+  // the C library and the kernel differs when another thread is runnable (under 100 on a
+  // busy machine, 838 on an idle one).
+  constexpr std::uint64_t kOwnPathSlack = 2'000;
   const std::uint64_t spinning = CountInstructions({probe, "300000", "spin"});
-  EXPECT_LT(spinning > many ? spinning - many : many - spinning, 100U) << spinning << " " << many;
+  EXPECT_LT(spinning > many ? spinning - many : many - spinning, kOwnPathSlack)
+      << spinning << " " << many;
 }
 
 TEST(CountInstructions, SaysSoWhenNothingWasBracketed) {
