@@ -220,6 +220,10 @@ runtime::TelemetryShape EcsTask::TelemetryShapeOf() const {
 
 void EcsTask::FillTelemetry(runtime::TaskTelemetry& out) const noexcept {
   FillWheelJoints(out, last_.measured.left_m, last_.measured.right_m, geometry_.wheel_radius_m);
+  // The profile's setpoint, as logged (not the PID's value on the encoder grid).
+  if (mode_ == EcsMode::kClosedLoop) {
+    FillWheelSetpoint(out, last_.setpoint.left_m, last_.setpoint.right_m);
+  }
 }
 
 }  // namespace hiltwin::app

@@ -17,6 +17,15 @@ nlohmann::ordered_json WheelsJson(const runtime::TelemetryRecord& r) {
   return wheels;
 }
 
+nlohmann::ordered_json SetpointJson(const runtime::TelemetryRecord& r) {
+  nlohmann::ordered_json setpoint = nlohmann::ordered_json::object();
+  const std::size_t n = r.task.joint_count;
+  for (std::size_t i = 0; i < n && i < r.joint_names.size(); ++i) {
+    setpoint[r.joint_names[i]] = {{"m", r.task.joint_setpoint_m[i]}};
+  }
+  return setpoint;
+}
+
 nlohmann::ordered_json TimingJson(const runtime::TelemetryRecord& r) {
   nlohmann::ordered_json timing = {
       {"rate_hz", r.rate_hz},
@@ -49,6 +58,7 @@ nlohmann::ordered_json ToJson(const runtime::TelemetryRecord& r) {
     j["pose"] = {{"x", r.task.x_m}, {"y", r.task.y_m}, {"theta", r.task.theta_rad}};
   }
   j["wheels"] = WheelsJson(r);
+  if (r.task.has_setpoint) j["setpoint"] = SetpointJson(r);
   j["timing"] = TimingJson(r);
   return j;
 }

@@ -109,6 +109,34 @@ TEST(EcsTask, ClosedLoopDrivesEachWheelOnItsOwnChannel) {
   EXPECT_EQ(task.last().setpoint.left_m, 0.01);  // logged as the profile gives it
 }
 
+// The telemetry record carries the profile's setpoint (as logged, not the PID's grid value)
+// in closed loop, and none in open loop; the wheels stay the measured travel.
+TEST(EcsTask, TelemetryCarriesTheSetpointInClosedLoopOnly) {
+  LoneBoard rig;
+  const SetpointProfile setpoints =
+      ParseCsvSetpoints("time,left_m,right_m\n0,0,0\n1,0.5,-1\n", "sp.csv");
+  EcsTask closed(rig.driver, setpoints, POnly(10.0), rig.geometry, kPeriodNs);
+  for (std::uint64_t k = 0; k <= 250; ++k) {
+    ASSERT_TRUE(closed.Exchange(true).ok());
+    ASSERT_EQ(closed.Step(Cycle(k)).code, runtime::StepStatus::Code::kOk);
+  }
+  runtime::TaskTelemetry t;
+  closed.FillTelemetry(t);
+  EXPECT_TRUE(t.has_setpoint);
+  EXPECT_EQ(t.joint_setpoint_m[0], setpoints.At(0.25).left_m);
+  EXPECT_EQ(t.joint_setpoint_m[1], setpoints.At(0.25).right_m);
+  EXPECT_EQ(t.joint_setpoint_m[0], closed.last().setpoint.left_m);
+  EXPECT_EQ(t.joint_position_m[0], 0.0);  // measured: nothing moves the wheels here
+  const InputProfile duties = OpenLoopProfile();
+  EcsTask open(rig.driver, duties, rig.geometry, kPeriodNs);
+  ASSERT_TRUE(open.Exchange(true).ok());
+  ASSERT_EQ(open.Step(Cycle(0)).code, runtime::StepStatus::Code::kOk);
+  runtime::TaskTelemetry u;
+  open.FillTelemetry(u);
+  EXPECT_FALSE(u.has_setpoint);
+  EXPECT_EQ(u.joint_count, 2U);
+}
+
 TEST(EcsTask, TrackingStatsCoverEveryStep) {
   LoneBoard rig;
   // The wheels never move (nothing behind the board): the error is the setpoint itself.

@@ -193,5 +193,24 @@ TEST(RecordJson, HasEveryDocumentedKeyAndNullForADistanceThatCannotFail) {
   EXPECT_FALSE(j.contains("pose"));  // a controller has none
 }
 
+// A closed-loop controller's setpoint, per joint as wheel travel (m), beside its wheels; a
+// record without one (a twin, an open loop) has no "setpoint" at all.
+TEST(RecordJson, CarriesTheSetpointPerJointOnlyWhenTheTaskHasOne) {
+  runtime::TelemetryRecord r;
+  r.role = "controller";
+  r.task.joint_count = 2;
+  r.task.joint_position_m = {0.1, 0.2};
+  r.joint_names = {"wheel_left_joint", "wheel_right_joint"};
+  EXPECT_FALSE(ToJson(r).contains("setpoint"));
+  r.task.has_setpoint = true;
+  r.task.joint_setpoint_m = {0.125, -0.25};
+  const nlohmann::ordered_json j = ToJson(r);
+  ASSERT_TRUE(j.contains("setpoint")) << j.dump();
+  EXPECT_EQ(j["setpoint"].size(), 2U) << j.dump();
+  EXPECT_EQ(j["setpoint"]["wheel_left_joint"]["m"].get<double>(), 0.125);
+  EXPECT_EQ(j["setpoint"]["wheel_right_joint"]["m"].get<double>(), -0.25);
+  EXPECT_EQ(j["wheels"]["wheel_left_joint"]["m"].get<double>(), 0.1);  // still the measured
+}
+
 }  // namespace
 }  // namespace hiltwin::telemetry

@@ -91,7 +91,7 @@ class EcsTask final : public runtime::RunTask {
   [[nodiscard]] double LogTimeS() const noexcept override { return last_.time_s; }
   void FillLogRow(std::span<double> values) const noexcept override;
   /// Both wheels as the encoders measured them at the last exchange (no pose: the controller
-  /// does not know it).
+  /// does not know it) and, in closed loop, their setpoints (the log's setpoint_*_m).
   [[nodiscard]] runtime::TelemetryShape TelemetryShapeOf() const override;
   void FillTelemetry(runtime::TaskTelemetry& out) const noexcept override;
 

@@ -26,4 +26,11 @@ inline void FillWheelJoints(runtime::TaskTelemetry& out, double left_m, double r
   out.joint_position_rad[1] = right_m / wheel_radius_m;
 }
 
+/// The two wheels' setpoints (travel, m) beside their joints: a closed loop's.
+inline void FillWheelSetpoint(runtime::TaskTelemetry& out, double left_m, double right_m) noexcept {
+  out.has_setpoint = true;
+  out.joint_setpoint_m[0] = left_m;
+  out.joint_setpoint_m[1] = right_m;
+}
+
 }  // namespace hiltwin::app

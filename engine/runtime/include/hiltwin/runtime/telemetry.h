@@ -33,6 +33,11 @@ struct TaskTelemetry {
   std::uint8_t joint_count = 0;
   std::array<double, kMaxTelemetryJoints> joint_position_rad{};  ///< wheel angles
   std::array<double, kMaxTelemetryJoints> joint_position_m{};    ///< wheel travel (r·angle)
+  /// What a closed-loop controller tells each joint to be at, as travel (m), in the joints'
+  /// order; without one (a twin, an open loop) has_setpoint stays false and the record has no
+  /// setpoint. The page draws a robot driven by it beside the real one.
+  bool has_setpoint = false;
+  std::array<double, kMaxTelemetryJoints> joint_setpoint_m{};
 };
 
 /// What a task's telemetry looks like, fixed for a run (RunTask::TelemetryShapeOf).
