@@ -330,7 +330,7 @@ TEST(TelemetryWeb, ChromiumAsSeventhPageSaysWhyItCannotConnectAndRetries) {
 
 // Measures, in screen pixels: every text of the 2D grid (axis labels and the scale bar's)
 // once the run has ended; and the 3D canvas's robot-coloured pixels (count and centroid) after
-// the first record and after the final one. The canvas keeps its last frame
+// the first record and after the final one, with the count of the setpoint ghost's violet. The canvas keeps its last frame
 // (preserveDrawingBuffer), which the page draws synchronously for those two records.
 constexpr const char* kProbeScript = R"js(
 (() => {
@@ -346,14 +346,16 @@ constexpr const char* kProbeScript = R"js(
     const ctx = copy.getContext("2d");
     ctx.drawImage(gl, 0, 0);
     const px = ctx.getImageData(0, 0, copy.width, copy.height).data;
-    let n = 0, sx = 0, sy = 0;
+    let n = 0, sx = 0, sy = 0, ghost = 0;
     for (let i = 0; i < px.length; i += 4) {
       const r = px[i], g = px[i + 1], b = px[i + 2];
       if (b > 100 && b > r + 60 && b > g + 40) {  // the body's blue, lit or in shade
         const p = i / 4; n += 1; sx += p % copy.width; sy += Math.floor(p / copy.width);
+      } else if (r > g + 15 && b > g + 50) {  // the ghost's see-through violet over the floor
+        ghost += 1;
       }
     }
-    return { n, x: n ? sx / n : 0, y: n ? sy / n : 0 };
+    return { n, x: n ? sx / n : 0, y: n ? sy / n : 0, ghost };
   }
   function labels() {
     return [...document.querySelectorAll("#grid text")].map((t) => {
@@ -583,6 +585,54 @@ TEST(TelemetryWeb, Chromium3dViewDrawsTheRobotMoving) {
   const double moved = std::hypot(robot[1]["x"].get<double>() - robot[0]["x"].get<double>(),
                                   robot[1]["y"].get<double>() - robot[0]["y"].get<double>());
   EXPECT_GE(moved, 30.0) << "the robot did not move across the picture: " << robot.dump();
+}
+
+// Issue 35, the setpoint: a controller's records carry its wheels' setpoints, and the page drives
+// a ghost robot with them beside the real one, in 2D and 3D, labelled "setpoint". The left
+// wheel's setpoint goes 0 -> 0.3 m and the right's 0 -> 0.5 m at constant speeds over 2 s: a
+// circular arc of radius 0.17/2 · 0.8/0.2 = 0.34 m turning (0.5 - 0.3)/0.17 = 1.18 rad, which
+// the page's arcs reproduce exactly. The real robot lags behind on a straight line.
+TEST(TelemetryWeb, ChromiumDrawsTheSetpointAsAGhostRobotIn2dAnd3d) {
+  if (!fs::exists(kChromium)) {
+    GTEST_SKIP() << kChromium << " is missing (apt-get install chromium; scripts/setup.sh)";
+  }
+  constexpr double kTrack = 0.17, kLeft = 0.3, kRight = 0.5;
+  std::vector<runtime::TelemetryRecord> records;
+  constexpr int kLast = 20;
+  for (int i = 0; i <= kLast; ++i) {
+    const double s = static_cast<double>(i) / kLast;
+    records.push_back(PoseRecord(0.2 * s, 0.0, 0.0, 2.0 * s, i == kLast));
+    records.back().task.has_setpoint = true;
+    records.back().task.joint_setpoint_m = {kLeft * s, kRight * s, 0.0, 0.0};
+  }
+  const double theta = (kRight - kLeft) / kTrack;
+  const double radius = kTrack / 2.0 * (kRight + kLeft) / (kRight - kLeft);
+  const double x = radius * std::sin(theta), y = radius * (1.0 - std::cos(theta));
+  const ProbedPage page(records);
+  const std::string dom = LoadProbed("setpoint", page, {"--enable-unsafe-swiftshader"});
+  const std::string ghost = Tag(dom, "ghost");
+  ASSERT_FALSE(ghost.empty()) << dom;
+  EXPECT_EQ(Attribute(ghost, "display"), "inline") << ghost;
+  EXPECT_NEAR(std::stod("0" + Attribute(ghost, "data-x")), x, 1e-9) << ghost;
+  EXPECT_NEAR(std::stod("0" + Attribute(ghost, "data-y")), y, 1e-9) << ghost;
+  EXPECT_NEAR(std::stod("0" + Attribute(ghost, "data-theta")), theta, 1e-9) << ghost;
+  EXPECT_EQ(Text(dom, "ghost-label"), "setpoint");
+  EXPECT_EQ(Attribute(Tag(dom, "ghost-label"), "display"), "inline");
+  ExpectRobotDrawnAt(dom, telemetry::ToJson(records.back())["pose"]);  // the robot as before
+  const std::string view = Tag(dom, "view3d");
+  ASSERT_EQ(Attribute(view, "data-state"), "webgl") << Text(dom, "view3d-note") << view;
+  EXPECT_NEAR(Data3d(dom, "data-ghost-x"), x, 1e-9) << view;
+  EXPECT_NEAR(Data3d(dom, "data-ghost-y"), y, 1e-9) << view;
+  EXPECT_NEAR(Data3d(dom, "data-ghost-theta"), theta, 1e-9) << view;
+  EXPECT_DOUBLE_EQ(Data3d(dom, "data-x"), 0.2) << view;
+  const nlohmann::json probe = Probe(dom);
+  ASSERT_TRUE(probe.is_object()) << "the page did not end its run: " << dom;
+  const nlohmann::json& frames = probe["robot"];
+  RecordProperty("frames", frames.dump());
+  ASSERT_EQ(frames.size(), 2U) << frames.dump();
+  ASSERT_TRUE(frames[1].is_object()) << "no canvas: " << frames.dump();
+  EXPECT_GE(frames[1]["ghost"].get<int>(), 100) << "no ghost in the last frame: " << frames.dump();
+  EXPECT_GE(frames[1]["n"].get<int>(), 100) << "no robot in the last frame: " << frames.dump();
 }
 
 // Without WebGL the page says so where the 3D view would be, and the 2D view works as before.
