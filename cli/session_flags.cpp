@@ -10,6 +10,7 @@
 #include "hiltwin/qos/monitor.h"
 #include "hiltwin/qos/rules.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/scheduler/overrun_policy.h"
@@ -119,6 +120,7 @@ std::vector<NamedFile> TwinRunFiles(const TwinRunFlags& f) {
   files.push_back({"--plant-map", f.plant_map_path, false});
   files.push_back({"--config", f.config_path, false});
   files.push_back({"--plant", FmuPathOf(f.plant), false});
+  files.push_back(ProfileFile("--show-setpoint", f.show_setpoint, BuiltinSetpointNames()));
   return files;
 }
 
@@ -285,6 +287,10 @@ void AddTwinRunFlags(CLI::App& app, TwinRunFlags& o) {
                  "fault injection (mock and wire): break the link at exchange K, e.g. "
                  "drop-answer,at=4000,count=3; KIND corrupt-request, corrupt-answer, drop-answer, "
                  "delay-answer or stuck-encoder (to the end without count) (repeatable)");
+  app.add_option("--show-setpoint", o.show_setpoint,
+                 "telemetry only: a controller's setpoint profile (closedloop or CSV "
+                 "time,left_m,right_m, as `ecs --setpoint`) sent with each record at the twin's "
+                 "time, so the web page draws it beside the robot (hil passes its own)");
 }
 
 TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command,
@@ -297,6 +303,7 @@ TwinRunOptions TwinRunOptionsFrom(const TwinRunFlags& f, const char* command,
   o.plant_map_path = f.plant_map_path;
   o.config_path = f.config_path;
   o.integrator = f.integrator;
+  o.show_setpoint = f.show_setpoint;
   // The controller rate is checked with the session's numbers, before the default (m,k) rule
   // is derived from it.
   ValidateTwinRunNumbers(o);

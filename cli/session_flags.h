@@ -87,6 +87,7 @@ struct TwinRunFlags {
   std::string config_path;
   std::string integrator;
   std::vector<std::string> inject_link_faults;
+  std::string show_setpoint;
 };
 
 /// Adds every `run` flag (shared and own) to `app`.

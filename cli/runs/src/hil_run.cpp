@@ -83,14 +83,16 @@ std::unique_ptr<WorkDir> MakeWorkDir(const HilRunOptions& o) {
 }
 
 /// One side's telemetry flags: its own namespace under --namespace; the page on the twin only;
-/// --accept-commands to both sides, this pair's own processes, when hil was given it.
-void AddTelemetry(std::vector<std::string>& argv, const telemetry::TelemetryOptions& t,
+/// --accept-commands to both sides, this pair's own processes, when hil was given it. False
+/// when the side gets no telemetry.
+bool AddTelemetry(std::vector<std::string>& argv, const telemetry::TelemetryOptions& t,
                   const char* side, bool serves_web) {
-  if (t.specs.empty() && (t.web.empty() || !serves_web)) return;
+  if (t.specs.empty() && (t.web.empty() || !serves_web)) return false;
   for (const std::string& spec : t.specs) argv.insert(argv.end(), {"--telemetry", spec});
   if (t.accept_commands) argv.emplace_back("--accept-commands");
   argv.insert(argv.end(), {"--namespace", t.ns + "/" + side, "--telemetry-rate", Num(t.rate_hz)});
   if (serves_web && !t.web.empty()) argv.insert(argv.end(), {"--web", t.web});
+  return true;
 }
 
 void AddRules(std::vector<std::string>& argv, const std::vector<std::string>& qos,
@@ -121,7 +123,11 @@ std::vector<std::string> TwinArgv(const HilRunOptions& o, const std::string& wir
   if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", SideFile(dir, "twin", kLog)});
   if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
   AddRules(argv, o.twin_qos, o.twin_max_miss_pct, o.on_violation);
-  AddTelemetry(argv, o.telemetry, "twin", true);
+  // The twin serves the page, so it sends the controller's setpoint too (it has no other way
+  // to know it): the page draws it beside the robot.
+  if (AddTelemetry(argv, o.telemetry, "twin", true) && o.mode == "closedloop") {
+    argv.insert(argv.end(), {"--show-setpoint", o.setpoint});
+  }
   argv.insert(argv.end(), o.twin_args.begin(), o.twin_args.end());
   return argv;
 }

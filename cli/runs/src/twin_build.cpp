@@ -1,7 +1,9 @@
 // A twin built from `run`'s flags (twin_build.h).
 #include "hiltwin/runs/twin_build.h"
 
+#include <optional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "hiltwin/fmi/fmu_plant.h"
@@ -37,6 +39,25 @@ std::unique_ptr<plant::Plant> OpenPlant(const TwinRunOptions& o,
   return entry->make(options);
 }
 
+/// --show-setpoint's profile, or none; refused where nothing would show it.
+std::optional<SetpointProfile> ShownSetpointOf(const TwinRunOptions& o) {
+  if (o.show_setpoint.empty()) return std::nullopt;
+  const telemetry::TelemetryOptions& t = o.session.telemetry;
+  if (t.specs.empty() && t.web.empty()) {
+    ThrowUsage("--show-setpoint " + o.show_setpoint + " draws the setpoint on the telemetry: "
+               "give --web (the page) or --telemetry too");
+  }
+  if (o.plant != kRelbotPlantName) {
+    ThrowUsage("--show-setpoint is the RELbot's wheel setpoints; --plant " + o.plant +
+               " has other joints (leave the flag out)");
+  }
+  try {
+    return LoadSetpointProfile(o.show_setpoint);
+  } catch (const ProfileError& e) {
+    ThrowUsage("--show-setpoint: " + std::string(e.what()));
+  }
+}
+
 }  // namespace
 
 std::string FmuPathOf(const std::string& plant) {
@@ -50,6 +71,7 @@ void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin) {
       twin.integrator = ParseIntegrator(o.integrator.empty() ? "rk4" : o.integrator);
     }
     twin.profile.emplace(LoadInputProfile(o.input));
+    twin.shown_setpoint = ShownSetpointOf(o);
   } catch (const ConfigError& e) {
     ThrowUsage(e.what());
   } catch (const ProfileError& e) {

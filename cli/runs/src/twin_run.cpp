@@ -19,6 +19,7 @@
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/relbot_plant.h"
+#include "hiltwin/relbot/setpoint_display_task.h"
 #include "hiltwin/runs/command.h"
 #include "hiltwin/runs/twin_build.h"
 #include "hiltwin/runtime/link_faulting_task.h"
@@ -147,7 +148,10 @@ TwinRunOutcome RunTwin(const TwinRunOptions& o, const char* command) {
   if (!link_faults.empty()) {
     faulting.emplace(*twin->task, *twin->backend->emulated_board(), link_faults);
   }
-  runtime::RunTask& task = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
+  runtime::RunTask& faulted = faulting ? static_cast<runtime::RunTask&>(*faulting) : *twin->task;
+  std::optional<SetpointDisplayTask> showing;
+  if (twin->shown_setpoint) showing.emplace(faulted, *twin->shown_setpoint);
+  runtime::RunTask& task = showing ? static_cast<runtime::RunTask&>(*showing) : faulted;
   const runtime::RunReport report = RunSessionOf(std::move(config), task);
   const int exit_code = PrintOutcome(role, report, runtime::ToJson(report), "", report_file);
   if (report.fault && report.fault->kind == lifecycle::StopReason::kModelFault &&

@@ -84,13 +84,18 @@ TEST(TelemetryUdp, AtTheConfiguredRateEveryDatagramIsJsonAndTheLastAgreesWithThe
   fs::remove_all(dir);
 }
 
+// Both sides publish, each under its own namespace; both carry the controller's setpoint (issue
+// 35): the controller as it follows it, the twin, which serves the page, because hil passes it
+// the profile (--show-setpoint).
 TEST(TelemetryUdp, HilPublishesBothSidesUnderItsNamespace) {
   const fs::path dir = TempDir("hil");
   const test::UdpListener listener;
+  const fs::path setpoint = dir / "turn.csv";
+  std::ofstream(setpoint) << "time,left_m,right_m\n0,0,0\n0.5,0.05,0.1\n";
   const test::RunResult r =
-      test::Run({HILTWIN_BINARY, "hil", "--duration", "1", "--telemetry",
-                 "udp:127.0.0.1:" + std::to_string(listener.port()), "--namespace", "lab/bench3",
-                 "--no-progress", "--log-dir", dir.string()},
+      test::Run({HILTWIN_BINARY, "hil", "--duration", "1", "--setpoint", setpoint.string(),
+                 "--telemetry", "udp:127.0.0.1:" + std::to_string(listener.port()), "--namespace",
+                 "lab/bench3", "--no-progress", "--log-dir", dir.string()},
                 60'000);
   ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.out << r.err;  // 3: a loaded machine
   std::map<std::string, nlohmann::json> last;  // namespace -> its last record
@@ -114,6 +119,51 @@ TEST(TelemetryUdp, HilPublishesBothSidesUnderItsNamespace) {
   const auto ecs_log = test::ReadCsvTable((dir / "ecs.csv").string()).LastRow();
   EXPECT_NEAR(controller["wheels"]["wheel_left_joint"]["m"].get<double>(),
               ecs_log.at("wheel_left_m"), 1e-9);
+  // The setpoint the controller last followed, and the profile's end on the twin (it ran on).
+  ASSERT_TRUE(controller.contains("setpoint")) << controller.dump();
+  EXPECT_NEAR(controller["setpoint"]["wheel_left_joint"]["m"].get<double>(),
+              ecs_log.at("setpoint_left_m"), 1e-9);
+  EXPECT_NEAR(controller["setpoint"]["wheel_right_joint"]["m"].get<double>(),
+              ecs_log.at("setpoint_right_m"), 1e-9);
+  ASSERT_TRUE(twin.contains("setpoint")) << twin.dump();
+  EXPECT_EQ(twin["setpoint"]["wheel_left_joint"]["m"].get<double>(), 0.05);
+  EXPECT_EQ(twin["setpoint"]["wheel_right_joint"]["m"].get<double>(), 0.1);
+  fs::remove_all(dir);
+}
+
+// `run --show-setpoint` sends a setpoint profile with the twin's telemetry, sampled at the
+// twin's own time: in a run of 0.3 s on the virtual clock the final record's is the ramp's at
+// 0.3 s. Without any telemetry it would do nothing: exit 2, as for a profile it cannot read.
+TEST(TelemetryUdp, RunShowsTheSetpointAtTheTwinsTimeAndRefusesItWithoutTelemetry) {
+  const fs::path dir = TempDir("show");
+  const fs::path setpoint = dir / "ramp.csv";
+  std::ofstream(setpoint) << "time,left_m,right_m\n0,0,0\n1,0.5,-1\n";
+  const test::UdpListener listener;
+  const test::RunResult r =
+      test::Run({HILTWIN_BINARY, "run", "--clock", "virtual", "--duration", "0.3",
+                 "--show-setpoint", setpoint.string(), "--telemetry",
+                 "udp:127.0.0.1:" + std::to_string(listener.port()), "--namespace", "t",
+                 "--no-progress"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const std::vector<nlohmann::json> got = ReceiveUntilFinal(listener, "t");
+  ASSERT_FALSE(got.empty());
+  const nlohmann::json& last = got.back()["t"];
+  ASSERT_TRUE(last.contains("setpoint")) << last.dump();
+  EXPECT_NEAR(last["setpoint"]["wheel_left_joint"]["m"].get<double>(), 0.15, 1e-12);
+  EXPECT_NEAR(last["setpoint"]["wheel_right_joint"]["m"].get<double>(), -0.3, 1e-12);
+  EXPECT_DOUBLE_EQ(got.back()["timestamp"].get<double>(), 0.3);
+
+  const test::RunResult alone = test::Run({HILTWIN_BINARY, "run", "--clock", "virtual",
+                                           "--duration", "0.1", "--show-setpoint", "closedloop"});
+  EXPECT_EQ(alone.exit_code, 2) << alone.out << alone.err;
+  EXPECT_NE(alone.err.find("--show-setpoint"), std::string::npos) << alone.err;
+  EXPECT_NE(alone.err.find("--web"), std::string::npos) << alone.err;
+  const test::RunResult missing =
+      test::Run({HILTWIN_BINARY, "run", "--clock", "virtual", "--duration", "0.1",
+                 "--show-setpoint", (dir / "missing.csv").string(), "--telemetry", "udp"});
+  EXPECT_EQ(missing.exit_code, 2) << missing.out << missing.err;
+  EXPECT_NE(missing.err.find("--show-setpoint"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("missing.csv"), std::string::npos) << missing.err;
   fs::remove_all(dir);
 }
 

@@ -19,6 +19,7 @@
 #include "hiltwin/relbot/integrator.h"
 #include "hiltwin/relbot/profile_pwm_source.h"
 #include "hiltwin/relbot/relbot_params.h"
+#include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/twin_run.h"
 
 namespace hiltwin::app {
@@ -37,12 +38,15 @@ struct Twin {
   std::unique_ptr<io::IcoBoardInverse> driver;
   std::optional<plant::PlantTwinTask> task;
   std::string input_name;
+  std::optional<SetpointProfile> shown_setpoint;  ///< --show-setpoint's profile
 };
 
 /// The FMU's path of `--plant fmu:PATH`; empty for a plant named by its name.
 [[nodiscard]] std::string FmuPathOf(const std::string& plant);
 
-/// Reads --config, --integrator and --input (exit 2 naming the problem) into `twin`.
+/// Reads --config, --integrator, --input and --show-setpoint (exit 2 naming the problem) into
+/// `twin`. --show-setpoint needs the RELbot (its joints are the wheels the setpoint is for) and
+/// some telemetry (--web or --telemetry) to send it with.
 void LoadTwinConfiguration(const TwinRunOptions& o, Twin& twin);
 
 /// Builds the plant named by --plant and its map (--plant-map or the plant's own) without

@@ -25,6 +25,9 @@ struct TwinRunOptions {
   /// (plant::PlantOptions), and a plant without integrators refuses it in its own words.
   std::string integrator;
   std::vector<io::LinkFaultInjection> link_faults;  ///< --inject-link-fault (mock and wire)
+  /// --show-setpoint: a setpoint profile (as `ecs --setpoint`) sent with the telemetry, for
+  /// the page to draw beside the robot; "" for none. `hil` passes its controller's.
+  std::string show_setpoint;
 };
 
 /// How the twin's runs name themselves in messages: `command` ("run", "trace", "tune") against
