@@ -330,8 +330,9 @@ TEST(TelemetryWeb, ChromiumAsSeventhPageSaysWhyItCannotConnectAndRetries) {
 
 // Measures, in screen pixels: every text of the 2D grid (axis labels and the scale bar's)
 // once the run has ended; and the 3D canvas's robot-coloured pixels (count and centroid) after
-// the first record and after the final one, with the count of the setpoint ghost's violet. The canvas keeps its last frame
-// (preserveDrawingBuffer), which the page draws synchronously for those two records.
+// the first record and after the final one, with the count of the setpoint ghost's violet.
+// The canvas keeps its last frame (preserveDrawingBuffer), which the page draws synchronously
+// for those two records.
 constexpr const char* kProbeScript = R"js(
 (() => {
   const out = document.createElement("pre");
