@@ -205,8 +205,8 @@ void AddTelemetryFlags(CLI::App& app, telemetry::TelemetryOptions& t) {
                  "controller for ecs; hil publishes its sides under NS/twin and NS/controller, "
                  "default hil)");
   app.add_option("--web", t.web,
-                 "serve a live page (pose, trail, wheels, timing) at ADDR:PORT (bare --web: "
-                 "127.0.0.1:8080)")
+                 "serve a live page (pose and trail in 2D or 3D, the setpoint, wheels, timing) at "
+                 "ADDR:PORT (bare --web: 127.0.0.1:8080)")
       ->expected(0, 1)
       ->default_str("127.0.0.1:8080");
   app.add_option("--telemetry-rate", t.rate_hz, "telemetry records per second (0 < HZ <= 1000)")

@@ -48,6 +48,10 @@ file(GLOB relbot_configs "${PROJECT_SOURCE_DIR}/relbot/*.toml")
 install(FILES ${relbot_configs} DESTINATION "${HILTWIN_INSTALL_DATADIR}" COMPONENT runtime)
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/config/" DESTINATION "${HILTWIN_INSTALL_DATADIR}/config"
         COMPONENT runtime)
+# The ROS 2 interface package of the Timing type, for a user of the package to copy into a ROS 2
+# workspace (docs/telemetry.md); hiltwin itself does not build it.
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/ros2/hiltwin_msgs"
+        DESTINATION "${HILTWIN_INSTALL_DATADIR}/ros2" COMPONENT runtime)
 
 # The man page and the bash completion, made by the built binary (cmake/GenerateManPage.cmake
 # names them <binary>.<ext> in the build folder; a cross build without an emulator, or a machine

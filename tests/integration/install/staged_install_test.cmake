@@ -20,7 +20,8 @@ hiltwin_test_run("install into a staging prefix" out
        "cmake/HiltwinInstall.cmake")
 set(installed bin/hiltwin include/hiltwin/runtime/run_session.h include/hiltwin/io/backend.h
     include/hiltwin/plant/plant.h share/hiltwin/relbot.toml
-    share/hiltwin/config/cyclonedds-loopback.xml share/doc/hiltwin/README.md
+    share/hiltwin/config/cyclonedds-loopback.xml
+    share/hiltwin/ros2/hiltwin_msgs/msg/Timing.msg share/doc/hiltwin/README.md
     share/bash-completion/completions/hiltwin)
 if(EXISTS "${BUILD_DIR}/hiltwin.1")  # only where help2man is (cmake/GenerateManPage.cmake)
   list(APPEND installed share/man/man1/hiltwin.1)

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,31 +26,12 @@ class DdsRosTopicsTest : public ::testing::Test {
   static void SetUpTestSuite() { test::UseLoopbackDds(); }
 };
 
-runtime::TelemetryShape Shape(bool virtual_clock) {
-  runtime::TelemetryShape shape;
-  shape.role = "twin";
-  shape.has_pose = true;
-  shape.joint_names = {"wheel_left_joint", "wheel_right_joint"};
-  shape.virtual_clock = virtual_clock;
-  return shape;
-}
-
+// The shared twin record, paused and FLAGGED, heading 1 rad (a quaternion of half-angle 0.5).
 runtime::TelemetryRecord Record(const std::string& ns) {
-  runtime::TelemetryRecord r;
-  r.ns = ns;
-  r.role = "twin";
-  r.rate_hz = 1000.0;
-  r.time_s = 12.25;
-  r.cycle = 12'250;
+  runtime::TelemetryRecord r = test::TwinRecord(ns);
   r.state = lifecycle::State::kPaused;
   r.verdict_so_far = qos::Verdict::kFlagged;
-  r.task.has_pose = true;
-  r.task.x_m = 0.5;
-  r.task.y_m = -0.25;
   r.task.theta_rad = 1.0;
-  r.task.joint_count = 2;
-  r.task.joint_position_rad = {3.5, -1.75, 0.0, 0.0};
-  r.joint_names = {"wheel_left_joint", "wheel_right_joint"};
   return r;
 }
 
@@ -157,6 +139,18 @@ Seen PublishUntilSeen(runtime::TelemetrySink& sink, const RosReaders& readers,
   return seen;
 }
 
+// A twin's sink on `domain`, opened, and the test's own readers of every topic it writes.
+struct TwinOnDds {
+  TwinOnDds(std::uint32_t domain, bool virtual_clock)
+      : ns(test::UniqueNamespace("twin")), sink(MakeDdsSink({domain})), peer(domain) {
+    sink->Open(test::TwinShape(virtual_clock), ns);
+  }
+  const std::string ns;
+  const std::shared_ptr<runtime::TelemetrySink> sink;
+  const test::Peer peer;
+  const RosReaders readers{peer, ns};
+};
+
 void ExpectPoseFrame(const Frame& f, const std::string& ns) {
   EXPECT_EQ(f.frame_id, ns + "/odom");
   EXPECT_EQ(f.child_frame_id, ns + "/base_link");
@@ -169,15 +163,11 @@ void ExpectPoseFrame(const Frame& f, const std::string& ns) {
 }
 
 TEST_F(DdsRosTopicsTest, OnTheVirtualClockOdometryTfAndClockCarryTheTasksTime) {
-  constexpr std::uint32_t kDomain = 213;
-  const std::string ns = test::UniqueNamespace("twin");
-  const auto sink = MakeDdsSink({kDomain});
-  sink->Open(Shape(true), ns);
-  EXPECT_EQ(sink->Describe(),
+  const TwinOnDds twin(213, true);
+  const std::string& ns = twin.ns;
+  EXPECT_EQ(twin.sink->Describe(),
             "DDS domain 213 rt/" + ns + "/{odom,pose,joint_states,timing,command} rt/tf rt/clock");
-  const test::Peer peer(kDomain);
-  const RosReaders readers(peer, ns);
-  const Seen seen = PublishUntilSeen(*sink, readers, Record(ns), true);
+  const Seen seen = PublishUntilSeen(*twin.sink, twin.readers, Record(ns), true);
 
   ASSERT_FALSE(seen.odom.empty());
   ExpectPoseFrame(seen.odom.front(), ns);
@@ -193,16 +183,11 @@ TEST_F(DdsRosTopicsTest, OnTheVirtualClockOdometryTfAndClockCarryTheTasksTime) {
 }
 
 TEST_F(DdsRosTopicsTest, OnTheRealClockStampsAreSystemTimeAndThereIsNoClockTopic) {
-  constexpr std::uint32_t kDomain = 214;
-  const std::string ns = test::UniqueNamespace("twin");
-  const auto sink = MakeDdsSink({kDomain});
-  sink->Open(Shape(false), ns);
-  EXPECT_EQ(sink->Describe(),
-            "DDS domain 214 rt/" + ns + "/{odom,pose,joint_states,timing,command} rt/tf");
-  const test::Peer peer(kDomain);
-  const RosReaders readers(peer, ns);
+  const TwinOnDds twin(214, false);
+  EXPECT_EQ(twin.sink->Describe(),
+            "DDS domain 214 rt/" + twin.ns + "/{odom,pose,joint_states,timing,command} rt/tf");
   const double before_s = SystemNow();
-  const Seen seen = PublishUntilSeen(*sink, readers, Record(ns), false);
+  const Seen seen = PublishUntilSeen(*twin.sink, twin.readers, Record(twin.ns), false);
   const double after_s = SystemNow();
   ASSERT_FALSE(seen.odom.empty());
   for (const double stamp_s :
@@ -216,12 +201,10 @@ TEST_F(DdsRosTopicsTest, OnTheRealClockStampsAreSystemTimeAndThereIsNoClockTopic
 
 // The twist is the pose's change between two records over their task time, in base_link.
 TEST_F(DdsRosTopicsTest, TwistIsTheBodyFrameVelocityBetweenRecords) {
-  constexpr std::uint32_t kDomain = 215;
-  const std::string ns = test::UniqueNamespace("twin");
-  const auto sink = MakeDdsSink({kDomain});
-  sink->Open(Shape(true), ns);
-  const test::Peer peer(kDomain);
-  const RosReaders readers(peer, ns);
+  const TwinOnDds twin(215, true);
+  const std::string& ns = twin.ns;
+  const auto& sink = twin.sink;
+  const RosReaders& readers = twin.readers;
   ASSERT_TRUE(WaitFor([&] { return readers.AllMatched(); }));
   runtime::TelemetryRecord r = Record(ns);
   sink->Publish(r);
@@ -245,12 +228,10 @@ TEST_F(DdsRosTopicsTest, TwistIsTheBodyFrameVelocityBetweenRecords) {
 // Before the loop's first cycle the record has no values yet (joint_count 0): a JointState
 // then had no names, and the first sample a subscriber got was empty.
 TEST_F(DdsRosTopicsTest, TheFirstJointStateHasTheNamesAndValues) {
-  constexpr std::uint32_t kDomain = 216;
-  const std::string ns = test::UniqueNamespace("twin");
-  const auto sink = MakeDdsSink({kDomain});
-  sink->Open(Shape(true), ns);
-  const test::Peer peer(kDomain);
-  const RosReaders readers(peer, ns);
+  const TwinOnDds twin(216, true);
+  const std::string& ns = twin.ns;
+  const auto& sink = twin.sink;
+  const RosReaders& readers = twin.readers;
   ASSERT_TRUE(WaitFor([&] { return readers.AllMatched(); }));
   runtime::TelemetryRecord before_first_cycle = Record(ns);
   before_first_cycle.task = {};  // the mailbox's value before the loop wrote it
@@ -273,7 +254,7 @@ TEST_F(DdsRosTopicsTest, WritersHaveRos2DefaultQos) {
   constexpr std::uint32_t kDomain = 217;
   const std::string ns = test::UniqueNamespace("twin");
   const auto sink = MakeDdsSink({kDomain});
-  sink->Open(Shape(true), ns);
+  sink->Open(test::TwinShape(true), ns);
   const test::Peer peer(kDomain);
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wold-style-cast"  // Cyclone's pseudo-handle macro
@@ -321,7 +302,7 @@ TEST_F(DdsRosTopicsTest, ALockstepControllerPublishesNoClock) {
   constexpr std::uint32_t kDomain = 218;
   const std::string ns = test::UniqueNamespace("controller");
   const auto sink = MakeDdsSink({kDomain});
-  runtime::TelemetryShape shape = Shape(true);
+  runtime::TelemetryShape shape = test::TwinShape(true);
   shape.role = "controller";
   shape.has_pose = false;
   shape.lockstep = true;

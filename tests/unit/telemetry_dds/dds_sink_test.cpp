@@ -15,47 +15,14 @@ namespace hiltwin::telemetry {
 namespace {
 
 using runtime::RemoteCommand;
+using test::TwinRecord;
+using test::TwinShape;
 using test::WaitFor;
 
 class DdsSinkTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { test::UseLoopbackDds(); }
 };
-
-runtime::TelemetryShape TwinShape() {
-  runtime::TelemetryShape shape;
-  shape.role = "twin";
-  shape.has_pose = true;
-  shape.joint_names = {"left_wheel_joint", "right_wheel_joint"};
-  shape.virtual_clock = true;  // stamps: the task's time (dds_ros_topics_test: system time)
-  return shape;
-}
-
-runtime::TelemetryRecord TwinRecord(const std::string& ns) {
-  runtime::TelemetryRecord r;
-  r.ns = ns;
-  r.role = "twin";
-  r.rate_hz = 1000.0;
-  r.time_s = 12.25;
-  r.cycle = 12'250;
-  r.cycles_planned = 20'000;
-  r.state = lifecycle::State::kRun;
-  r.deadline_misses = 3;
-  r.latency_p99_us = 41.5;
-  r.latency_max_us = 97.25;
-  r.latency_samples = 1000;
-  r.distance_to_violation = std::nullopt;
-  r.verdict_so_far = qos::Verdict::kPass;
-  r.task.has_pose = true;
-  r.task.x_m = 0.5;
-  r.task.y_m = -0.25;
-  r.task.theta_rad = 1.125;
-  r.task.joint_count = 2;
-  r.task.joint_position_rad = {3.5, -1.75, 0.0, 0.0};
-  r.task.joint_position_m = {0.35, -0.175, 0.0, 0.0};
-  r.joint_names = {"left_wheel_joint", "right_wheel_joint"};
-  return r;
-}
 
 struct Joints {
   std::int32_t sec = -1;

@@ -11,11 +11,13 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 #include "fakes/test_paths.h"
+#include "hiltwin/runtime/telemetry.h"
 #include "ros_types.h"
 
 namespace hiltwin::test {
@@ -40,6 +42,44 @@ inline bool WaitFor(const std::function<bool()>& done, int timeout_ms = 5000) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   return true;
+}
+
+/// The twin's telemetry shape: a pose and two wheel joints. `virtual_clock` sets the stamps:
+/// the task's time when true, system time when false.
+inline runtime::TelemetryShape TwinShape(bool virtual_clock = true) {
+  runtime::TelemetryShape shape;
+  shape.role = "twin";
+  shape.has_pose = true;
+  shape.joint_names = {"left_wheel_joint", "right_wheel_joint"};
+  shape.virtual_clock = virtual_clock;
+  return shape;
+}
+
+/// One of the twin's records with every field set to a value a test can read back exactly.
+inline runtime::TelemetryRecord TwinRecord(const std::string& ns) {
+  runtime::TelemetryRecord r;
+  r.ns = ns;
+  r.role = "twin";
+  r.rate_hz = 1000.0;
+  r.time_s = 12.25;
+  r.cycle = 12'250;
+  r.cycles_planned = 20'000;
+  r.state = lifecycle::State::kRun;
+  r.deadline_misses = 3;
+  r.latency_p99_us = 41.5;
+  r.latency_max_us = 97.25;
+  r.latency_samples = 1000;
+  r.distance_to_violation = std::nullopt;
+  r.verdict_so_far = qos::Verdict::kPass;
+  r.task.has_pose = true;
+  r.task.x_m = 0.5;
+  r.task.y_m = -0.25;
+  r.task.theta_rad = 1.125;
+  r.task.joint_count = 2;
+  r.task.joint_position_rad = {3.5, -1.75, 0.0, 0.0};
+  r.task.joint_position_m = {0.35, -0.175, 0.0, 0.0};
+  r.joint_names = {"left_wheel_joint", "right_wheel_joint"};
+  return r;
 }
 
 /// The test's own participant on `domain`.
