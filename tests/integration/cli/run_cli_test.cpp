@@ -233,7 +233,13 @@ TEST_F(RunCli, SigtermMidRunStopsCleanlyWithReportAndCompleteLog) {
       hiltwin::test::Spawn(Args({"--duration", "60", "--rate", "1000", "--priority", "0",
                                  "--report", Path("r.json"), "--log", Path("log.csv")}),
                            Path("out.txt"));
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  // Stop it once the loop is under way: its log holds a few hundred rows (a fixed 1.5 s was
+  // one cycle on a machine at load 19, where the start-up took longer than that).
+  const auto log_started = std::chrono::steady_clock::now();
+  while (hiltwin::test::ReadOutput(Path("log.csv")).size() < 300U * 60U &&
+         std::chrono::steady_clock::now() - log_started < std::chrono::seconds(30)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
   ASSERT_EQ(kill(run.pid(), SIGTERM), 0);
   const auto status = run.WaitFor(std::chrono::seconds(20));
   ASSERT_TRUE(status.has_value()) << "still running 20 s after SIGTERM";

@@ -147,6 +147,16 @@ class TelemetryDds : public ::testing::Test {
     return row;
   }
 
+  // Waits (up to 10 s) until the probe writing `out` received a timing record: the task is
+  // publishing, so a monitor started now finds it however slowly the machine started it.
+  void WaitForTiming(const std::string& out) const {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (Samples(ReadLines(Path(out)), "timing").empty()) {
+      ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no timing record on the probe";
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
   static std::vector<Json> Samples(const std::vector<Json>& lines, const std::string& topic) {
     std::vector<Json> samples;
     for (const Json& j : lines) {
@@ -289,9 +299,10 @@ TEST_F(TelemetryDds, RosDomainIdPicksTheDomainOfRunAndMonitor) {
   const std::string ns = Ns("twin");
   const ScopedRosDomainId env("227");
   Process probe = Probe(kDomain, ns, "probe.jsonl");
-  std::vector<std::string> argv = Twin(kDomain, ns, "3");
+  std::vector<std::string> argv = Twin(kDomain, ns, "6");
   std::replace(argv.begin(), argv.end(), std::string("dds:227"), std::string("dds"));
   Process twin = hiltwin::test::Spawn(argv, Path("twin.out"));
+  ASSERT_NO_FATAL_FAILURE(WaitForTiming("probe.jsonl"));  // at load 19 it took over 2 s
   const auto monitor = hiltwin::test::Run({HILTWIN_BINARY, "monitor", "--json", "--wait", "2"});
   ASSERT_EQ(monitor.exit_code, 0) << monitor.out << monitor.err;
   const Json listed = Json::parse(monitor.out);
