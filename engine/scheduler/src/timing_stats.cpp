@@ -9,6 +9,7 @@ void TimingStats::Reset() noexcept {
   min_ns_ = std::numeric_limits<std::int64_t>::max();
   max_ns_ = std::numeric_limits<std::int64_t>::min();
   sum_ns_ = 0;
+  last_ns_ = std::numeric_limits<std::int64_t>::min();
 }
 
 TimingSummary TimingStats::Summary() const noexcept {

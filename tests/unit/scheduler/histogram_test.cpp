@@ -126,6 +126,40 @@ TEST(TimingStats, EmptyAndResetReadAsZeroWhateverWasRecorded) {
   EXPECT_EQ(s.Summary().p999_ns, 5);
 }
 
+TEST(TimingStats, RunsOfEqualValuesCountLikeAnyOther) {
+  // Runs of repeated values (the cheap path) mixed with changes, signed, against a histogram
+  // fed every |value| and the exact figures.
+  std::mt19937_64 rng(11);
+  TimingStats s;
+  LogLinearHistogram reference;
+  std::int64_t lo = INT64_MAX, hi = INT64_MIN, sum = 0;
+  std::int64_t v = 0;
+  for (int i = 0; i < 200'000; ++i) {
+    if (rng() % 4 == 0) v = static_cast<std::int64_t>(rng() % 2'000'001) - 1'000'000;
+    s.Record(v);
+    reference.Record(v < 0 ? -v : v);
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    sum += v;
+  }
+  const TimingSummary got = s.Summary();
+  EXPECT_EQ(got.count, 200'000U);
+  EXPECT_EQ(got.min_ns, lo);
+  EXPECT_EQ(got.max_ns, hi);
+  EXPECT_DOUBLE_EQ(got.mean_ns, static_cast<double>(sum) / 200'000.0);
+  for (const double q : {0.0, 0.5, 0.99, 0.999, 1.0}) {
+    EXPECT_EQ(s.histogram().ValueAtQuantile(q), reference.ValueAtQuantile(q)) << q;
+  }
+  for (std::size_t i = 0; i < LogLinearHistogram::BucketCount(); ++i) {
+    ASSERT_EQ(s.histogram().CountAt(i), reference.CountAt(i)) << i;
+  }
+  s.Reset();  // a value equal to the last before the reset is a first value again
+  s.Record(v);
+  EXPECT_EQ(s.Summary().count, 1U);
+  EXPECT_EQ(s.Summary().min_ns, v);
+  EXPECT_EQ(s.Summary().max_ns, v);
+}
+
 TEST(TimingStats, ExactMinMeanMaxAndSignedJitter) {
   TimingStats s;
   for (std::int64_t v : {-300, 100, 200, 1000}) s.Record(v);

@@ -25,10 +25,17 @@ class LogLinearHistogram {
   /// Inline and branch-free but for the top bucket: the loop records several values a cycle.
   void Record(std::int64_t value_ns) noexcept {
     value_ns = std::max<std::int64_t>(value_ns, 0);
-    ++counts_[BucketIndex(value_ns)];
+    last_index_ = BucketIndex(value_ns);
+    ++counts_[last_index_];
     // The sentinels of an empty histogram (Reset) make the first value both extremes.
     min_ns_ = std::min(min_ns_, value_ns);
     max_ns_ = std::max(max_ns_, value_ns);
+    ++count_;
+  }
+  /// Adds the value recorded last once more (after at least one Record): its bucket is known
+  /// and the extremes cannot move.
+  void RecordLastAgain() noexcept {
+    ++counts_[last_index_];
     ++count_;
   }
   void Reset() noexcept;
@@ -68,6 +75,7 @@ class LogLinearHistogram {
   std::uint64_t count_ = 0;
   std::int64_t min_ns_ = std::numeric_limits<std::int64_t>::max();  // of the values recorded
   std::int64_t max_ns_ = 0;
+  std::size_t last_index_ = 0;  // bucket of the value recorded last
 };
 
 }  // namespace hiltwin::scheduler
