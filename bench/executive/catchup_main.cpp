@@ -88,7 +88,8 @@ double RunDrain(const Options& o, bool old_path, std::size_t& catch_up_cycles) {
   config.max_cycles = kCyclesPerStall * static_cast<std::uint64_t>(o.stalls);
   config.overrun_policy = sched::OverrunPolicy::kCatchUp;
   sched::Executive executive(clock, config);
-  const auto capacity = static_cast<std::size_t>(o.stalls) * static_cast<std::size_t>(o.stall_periods + 2);
+  const auto capacity =
+      static_cast<std::size_t>(o.stalls) * static_cast<std::size_t>(o.stall_periods + 2);
   DrainObserver drain(clock, config.period_ns, old_path, capacity);
   executive.AddObserver(drain);
   StallingTask task(clock, config.period_ns * o.stall_periods + config.period_ns / 2);
