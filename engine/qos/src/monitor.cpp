@@ -133,9 +133,9 @@ bool QosMonitor::Bit(std::uint64_t index) const noexcept {
 
 void QosMonitor::SetBit(std::uint64_t index, bool value) noexcept {
   const std::uint64_t slot = index & ring_mask_;
-  const std::uint64_t mask = std::uint64_t{1} << (slot & 63);
+  const std::uint64_t shift = slot & 63;
   std::uint64_t& word = ring_words_[slot >> 6];
-  word = value ? (word | mask) : (word & ~mask);
+  word = (word & ~(std::uint64_t{1} << shift)) | (std::uint64_t{value} << shift);
 }
 
 void QosMonitor::MarkViolation(std::size_t rule, std::uint64_t cycle) noexcept {
@@ -151,9 +151,7 @@ void QosMonitor::MarkViolation(std::size_t rule, std::uint64_t cycle) noexcept {
 }
 
 std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
-  if (engine.miss_budget > 0) {
-    return ClampDistance(engine.miss_budget > misses_ ? engine.miss_budget - misses_ : 0);
-  }
+  if (engine.miss_budget > 0) return BudgetDistance(engine);
   // No plan: the ratio is judged over the cycles run so far. Smallest j >= 1 with
   // (M + j)·100 >= P·(T + j), i.e. j >= (P·T - 100·M) / (100 - P).
   const double pct = engine.max_miss_pct;
@@ -210,7 +208,9 @@ std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
       abort_rule_ = rule;
     }
   }
-  status.distance_to_failure = RatioDistance(engine);
+  // With a plan (every timed run) the distance is the budget left: no call for it.
+  status.distance_to_failure =
+      engine.miss_budget > 0 ? BudgetDistance(engine) : RatioDistance(engine);
 }
 
 bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
@@ -225,17 +225,14 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
   }
   const std::uint64_t t = judged_cycles_;  // judged index of this cycle
   ++judged_cycles_;
-  if (missed) {
-    ++misses_;
-    ++run_;
-    max_run_ = std::max(max_run_, run_);
-  } else {
-    run_ = 0;
-  }
+  misses_ += missed ? 1U : 0U;
+  run_ = missed ? run_ + 1 : 0;
+  max_run_ = std::max(max_run_, run_);
 
   std::uint32_t min_distance = kNeverFails;
   bool any_violated = false;
-  for (std::size_t i = 0; i < engines_.size(); ++i) {
+  const std::size_t rules = engines_.size();
+  for (std::size_t i = 0; i < rules; ++i) {
     Engine& engine = engines_[i];
     RuleStatus& status = status_[i];
     bool violated_now = false;
@@ -250,7 +247,11 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
             violated_now ? 0 : ClampDistance(engine.allowed_misses + 1 - run_);
         break;
       case RuleKind::kMissRatio:
-        UpdateRatioRule(engine, status, i, cycle);
+        // A met cycle can only lower the ratio: a rule that holds still holds, its budget and
+        // distance (under a plan) are unchanged, so only a miss or a violated rule is worked.
+        if (missed || status.violated || engine.miss_budget == 0) {
+          UpdateRatioRule(engine, status, i, cycle);
+        }
         break;
     }
     if (violated_now) MarkViolation(i, cycle);

@@ -28,43 +28,29 @@ CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
       violations_seen_(monitor.rules().size(), 0) {}
 
 scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
-  rules_ = lifecycle_.rules();
+  // The rules change only with the state, which changes a few times a run.
+  const lifecycle::State state = lifecycle_.state();
+  if (!rules_state_ || *rules_state_ != state) [[unlikely]] {
+    rules_state_ = state;
+    rules_ = lifecycle::RulesOf(state);
+  }
   stepped_ = false;
-  peer_stop_seen_ = false;
   step_status_ = StepStatus::Ok();
   const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
   const io::ExchangeStatus io = task_.Exchange(rules_.live_outputs);
   io_ns_ = clock_.NowNs() - io_start_ns;
   io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
-  if (io_fault_) {
-    TraceIoError(context.cycle, tracing::IoErrorKind::kFault);
-    NoteFault(StopReason::kIoFault, context.cycle, io.reason);
-    return scheduler::CycleAction::kContinue;  // OnCycle still records the cycle, then stops
+  peer_stop_seen_ = false;
+  if (!io.ok() || io.peer_absent || io.pulse_limit || io.peer_stopped != nullptr) [[unlikely]] {
+    NoteExchange(io, context.cycle);
+    if (io_fault_) return scheduler::CycleAction::kContinue;  // OnCycle records, then stops
   }
-  if (!io.ok()) {
-    ++counts_.io_errors;  // the task held its inputs
-    TraceIoError(context.cycle, tracing::IoErrorKind::kHeldInputs);
-  }
-  if (io.peer_absent) {
-    ++counts_.peer_absent_cycles;
-    TraceIoError(context.cycle, tracing::IoErrorKind::kPeerAbsent);
-  }
-  if (io.pulse_limit) {
-    ++counts_.pulse_limit_cycles;
-    TraceIoError(context.cycle, tracing::IoErrorKind::kPulseLimit);
-  }
-  peer_stop_seen_ = io.peer_stopped != nullptr;
-  if (peer_stop_seen_ && peer_stopped_ == nullptr) peer_stopped_ = io.peer_stopped;
   if (!rules_.steps_model) {
     ++counts_.paused_cycles;
     return scheduler::CycleAction::kContinue;
   }
   step_status_ = task_.Step(context);
-  const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(context.cycle);
-  if (extra_ns > 0) {
-    HILTWIN_TRACE(overrun_injected, context.cycle, extra_ns);
-    clock_.SpendNs(extra_ns);
-  }
+  if (!injector_.empty()) InjectOverrun(context.cycle);
   if (!virtual_compute_ns_.empty()) {
     clock_.SpendNs(virtual_compute_ns_[context.cycle % virtual_compute_ns_.size()]);
   }
@@ -74,6 +60,36 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
     stepped_ = true;
   }
   return scheduler::CycleAction::kContinue;
+}
+
+void CycleRunner::NoteExchange(const io::ExchangeStatus& io, std::uint64_t cycle) noexcept {
+  if (io_fault_) {
+    TraceIoError(cycle, tracing::IoErrorKind::kFault);
+    NoteFault(StopReason::kIoFault, cycle, io.reason);
+    return;  // the step is not run on stale inputs: nothing else of this exchange counts
+  }
+  if (!io.ok()) {
+    ++counts_.io_errors;  // the task held its inputs
+    TraceIoError(cycle, tracing::IoErrorKind::kHeldInputs);
+  }
+  if (io.peer_absent) {
+    ++counts_.peer_absent_cycles;
+    TraceIoError(cycle, tracing::IoErrorKind::kPeerAbsent);
+  }
+  if (io.pulse_limit) {
+    ++counts_.pulse_limit_cycles;
+    TraceIoError(cycle, tracing::IoErrorKind::kPulseLimit);
+  }
+  peer_stop_seen_ = io.peer_stopped != nullptr;
+  if (peer_stop_seen_ && peer_stopped_ == nullptr) peer_stopped_ = io.peer_stopped;
+}
+
+void CycleRunner::InjectOverrun(std::uint64_t cycle) noexcept {
+  const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(cycle);
+  if (extra_ns > 0) {
+    HILTWIN_TRACE(overrun_injected, cycle, extra_ns);
+    clock_.SpendNs(extra_ns);
+  }
 }
 
 scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sample) noexcept {

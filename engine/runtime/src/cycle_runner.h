@@ -108,6 +108,11 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   /// unchanged, the common case).
   bool PostEvents(const scheduler::TimingSample& sample) noexcept;
   void NoteFault(lifecycle::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
+  /// Counts and traces an exchange that was not plainly ok (out of the common cycle's path).
+  [[gnu::cold, gnu::noinline]] void NoteExchange(const io::ExchangeStatus& io,
+                                                 std::uint64_t cycle) noexcept;
+  /// Spends the injected extra compute time of `cycle`, if any (only with --inject-overrun).
+  [[gnu::noinline]] void InjectOverrun(std::uint64_t cycle) noexcept;
 
   RunTask& task_;
   kernel_glue::Clock& clock_;
@@ -129,6 +134,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   // This cycle, from Step to OnCycle. Only the loop thread changes the state while the loop
   // runs, so the rules read in Step hold until OnCycle posts events.
   lifecycle::StateRules rules_;
+  std::optional<lifecycle::State> rules_state_;  ///< the state rules_ are of (none yet)
   kernel_glue::TimeNs io_ns_ = 0;
   bool stepped_ = false;
   bool io_fault_ = false;

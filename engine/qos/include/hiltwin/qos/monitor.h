@@ -149,6 +149,11 @@ class QosMonitor {
   void UpdateRatioRule(const Engine& engine, RuleStatus& status, std::size_t rule,
                        std::uint64_t cycle) noexcept;
   [[nodiscard]] std::uint32_t RatioDistance(const Engine& engine) const noexcept;
+  /// The ratio rule's distance under a plan: the misses its budget has left.
+  [[nodiscard]] std::uint32_t BudgetDistance(const Engine& engine) const noexcept {
+    const std::uint64_t left = engine.miss_budget > misses_ ? engine.miss_budget - misses_ : 0;
+    return left >= kNeverFails ? kNeverFails : static_cast<std::uint32_t>(left);
+  }
 
   QosConfig config_;
   std::vector<RuleStatus> status_;

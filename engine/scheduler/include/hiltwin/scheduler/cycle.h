@@ -13,8 +13,8 @@ using kernel_glue::TimeNs;
 struct TimingSample {
   std::uint64_t cycle = 0;        ///< release index k (release = t0 + k·period)
   TimeNs release_ns = 0;          ///< when the cycle should have started
-  TimeNs wake_ns = 0;             ///< when the sleep returned
-  TimeNs start_ns = 0;            ///< when the step began
+  TimeNs wake_ns = 0;             ///< when the sleep returned (catch-up: when it was skipped)
+  TimeNs start_ns = 0;            ///< when the step began: the same clock reading as wake_ns
   TimeNs end_ns = 0;              ///< when the step (and its I/O) ended
   TimeNs io_ns = 0;               ///< of end - start, the time the step spent in I/O
   std::uint32_t releases_skipped = 0;  ///< releases after this one dropped by kSkip (each a miss)
