@@ -59,6 +59,13 @@ std::uint8_t FrameCrcOf(const FrameBytes& bytes, std::index_sequence<kPositions.
 std::uint8_t FrameCrc(const FrameBytes& bytes) noexcept {
   return FrameCrcOf(bytes, std::make_index_sequence<kCrcOffset>{});
 }
+/// FrameCrc of a frame whose bytes 2..9 are zero (NOOP, RESET: the fetch and its answer, two of
+/// the seven frames an exchange codes): only bytes 0, 1 and 10 contribute.
+std::uint8_t EmptyFrameCrc(const FrameBytes& bytes) noexcept {
+  return static_cast<std::uint8_t>(kFrameCrc.of_zeros ^ kFrameCrc.at[0][bytes[0]] ^
+                                   kFrameCrc.at[1][bytes[1]] ^
+                                   kFrameCrc.at[kStatusOffset][bytes[kStatusOffset]]);
+}
 
 // What bytes 2..9 hold, per opcode, direction and host image: decided by a lookup, not by
 // branches per frame.
@@ -201,6 +208,9 @@ FrameError CheckEncWords(std::uint64_t body, std::uint64_t carried) noexcept {
   const std::uint64_t allowed = carried & ~AllLanes(kEncReservedBit);
   return (body & ~allowed) == 0 ? FrameError::kOk : FrameError::kReservedBits;
 }
+FrameError CheckWords(std::uint64_t body, Payload payload, std::uint64_t carried) noexcept {
+  return payload == Payload::kPwm ? CheckPwmWords(body, carried) : CheckEncWords(body, carried);
+}
 FrameError CheckPayload(const FrameBytes& in, Payload payload, std::uint64_t carried) noexcept {
   switch (payload) {
     case Payload::kNone: return GetBody(in) == 0 ? FrameError::kOk : FrameError::kReservedBits;
@@ -211,6 +221,27 @@ FrameError CheckPayload(const FrameBytes& in, Payload payload, std::uint64_t car
     case Payload::kRaw: break;
   }
   return FrameError::kOk;
+}
+
+/// What every frame is checked for first, in this order: CRC, opcode, status byte.
+FrameError CheckHeader(const FrameBytes& in, Direction direction) noexcept {
+  const std::uint8_t crc = GetBody(in) == 0 ? EmptyFrameCrc(in) : FrameCrc(in);
+  if (crc != in[kCrcOffset]) return FrameError::kChecksum;
+  if (in[0] > static_cast<std::uint8_t>(Opcode::kTest)) return FrameError::kOpcode;
+  const std::uint8_t status = in[kStatusOffset];
+  if (direction == Direction::kRequest ? status != 0 : (status & ~kStatusMask) != 0) {
+    return FrameError::kReservedBits;
+  }
+  return FrameError::kOk;
+}
+
+/// Bytes 0, 1, 10 and 11 around a payload already in place.
+void PutHeader(unsigned op, std::uint8_t sequence, std::uint8_t answer_status, bool empty_body,
+               FrameBytes& out) noexcept {
+  out[0] = static_cast<std::uint8_t>(op);
+  out[1] = sequence;
+  out[kStatusOffset] = answer_status;
+  out[kCrcOffset] = empty_body ? EmptyFrameCrc(out) : FrameCrc(out);
 }
 
 // Decoding writes the carried words only: a per-channel frame leaves the other slots as they were.
@@ -319,7 +350,8 @@ FrameError Encode(const Frame& frame, Direction direction, Image host_image,
   const bool answer = direction == Direction::kAnswer;
   if (answer && (frame.status & ~kStatusMask) != 0) return FrameError::kReservedBits;
   // Every byte is written exactly once: no clearing pass before the fields.
-  switch (kPayloads[PayloadIndex(op, direction, host_image)]) {
+  const Payload payload = kPayloads[PayloadIndex(op, direction, host_image)];
+  switch (payload) {
     case Payload::kPwm:
       if (!PutPwmWords(frame, kCarriedLanes[op], out)) return FrameError::kOutOfRange;
       break;
@@ -340,22 +372,17 @@ FrameError Encode(const Frame& frame, Direction direction, Image host_image,
     case Payload::kRaw: std::memcpy(&out[kPayloadOffset], frame.raw.data(), kPayloadBytes); break;
     case Payload::kNone: std::memset(&out[kPayloadOffset], 0, kPayloadBytes); break;
   }
-  out[0] = static_cast<std::uint8_t>(op);
-  out[1] = frame.sequence;
-  out[kStatusOffset] = answer ? frame.status : std::uint8_t{0};
-  out[kCrcOffset] = FrameCrc(out);
+  PutHeader(op, frame.sequence, answer ? frame.status : std::uint8_t{0},
+            payload == Payload::kNone, out);
   return FrameError::kOk;
 }
 
 FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
                   Frame& out) noexcept {
-  if (FrameCrc(in) != in[kCrcOffset]) return FrameError::kChecksum;
+  const FrameError header = CheckHeader(in, direction);
+  if (header != FrameError::kOk) return header;
   const unsigned op = in[0];
-  if (op > static_cast<unsigned>(Opcode::kTest)) return FrameError::kOpcode;
   const std::uint8_t status = in[kStatusOffset];
-  if (direction == Direction::kRequest ? status != 0 : (status & ~kStatusMask) != 0) {
-    return FrameError::kReservedBits;
-  }
   const Payload payload = kPayloads[PayloadIndex(op, direction, host_image)];
   // Validate everything before writing `out`, so a refused frame changes nothing.
   const FrameError error = CheckPayload(in, payload, kCarriedLanes[op]);
@@ -376,6 +403,33 @@ FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
     case Payload::kRaw: std::memcpy(out.raw.data(), &in[kPayloadOffset], kPayloadBytes); break;
     case Payload::kNone: break;
   }
+  return FrameError::kOk;
+}
+
+constexpr auto kAllOpcode = static_cast<unsigned>(Opcode::kAll);
+
+FrameError EncodeAll(const AllFrame& frame, Direction direction, Image host_image,
+                     FrameBytes& out) noexcept {
+  const bool answer = direction == Direction::kAnswer;
+  if (answer && (frame.status & ~kStatusMask) != 0) return FrameError::kReservedBits;
+  const Payload payload = kPayloads[PayloadIndex(kAllOpcode, direction, host_image)];
+  const FrameError error = CheckWords(frame.words, payload, kCarriedLanes[kAllOpcode]);
+  if (error != FrameError::kOk) return error;
+  PutBody(out, frame.words);
+  PutHeader(kAllOpcode, frame.sequence, answer ? frame.status : std::uint8_t{0}, false, out);
+  return FrameError::kOk;
+}
+
+FrameError DecodeAll(const FrameBytes& in, Direction direction, Image host_image,
+                     AllFrame& out) noexcept {
+  const FrameError header = CheckHeader(in, direction);
+  if (header != FrameError::kOk) return header;
+  if (in[0] != kAllOpcode) return FrameError::kOpcode;
+  const std::uint64_t words = GetBody(in);
+  const Payload payload = kPayloads[PayloadIndex(kAllOpcode, direction, host_image)];
+  const FrameError error = CheckWords(words, payload, kCarriedLanes[kAllOpcode]);
+  if (error != FrameError::kOk) return error;
+  out = AllFrame{in[1], in[kStatusOffset], words};
   return FrameError::kOk;
 }
 
