@@ -29,7 +29,9 @@ std::uint8_t BitwiseCrc(const FrameBytes& b) {
 // ---- The reference: the per-field codec before the fast paths. ----
 Payload RefPayloadOf(unsigned op, Direction direction, Image host_image) {
   if (op == 0 || op == 2) return Payload::kNone;
-  if (op == 1) return direction == Direction::kRequest ? Payload::kInitRequest : Payload::kInitAnswer;
+  if (op == 1) {
+    return direction == Direction::kRequest ? Payload::kInitRequest : Payload::kInitAnswer;
+  }
   if (op == 3) {
     const bool pwm = (direction == Direction::kRequest) == (host_image == Image::kIcoboard);
     return pwm ? Payload::kPwm : Payload::kEnc;
@@ -159,7 +161,8 @@ Frame RandomFrame(std::mt19937_64& rng, unsigned op, bool in_range) {
                        Pick(rng, 0, 1) == 1};
   }
   for (auto& b : f.raw) b = Pick<std::uint8_t>(rng, 0, 255);
-  f.init_request = {Pick<std::uint32_t>(rng, 0, 0xFFFF'FFFFU), Pick<std::uint32_t>(rng, 0, 0xFFFF'FFFFU)};
+  f.init_request = {Pick<std::uint32_t>(rng, 0, 0xFFFF'FFFFU),
+                    Pick<std::uint32_t>(rng, 0, 0xFFFF'FFFFU)};
   f.init_answer = {Pick<std::uint8_t>(rng, 0, 255), Pick<std::uint8_t>(rng, 0, 255),
                    Pick<std::uint8_t>(rng, 0, 255), Pick<std::uint32_t>(rng, 0, 0xFFFF'FFFFU)};
   return f;
