@@ -57,35 +57,70 @@ void EmulatedFpga::SendAnswer(FrameBytes& miso) noexcept {
 }
 
 void EmulatedFpga::TakeRequest(const FrameBytes& mosi) noexcept {
-  FrameBytes request_bytes = mosi;
-  const bool data = request_bytes[0] != static_cast<std::uint8_t>(Opcode::kNoop);
+  const bool data = mosi[0] != static_cast<std::uint8_t>(Opcode::kNoop);
+  answer_register_data_ = data;
   if (data && faults_.corrupt_requests > 0) {
     --faults_.corrupt_requests;
+    FrameBytes damaged = mosi;
     const std::uint32_t bit = corrupt_bit_++ % kFrameBits;
-    request_bytes[bit / 8] = static_cast<std::uint8_t>(request_bytes[bit / 8] ^ (1U << (bit % 8)));
+    damaged[bit / 8] = static_cast<std::uint8_t>(damaged[bit / 8] ^ (1U << (bit % 8)));
+    ActOn(damaged);
+  } else {
+    ActOn(mosi);
   }
+}
 
+void EmulatedFpga::ActOn(const FrameBytes& request_bytes) noexcept {
+  if (request_bytes[0] == static_cast<std::uint8_t>(Opcode::kAll)) {
+    TakeAll(request_bytes);
+    return;
+  }
   Frame request;
   Frame answer;
-  const FrameError error = Decode(request_bytes, Direction::kRequest, image_, request);
-  if (error != FrameError::kOk) {
-    // Never act on a damaged request: hold every output, say so in the status byte.
-    ++requests_rejected_;
-    const std::uint8_t op = request_bytes[0];
-    answer.opcode = op <= static_cast<std::uint8_t>(Opcode::kTest) ? static_cast<Opcode>(op)
-                                                                   : Opcode::kNoop;
-    answer.sequence = request_bytes[1];
-    answer.status = kStatusRequestRejected;
-  } else {
-    HandleRequest(request, answer);
+  if (Decode(request_bytes, Direction::kRequest, image_, request) != FrameError::kOk) {
+    Reject(request_bytes);
+    return;
   }
-  if (initialised_) answer.status = static_cast<std::uint8_t>(answer.status | kStatusInitialised);
-  if (pulse_limit_) answer.status = static_cast<std::uint8_t>(answer.status | kStatusPulseLimit);
-
+  HandleRequest(request, answer);
+  answer.status = WithStateBits(answer.status);
   if (Encode(answer, Direction::kAnswer, image_, answer_register_) != FrameError::kOk) {
     answer_register_.fill(0xFF);  // cannot happen for values the model produces; fail visibly
   }
-  answer_register_data_ = data;
+}
+
+void EmulatedFpga::TakeAll(const FrameBytes& request_bytes) noexcept {
+  // The per-cycle frame, word-wide: no Frame between the bytes and the board.
+  AllFrame request;
+  if (DecodeAll(request_bytes, Direction::kRequest, image_, request) != FrameError::kOk) {
+    Reject(request_bytes);
+    return;
+  }
+  AllFrame answer{request.sequence, 0, 0};
+  if (initialised_) answer.words = HandleAll(request.words);  // else zeros, no kStatusInitialised
+  answer.status = WithStateBits(0);
+  if (EncodeAll(answer, Direction::kAnswer, image_, answer_register_) != FrameError::kOk) {
+    answer_register_.fill(0xFF);  // cannot happen for values the model produces; fail visibly
+  }
+}
+
+void EmulatedFpga::Reject(const FrameBytes& request_bytes) noexcept {
+  // Never act on a damaged request: hold every output, say so in the status byte.
+  ++requests_rejected_;
+  Frame answer;
+  const std::uint8_t op = request_bytes[0];
+  answer.opcode = op <= static_cast<std::uint8_t>(Opcode::kTest) ? static_cast<Opcode>(op)
+                                                                 : Opcode::kNoop;
+  answer.sequence = request_bytes[1];
+  answer.status = WithStateBits(kStatusRequestRejected);
+  if (Encode(answer, Direction::kAnswer, image_, answer_register_) != FrameError::kOk) {
+    answer_register_.fill(0xFF);
+  }
+}
+
+std::uint8_t EmulatedFpga::WithStateBits(std::uint8_t status) const noexcept {
+  if (initialised_) status = static_cast<std::uint8_t>(status | kStatusInitialised);
+  if (pulse_limit_) status = static_cast<std::uint8_t>(status | kStatusPulseLimit);
+  return status;
 }
 
 void EmulatedFpga::HandleRequest(const Frame& request, Frame& answer) noexcept {
@@ -95,7 +130,7 @@ void EmulatedFpga::HandleRequest(const Frame& request, Frame& answer) noexcept {
     case Opcode::kNoop: break;
     case Opcode::kInit: HandleInit(request, answer); break;
     case Opcode::kReset: ResetState(); break;
-    case Opcode::kAll: HandleAll(request, answer); break;
+    case Opcode::kAll: break;  // TakeAll
     case Opcode::kTest: answer.raw = request.raw; break;
     default: FillReadback(request.opcode, answer); break;
   }
@@ -125,40 +160,51 @@ void EmulatedFpga::HandleInit(const Frame& request, Frame& answer) noexcept {
   if (image_ == Image::kIcoboardInverse) PublishPeriod();
 }
 
-void EmulatedFpga::HandleAll(const Frame& request, Frame& answer) noexcept {
-  if (!initialised_) return;  // answer carries zeros and no kStatusInitialised
+ChannelWords EmulatedFpga::HandleAll(ChannelWords request_words) noexcept {
   const std::int64_t t_ns =
       clock_ != nullptr ? clock_->NowNs() : static_cast<std::int64_t>(data_frames_) * step_ns_;
   ++data_frames_;
   time_ns_ = t_ns;
+  return image_ == Image::kIcoboardInverse ? SampleTwin(request_words, t_ns)
+                                           : SampleEcs(request_words, t_ns);
+}
 
-  if (image_ == Image::kIcoboardInverse) {
-    pulse_limit_ = false;
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      emulators_[c].SetStuck(faults_.stick_encoder);
-      if (!emulators_[c].StartPeriod(request.enc[c].counts, t_ns)) pulse_limit_ = true;
-      pins_out_[c] = request.enc[c].pin;
-    }
-    PublishPeriod();
-    duty_scratch_.fill(0.0);
-    if (pwm_source_ != nullptr) pwm_source_->DutyAt(t_ns, duty_scratch_);
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      pwm_values_[c] = PwmReaderValue(duty_scratch_[c]);
-      answer.pwm[c] = PwmWordFromValue(pwm_values_[c], pins_in_[c]);
-    }
-  } else {
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      pwm_values_[c] = PwmValueFromWord(request.pwm[c]);
-      pins_out_[c] = request.pwm[c].pin;
-    }
-    if (encoder_source_ != nullptr) {
-      lines_.Update(*encoder_source_, t_ns, faults_.stick_encoder);
-      for (std::size_t c = 0; c < kChannels; ++c) counts_[c] = lines_.relative_counts(c);
-    }
-    for (std::size_t c = 0; c < kChannels; ++c) {
-      answer.enc[c] = EncWord{static_cast<std::int16_t>(counts_[c]), pins_in_[c]};
-    }
+ChannelWords EmulatedFpga::SampleTwin(ChannelWords encoder_words, std::int64_t t_ns) noexcept {
+  bool limited = false;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const EncWord target = UnpackEnc(ChannelWord(encoder_words, c));
+    emulators_[c].SetStuck(faults_.stick_encoder);
+    limited = !emulators_[c].StartPeriod(target.counts, t_ns) || limited;
+    pins_out_[c] = target.pin;
   }
+  pulse_limit_ = limited;
+  PublishPeriod();
+  duty_scratch_.fill(0.0);
+  if (pwm_source_ != nullptr) pwm_source_->DutyAt(t_ns, duty_scratch_);
+  ChannelWords pwm_words = 0;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    pwm_values_[c] = PwmReaderValue(duty_scratch_[c]);
+    pwm_words |= PlaceChannelWord(c, PackPwm(PwmWordFromValue(pwm_values_[c], pins_in_[c])));
+  }
+  return pwm_words;
+}
+
+ChannelWords EmulatedFpga::SampleEcs(ChannelWords pwm_words, std::int64_t t_ns) noexcept {
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const PwmWord word = UnpackPwm(ChannelWord(pwm_words, c));
+    pwm_values_[c] = PwmValueFromWord(word);
+    pins_out_[c] = word.pin;
+  }
+  if (encoder_source_ != nullptr) {
+    lines_.Update(*encoder_source_, t_ns, faults_.stick_encoder);
+    for (std::size_t c = 0; c < kChannels; ++c) counts_[c] = lines_.relative_counts(c);
+  }
+  ChannelWords encoder_words = 0;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const EncWord word{static_cast<std::int16_t>(counts_[c]), pins_in_[c]};
+    encoder_words |= PlaceChannelWord(c, PackEnc(word));
+  }
+  return encoder_words;
 }
 
 void EmulatedFpga::FillReadback(Opcode opcode, Frame& answer) const noexcept {

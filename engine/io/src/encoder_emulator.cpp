@@ -23,8 +23,10 @@ std::uint32_t MaxCountsPerStep(std::int64_t step_ns, std::uint32_t divider) noex
   return MaxPulsesPerPeriod(SubticksPerStep(step_ns, divider));
 }
 
-PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
-                     std::int32_t resolution) noexcept {
+namespace {
+// Table 4.1, inlined into StartPeriod: it runs for every channel of every ALL frame.
+inline PulsePlan PlanTable41(std::int32_t old_counts, std::int32_t new_counts,
+                             std::int32_t resolution) noexcept {
   const std::int32_t half = resolution / 2;
   const std::int32_t difference = new_counts - old_counts;  // in (-resolution, resolution)
   PulsePlan plan;
@@ -40,6 +42,12 @@ PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
     plan = {static_cast<std::uint32_t>(resolution + difference), +1, DifferenceCase::kD};
   }
   return plan;
+}
+}  // namespace
+
+PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
+                     std::int32_t resolution) noexcept {
+  return PlanTable41(old_counts, new_counts, resolution);
 }
 
 std::uint32_t PulseSegment::EdgesBy(std::int64_t t_ns) const noexcept {
@@ -98,7 +106,7 @@ bool EncoderEmulator::StartPeriod(std::int32_t target_counts, std::int64_t t_ns)
     segment_.direction = 0;
     return true;
   }
-  const PulsePlan plan = PlanPulses(reached, WrapToRelative(target_counts));
+  const PulsePlan plan = PlanTable41(reached, WrapToRelative(target_counts), kEncoderResolution);
   last_case_ = plan.difference_case;
   segment_.direction = plan.direction;
   // At most one edge per sub-tick, and never half a turn: a move of 8192 on the 14-bit wrapping

@@ -111,12 +111,22 @@ class EmulatedFpga final : public SpiDevice {
  private:
   void HandleRequest(const Frame& request, Frame& answer) noexcept;
   void HandleInit(const Frame& request, Frame& answer) noexcept;
-  void HandleAll(const Frame& request, Frame& answer) noexcept;
+  /// An ALL frame's sampling moment: takes the request's channel words, returns the answer's.
+  ChannelWords HandleAll(ChannelWords request_words) noexcept;
+  ChannelWords SampleTwin(ChannelWords encoder_words, std::int64_t t_ns) noexcept;
+  ChannelWords SampleEcs(ChannelWords pwm_words, std::int64_t t_ns) noexcept;
   void FillReadback(Opcode opcode, Frame& answer) const noexcept;
   /// Shifts out the answer register, applying the answer faults to answers of non-NOOPs.
   void SendAnswer(FrameBytes& miso) noexcept;
   /// Decodes the request (after the request faults) and acts on it: the new answer register.
   void TakeRequest(const FrameBytes& mosi) noexcept;
+  void ActOn(const FrameBytes& request_bytes) noexcept;
+  /// ALL, the per-cycle request, decoded and answered word-wide.
+  void TakeAll(const FrameBytes& request_bytes) noexcept;
+  /// The answer to a request that failed its checks.
+  void Reject(const FrameBytes& request_bytes) noexcept;
+  /// `status` with INITIALISED and PULSE_LIMIT as the board stands.
+  [[nodiscard]] std::uint8_t WithStateBits(std::uint8_t status) const noexcept;
   void ResetState() noexcept;
   /// Twin image: hands the periods just started to the sink.
   void PublishPeriod() noexcept;
@@ -157,6 +167,13 @@ class EmulatedSpiBus final : public SpiBus {
       : device_(device), name_(name) {}
   BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept override {
     device_.Exchange(mosi, miso);
+    return {};
+  }
+  /// Both transfers straight to the device (an emulated transfer cannot fail).
+  BusStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                         const FrameBytes& fetch, FrameBytes& answer) noexcept override {
+    device_.Exchange(request, request_miso);
+    device_.Exchange(fetch, answer);
     return {};
   }
   [[nodiscard]] const char* Name() const noexcept override { return name_; }

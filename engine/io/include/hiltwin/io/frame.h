@@ -162,6 +162,36 @@ enum class FrameError : std::uint8_t {
 [[nodiscard]] FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
                                 Frame& out) noexcept;
 
+/// The four channel words of a frame (the PackPwm/PackEnc bits) as one value in wire order:
+/// channel c's word in bits 63-16c..48-16c, so bytes 2..9 of the frame are its big-endian bytes.
+/// Word-wide packing for the per-cycle ALL frames.
+using ChannelWords = std::uint64_t;
+[[nodiscard]] constexpr std::uint16_t ChannelWord(ChannelWords words, std::size_t c) noexcept {
+  return static_cast<std::uint16_t>((words >> (48U - 16U * (c & 3U))) & 0xFFFFU);
+}
+/// `word` as channel c's word (OR the four together).
+[[nodiscard]] constexpr ChannelWords PlaceChannelWord(std::size_t c, std::uint16_t word) noexcept {
+  return ChannelWords{word} << (48U - 16U * (c & 3U));
+}
+
+/// An ALL frame (the per-cycle opcode) without a Frame in between: what its bytes 1..10 hold.
+struct AllFrame {
+  std::uint8_t sequence = 0;
+  std::uint8_t status = 0;  ///< kStatus* bits in answers, 0 in requests
+  ChannelWords words = 0;   ///< PWM or encoder words, as PayloadOf(kAll, ...) says
+  friend bool operator==(const AllFrame&, const AllFrame&) = default;
+};
+
+/// Encode() of the ALL frame `frame`: the same bytes and the same checks as for a Frame with
+/// opcode kAll and these words (a word Decode would refuse is refused: kOutOfRange for a PWM
+/// magnitude above 2048, kReservedBits for an encoder word with bit 15 set).
+[[nodiscard]] FrameError EncodeAll(const AllFrame& frame, Direction direction, Image host_image,
+                                   FrameBytes& out) noexcept;
+/// Decode() of an ALL frame: the same checks and errors; `out` untouched on any error. A valid
+/// frame of another opcode gives kOpcode: call Decode for frames whose byte 0 is not kAll.
+[[nodiscard]] FrameError DecodeAll(const FrameBytes& in, Direction direction, Image host_image,
+                                   AllFrame& out) noexcept;
+
 /// Packs/unpacks channel words (exposed for the board model and tests).
 [[nodiscard]] std::uint16_t PackPwm(const PwmWord& word) noexcept;
 [[nodiscard]] std::uint16_t PackEnc(const EncWord& word) noexcept;
