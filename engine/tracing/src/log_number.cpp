@@ -86,22 +86,33 @@ char* WriteUnsigned(char* first, std::uint64_t v) noexcept {
   return WriteZeroPadded(first, v, DigitCount(v));
 }
 
+/// Writes the `count` digits of `digits` from first + 1, then moves the first `whole` of them
+/// left by one and puts the decimal point after them: "d.ddd" in one pass over the digits.
+/// Returns the end.
+char* WriteWithPoint(char* first, std::uint64_t digits, int count, int whole) noexcept {
+  char* const end = WriteZeroPadded(first + 1, digits, count);
+  if (whole == 1) {  // a state's "1.7241130790320105", a duty's "0.7998046875": no memmove
+    first[0] = first[1];
+  } else {
+    std::memmove(first, first + 1, static_cast<std::size_t>(whole));
+  }
+  first[whole] = '.';
+  return end;
+}
+
 /// `units` · 10^-Decimals (units < 10^18) with its trailing zeros and a bare decimal point
 /// removed, e.g. 4.99975, 12, -0.5, -0.
 template <int Decimals>
 char* WriteFixed(char* first, bool negative, std::uint64_t units) noexcept {
   constexpr std::uint64_t kScale = Pow10(Decimals);
   if (negative) *first++ = '-';
-  first = WriteUnsigned(first, units / kScale);
-  std::uint64_t fraction = units % kScale;
-  if (fraction == 0) return first;
-  int decimals = Decimals;
-  while (fraction % 10U == 0) {
-    fraction /= 10U;
-    --decimals;
-  }
-  *first++ = '.';
-  return WriteZeroPadded(first, fraction, decimals);
+  if (units % kScale == 0) return WriteUnsigned(first, units / kScale);
+  // All digits at once, at least one before the point ("0.000250" for 250 micro-units), then
+  // the trailing zeros cut off: the fraction is not 0, so the point stays.
+  const int count = std::max(DigitCount(units), Decimals + 1);
+  char* end = WriteWithPoint(first, units, count, count - Decimals);
+  while (end[-1] == '0') --end;
+  return end;
 }
 
 /// x rounded to a whole number, ties to even, as std::nearbyint in the default rounding mode
@@ -139,16 +150,7 @@ char* FormatShortest(char* first, double value) noexcept {
   const int scientific_chars = count + (count > 1 ? 1 : 0) + 2 + exponent_chars;
   const int decimals = -exponent;
   if (count > decimals) {  // d.ddd: always shorter than d.ddde+XX
-    // The digits one place to the right, then those before the point moved left by one.
-    char* const end = WriteZeroPadded(first + 1, digits, count);
-    const int whole_digits = count - decimals;
-    if (whole_digits == 1) {  // a state's "1.7241130790320105": no memmove call
-      first[0] = first[1];
-    } else {
-      std::memmove(first, first + 1, static_cast<std::size_t>(whole_digits));
-    }
-    first[whole_digits] = '.';
-    return end;
+    return WriteWithPoint(first, digits, count, count - decimals);
   }
   if (2 + decimals <= scientific_chars) {  // 0.000ddd, fixed on a tie as std::to_chars
     *first++ = '0';
@@ -187,19 +189,22 @@ char* FormatLogNumber(char* first, double value) noexcept {
   if (magnitude < 1e6) {
     const double micros = RoundWhole(magnitude * 1e6);
     if (micros / 1e6 == magnitude) {
-      return WriteFixed<6>(first, negative, static_cast<std::uint64_t>(micros));
+      // int64: one conversion instruction (micros < 10^12); uint64 takes a branch more.
+      return WriteFixed<6>(first, negative, static_cast<std::uint64_t>(
+                                                static_cast<std::int64_t>(micros)));
     }
     const double steps = magnitude * 2048.0;  // exact: a power-of-two scale, below 2^31
-    const auto whole_steps = static_cast<std::uint64_t>(steps);
+    const auto whole_steps = static_cast<std::int64_t>(steps);
     if (static_cast<double>(whole_steps) == steps) {
       // n / 2^11 = n · 5^11 / 10^11; below 10^6 · 2^11 · 5^11 < 2^57, no overflow.
-      return WriteFixed<11>(first, negative, whole_steps * 48'828'125U);
+      return WriteFixed<11>(first, negative,
+                            static_cast<std::uint64_t>(whole_steps) * 48'828'125U);
     }
   } else if (magnitude < 9007199254740992.0) {  // 2^53: every whole double below is exact
-    const auto whole = static_cast<std::uint64_t>(magnitude);
+    const auto whole = static_cast<std::int64_t>(magnitude);
     if (static_cast<double>(whole) == magnitude) {
       if (negative) *first++ = '-';
-      return WriteUnsigned(first, whole);
+      return WriteUnsigned(first, static_cast<std::uint64_t>(whole));
     }
   }
   return FormatShortest(first, value);
