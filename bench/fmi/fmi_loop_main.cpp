@@ -148,7 +148,7 @@ double TwinInstructionsPerStep(const std::string& hiltwin, const char* fmu_path,
 
 fs::path WriteLagMap(const fs::path& dir) {
   fs::create_directories(dir);
-  const fs::path map = dir / "lag_map.toml";
+  fs::path map = dir / "lag_map.toml";
   std::ofstream(map) << "[[pwm]]\nchannel = 1\ninput = \"u\"\ngain = 1.0\n\n"
                         "[[encoder]]\nchannel = 1\noutput = \"y\"\nunit = \"rad\"\n"
                         "counts_per_unit = 651.9\n";
