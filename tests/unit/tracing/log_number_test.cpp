@@ -1,0 +1,200 @@
+// The log cell formatter (engine/tracing/src/log_number.h) against the one it replaced, kept
+// here verbatim as the reference: the log must stay byte-identical. And its shortest form
+// against std::to_chars, whose text the log format names.
+#include "log_number.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using hiltwin::tracing::detail::FormatLogNumber;
+using hiltwin::tracing::detail::FormatShortest;
+using hiltwin::tracing::detail::kMaxNumberChars;
+using hiltwin::tracing::detail::kNumberScratchChars;
+
+// ---- The reference: csv_logger.cpp's FormatFixed and FormatDouble before issue 36. ----
+char* RefFormatFixed(char* first, char* last, bool negative, std::uint64_t units, int decimals) {
+  if (negative) *first++ = '-';
+  std::uint64_t scale = 1;
+  for (int i = 0; i < decimals; ++i) scale *= 10U;
+  first = std::to_chars(first, last, units / scale).ptr;
+  std::uint64_t fraction = units % scale;
+  if (fraction == 0) return first;
+  while (fraction % 10U == 0) {
+    fraction /= 10U;
+    --decimals;
+  }
+  *first++ = '.';
+  char* const end = first + decimals;
+  for (char* p = end; p != first; fraction /= 10U) *--p = static_cast<char>('0' + fraction % 10U);
+  return end;
+}
+
+char* RefFormatDouble(char* first, char* last, double value) {
+  if (std::isnan(value)) return std::copy_n("NaN", 3, first);
+  if (std::isinf(value)) {
+    if (value < 0) *first++ = '-';
+    return std::copy_n("Inf", 3, first);
+  }
+  const double magnitude = std::fabs(value);
+  const bool negative = std::signbit(value);
+  if (magnitude < 1e6) {
+    const double micros = std::nearbyint(magnitude * 1e6);
+    if (micros / 1e6 == magnitude) {
+      return RefFormatFixed(first, last, negative, static_cast<std::uint64_t>(micros), 6);
+    }
+    const double steps = magnitude * 2048.0;
+    if (steps == std::floor(steps)) {
+      return RefFormatFixed(first, last, negative,
+                            static_cast<std::uint64_t>(steps) * 48'828'125U, 11);
+    }
+  } else if (magnitude < 9007199254740992.0) {
+    const auto whole = static_cast<std::int64_t>(value);
+    if (static_cast<double>(whole) == value) return std::to_chars(first, last, whole).ptr;
+  }
+  return std::to_chars(first, last, value).ptr;
+}
+// ---- end of the reference ----
+
+std::string Reference(double value) {
+  char text[64];
+  return {text, RefFormatDouble(text, text + sizeof text, value)};
+}
+
+// The text, after checking that it and the scratch written past it stay in their room.
+std::string Cell(double value) {
+  char text[kMaxNumberChars + kNumberScratchChars + 16];
+  std::fill(std::begin(text), std::end(text), '#');
+  char* const end = FormatLogNumber(text, value);
+  EXPECT_LE(end - text, static_cast<std::ptrdiff_t>(kMaxNumberChars)) << Reference(value);
+  EXPECT_TRUE(std::all_of(end + kNumberScratchChars, std::end(text), [](char c) {
+    return c == '#';
+  })) << Reference(value);
+  return {text, end};
+}
+
+std::string StdShortest(double value) {
+  char text[64];
+  return {text, std::to_chars(text, text + sizeof text, value).ptr};
+}
+
+std::string Shortest(double value) {
+  char text[kMaxNumberChars + kNumberScratchChars];
+  return {text, FormatShortest(text, value)};
+}
+
+// Compares cell for cell; stops after a few mismatches so a broken build says what, briefly.
+void ExpectSameCells(const std::vector<double>& values) {
+  int mismatches = 0;
+  for (const double v : values) {
+    const std::string expected = Reference(v);
+    const std::string actual = Cell(v);
+    if (expected != actual) {
+      ADD_FAILURE() << "value " << StdShortest(v) << " (bits 0x" << std::hex
+                    << std::bit_cast<std::uint64_t>(v) << "): expected " << expected << ", got "
+                    << actual;
+      if (++mismatches == 10) return;
+    }
+  }
+}
+
+double FromBits(std::uint64_t bits) { return std::bit_cast<double>(bits); }
+
+TEST(LogNumberTest, SpecialValuesAreSpelledAsBefore) {
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(Cell(std::nan("")), "NaN");
+  EXPECT_EQ(Cell(-std::nan("")), "NaN");
+  EXPECT_EQ(Cell(inf), "Inf");
+  EXPECT_EQ(Cell(-inf), "-Inf");
+  EXPECT_EQ(Cell(0.0), "0");
+  EXPECT_EQ(Cell(-0.0), "-0");
+  EXPECT_EQ(Cell(0.25025000000000003), "0.25025000000000003");
+  EXPECT_EQ(Cell(4.99975), "4.99975");
+  EXPECT_EQ(Cell(0.7998046875), "0.7998046875");
+  EXPECT_EQ(Cell(1e-06), "0.000001");  // the 6-decimal shortcut, not to_chars' 1e-06
+  EXPECT_EQ(Cell(1e-07), "1e-07");
+  EXPECT_EQ(Cell(123456789.0), "123456789");
+  EXPECT_EQ(Cell(-1.7241130790320105), "-1.7241130790320105");
+  ExpectSameCells({std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
+                   std::numeric_limits<double>::min(), std::numeric_limits<double>::denorm_min(),
+                   -std::numeric_limits<double>::denorm_min(), 9007199254740992.0,
+                   9007199254740991.0, -9007199254740993.0, 1e6, 999999.9999995, 1e22, 1e23,
+                   0.1, 0.2, 0.3, 1.0 / 3.0, 5e-324, 1.5e-5, 0.0001, 0.00001});
+}
+
+TEST(LogNumberTest, TwinShapedCellsMatchTheFormerFormatter) {
+  std::vector<double> values;
+  for (std::int64_t k = 0; k < 200'000; ++k) {
+    values.push_back(static_cast<double>(k) * 0.00025);            // time stamps k * h
+    values.push_back(static_cast<double>(k - 100'000) / 2048.0);   // PWM duties
+    values.push_back(static_cast<double>(k * 7919 - 3'000'000));   // counters, encoder counts
+    values.push_back(static_cast<double>(k) * 1e-6 - 0.1);         // microseconds, not exact
+  }
+  ExpectSameCells(values);
+}
+
+TEST(LogNumberTest, ValuesAtTheShortcutsEdgesMatchTheFormerFormatter) {
+  std::vector<double> values;
+  std::mt19937_64 random(36);
+  std::uniform_int_distribution<std::int64_t> units(-999'999'999'999, 999'999'999'999);
+  for (int i = 0; i < 100'000; ++i) {
+    // n micro-units and their neighbours, and half-way points the rounding must treat alike.
+    const double v = static_cast<double>(units(random)) / 1e6;
+    values.push_back(v);
+    values.push_back(std::nextafter(v, 0.0));
+    values.push_back(std::nextafter(v, 2e6));
+    values.push_back((static_cast<double>(units(random)) + 0.5) / 1e6);
+    values.push_back(static_cast<double>(units(random) % 1'000'000'000) / 2048.0);
+  }
+  for (int e = -30; e <= 30; ++e) {
+    const double p = std::pow(10.0, e);
+    for (const double v : {p, std::nextafter(p, 0.0), std::nextafter(p, 1e300), 1e6 - p}) {
+      values.push_back(v);
+      values.push_back(-v);
+    }
+  }
+  ExpectSameCells(values);
+}
+
+TEST(LogNumberTest, RandomDoublesMatchTheFormerFormatter) {
+  std::vector<double> values;
+  std::mt19937_64 random(3636);
+  std::uniform_real_distribution<double> state(-10.0, 10.0);
+  for (int i = 0; i < 200'000; ++i) {
+    values.push_back(FromBits(random()));  // every exponent, NaN and Inf included
+    values.push_back(state(random));       // a model's states: full precision
+    values.push_back(state(random) * 1e-5);
+  }
+  ExpectSameCells(values);
+}
+
+TEST(LogNumberTest, ShortestIsTheStandardLibrarysText) {
+  std::mt19937_64 random(360);
+  int mismatches = 0;
+  for (int i = 0; i < 300'000 && mismatches < 10; ++i) {
+    const double v = FromBits(random());
+    if (!std::isfinite(v)) continue;
+    if (Shortest(v) != StdShortest(v)) {
+      ++mismatches;
+      ADD_FAILURE() << "bits 0x" << std::hex << std::bit_cast<std::uint64_t>(v) << ": expected "
+                    << StdShortest(v) << ", got " << Shortest(v);
+    }
+  }
+  for (const double v : {1e-5, 1.5e-5, 1.2345e-4, 0.001, 1e-100, 1.25e-100, 4.9e-324, 1e21,
+                         123456789012345678901.0, -0.0, 0.0}) {
+    EXPECT_EQ(Shortest(v), StdShortest(v));
+    EXPECT_EQ(Shortest(-v), StdShortest(-v));
+  }
+}
+
+}  // namespace
