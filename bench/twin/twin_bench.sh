@@ -49,8 +49,8 @@ for variant in with without; do
   target=0.8; [[ $variant == without ]] && target=0.5
   whole=$(cut -d' ' -f1 "$tmp/$variant" | median); loop=$(cut -d' ' -f2 "$tmp/$variant" | median)
   met=$([[ $(echo "$whole <= $target" | bc) == 1 ]] && echo met || echo "NOT met")
-  printf '  median of 3, %s the log: whole command %s s (%.0fx real time), loop %s s (target <= %s s: %s)\n' \
-    "$variant" "$whole" "$(echo "600 / $whole" | bc -l)" "$loop" "$target" "$met"
+  printf '  median of 3 %s the log: whole command %s s (target <= %s s: %s; %.0fx real time), loop %s s\n' \
+    "$variant" "$whole" "$target" "$met" "$(echo "600 / $whole" | bc -l)" "$loop"
 done
 
 period_us=$(( 1000000 / rate ))
