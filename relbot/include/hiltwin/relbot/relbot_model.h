@@ -91,6 +91,14 @@ void RelbotDerivative(const RelbotCoefficients& c, const RelbotState& x, double 
 /// Largest fixed step (s) at which `integrator` integrates the RELbot stably.
 [[nodiscard]] double RelbotMaxStableStepS(const RelbotParams& params, Integrator integrator);
 
+/// The heading's cosine and sine at the heading whose bits are `heading_bits`; starts at
+/// heading 0, where both are exact.
+struct RelbotHeadingTrigCache {
+  std::uint64_t heading_bits = 0;
+  double cos_h = 1.0;
+  double sin_h = 0.0;
+};
+
 /// The RELbot plant at a fixed step with a chosen explicit integrator.
 class RelbotModel {
  public:
@@ -130,6 +138,7 @@ class RelbotModel {
   double step_s_;
   std::uint64_t steps_ = 0;
   State state_ = State::Zero();
+  RelbotHeadingTrigCache trig_cache_;  ///< valid for any state: keyed by the heading's bits
 };
 
 }  // namespace hiltwin::app
