@@ -117,7 +117,10 @@ class RelbotModel {
   /// Outputs at the current time.
   [[nodiscard]] RelbotOutputs Outputs() const noexcept { return OutputsOf(state_); }
   /// False once any state became NaN or infinite (a diverged model: stop the run).
-  [[nodiscard]] bool StateIsFinite() const noexcept { return state_.allFinite(); }
+  /// x * 0 is a zero for every finite x and NaN for NaN and +-Inf, so the sum is NaN exactly
+  /// when a state is not finite: one vectorised pass, where allFinite() tests each entry
+  /// with a branch of its own (a twelfth of a step).
+  [[nodiscard]] bool StateIsFinite() const noexcept { return (state_ * 0.0).sum() == 0.0; }
 
   [[nodiscard]] const State& state() const noexcept { return state_; }
   /// Replaces the state (tests, restoring a snapshot).
