@@ -51,7 +51,20 @@ TEST(ProfilePwmSource, PlaysTheControllersSamplesBitForBitInAnyOrder) {
     std::uint64_t seed = 99;
     for (int k = 0; k < 5000; ++k) {
       seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-      expect_plays(static_cast<std::int64_t>(seed >> 30));  // up to about 200 s, any ns
+      expect_plays(static_cast<std::int64_t>(seed >> (30 + k % 24)));  // ns to months, any ns
+    }
+    // Half a period either side of a frame, and where the frame's integer arithmetic hands
+    // over to doubles (2^51 ns, 26 days).
+    for (const std::int64_t base : {std::int64_t{0}, std::int64_t{1} << 40,
+                                    (std::int64_t{1} << 51) - period_ns, std::int64_t{1} << 51,
+                                    std::int64_t{1} << 60}) {
+      for (std::int64_t k = 0; k < 9; ++k) {
+        const std::int64_t frame_start = base - base % period_ns + k * period_ns;
+        for (const std::int64_t offset : {period_ns / 2 - 1, period_ns / 2, period_ns / 2 + 1,
+                                          period_ns - 1}) {
+          expect_plays(frame_start + offset);
+        }
+      }
     }
   }
 }
