@@ -31,7 +31,8 @@ ProfilePwmSource::ProfilePwmSource(const InputProfile& profile, double controlle
 double ProfilePwmSource::FrameOf(std::int64_t t_ns) const noexcept {
   if (t_ns < 0) return 0.0;
   if (t_ns < kIntegerFramesBelowNs && period_ns_ > 0) {
-    return static_cast<double>((2 * t_ns + period_ns_) / (2 * period_ns_));
+    const std::int64_t frame = (2 * t_ns + period_ns_) / (2 * period_ns_);  // rounds to nearest
+    return static_cast<double>(frame);
   }
   return std::round(static_cast<double>(t_ns) / twin_period_ns_);
 }

@@ -125,9 +125,10 @@ TEST(InputProfile, ACursorGivesTheSameDutyForwardBackwardAndAtRandom) {
     const double t = static_cast<double>(seed >> 11) * 0x1p-53 * 100.0 - 1.0;
     expect_same(k % 5 == 0 ? std::round(t) : t, cursor);
   }
+  const std::size_t n = profile.knots().size();
   for (const double t : {1.0, 8.0, 13.0, 34.5, 35.5, 36.0, 72.0, 0.0, -1.0, 1e9}) {
-    for (std::size_t start : {std::size_t{0}, std::size_t{3}, profile.knots().size(),
-                              profile.knots().size() + 1, std::numeric_limits<std::size_t>::max()}) {
+    for (std::size_t start : {std::size_t{0}, std::size_t{3}, n, n + 1,
+                              std::numeric_limits<std::size_t>::max()}) {
       expect_same(t, start);
     }
   }
