@@ -257,7 +257,9 @@ class ModelStage {
 
 }  // namespace
 
-void RelbotModel::Step(double duty_left, double duty_right) noexcept {
+// Flattened: g++ -O2 keeps Eigen's assignment loops (the stages' x + a k) out of line, three
+// calls a step; inlined they cost a tenth less.
+[[gnu::flatten]] void RelbotModel::Step(double duty_left, double duty_right) noexcept {
   const ModelStage stage(coefficients_,
                          DriveOf(coefficients_, SaturateDuty(duty_left), SaturateDuty(duty_right)),
                          trig_cache_);
