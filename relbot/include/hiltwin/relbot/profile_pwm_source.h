@@ -28,7 +28,17 @@ class ProfilePwmSource final : public io::PwmSignalSource {
   const InputProfile& profile_;
   double controller_rate_hz_;
   double twin_rate_hz_;
-  double twin_period_ns_;  ///< whole nanoseconds, as the board counts them
+  /// Frame index of t_ns on the twin's grid (0 before it starts): round(t_ns / period).
+  [[nodiscard]] double FrameOf(std::int64_t t_ns) const noexcept;
+
+  std::int64_t period_ns_;  ///< whole nanoseconds, as the board counts them
+  double twin_period_ns_;   ///< the same, as a double
+  // The controller holds a sample over several frames (4 at 1 kHz into a 4 kHz twin): the
+  // last sample's duty is kept rather than looked up again, and the lookup starts where the
+  // last one ended.
+  double last_sample_;  ///< NaN until the first lookup
+  Duty last_duty_;
+  std::size_t cursor_ = 0;
 };
 
 }  // namespace hiltwin::app
