@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -405,6 +406,13 @@ runtime::TelemetryRecord PoseRecord(double x, double y, double theta, double t, 
   return r;
 }
 
+/// httplib's task queue that runs each connection at once, on the thread that accepted it.
+class ServeInline : public httplib::TaskQueue {
+ public:
+  void enqueue(std::function<void()> fn) override { fn(); }
+  void shutdown() override {}
+};
+
 /// The page, its three.js and `records` as one finite /events stream, with the probe.
 class ProbedPage {
  public:
@@ -449,6 +457,12 @@ class ProbedPage {
     server_.Get("/events", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(events_, "text/event-stream");
     });
+    // Every connection is served on the listening thread, one request each: httplib's own
+    // pool hands a connection to a worker inside the library, which is not built with TSan,
+    // so the TSan build saw the listener's allocation freed by a worker as a data race. A
+    // test's page needs no parallel serving: Chromium's other connections wait in the backlog.
+    server_.new_task_queue = [] { return new ServeInline; };
+    server_.set_keep_alive_max_count(1);
     port_ = server_.bind_to_any_port("127.0.0.1");
     // Bound is listening: a browser's connection waits in the backlog until the thread runs.
     thread_ = std::thread([this] { server_.listen_after_bind(); });
