@@ -4,7 +4,7 @@ namespace hiltwin::runtime {
 
 io::ExchangeStatus LinkFaultingTask::Exchange(bool live_outputs) noexcept {
   schedule_.Arm(exchanges_++, board_.faults());
-  return task_.Exchange(live_outputs);
+  return wrapped().Exchange(live_outputs);
 }
 
 }  // namespace hiltwin::runtime
