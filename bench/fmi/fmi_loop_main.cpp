@@ -1,20 +1,27 @@
 // An FMU plant's whole loop against a bare FMI 2.0 master stepping the same FMU (issue 36:
-// "within 3x of a bare FMI master by CPU time"). The FMU is tests/fmus' lag.fmu: its step does
-// real work (an exp() per step, y <- K u + (y - K u) exp(-h / tau)), where msd.fmu's is four
-// multiply-adds with a cached transition matrix, so lag is the fairer of the two trivial FMUs.
-//   (a) `hiltwin run --plant fmu:lag.fmu --plant-map <u from PWM 1, y to encoder 1>
-//       --clock virtual`: the twin at 4 kHz, as fast as it runs: the loop, the mock board's
-//       exchange, QoS, statistics and the FMU's SetReal/DoStep/GetReal per cycle.
+// "within 3x of a bare FMI master by CPU time"), for two FMUs of tests/fmus, since the ratio is
+// (loop + FMU) / FMU and so depends on what the FMU's step costs:
+//   lag     lag.fmu, a first-order lag: one exp() a step (~150 instructions), a trivial model;
+//   relbot  relbot.fmu, the RELbot's 12-state model with RK4 (relbot/src/relbot_model.cpp in C):
+//           a plant-sized step, driven straight (duties 0.5, 0.5), as the built-in model is in
+//           the cycle benchmark's window;
+//   relbot_turning  the same FMU turning (duties 0.5, 0.25): a sincos in each RK4 stage.
+// For each:
+//   (a) `hiltwin run --plant fmu:<fmu> --plant-map <map> --input <held duties> --clock virtual`:
+//       the twin at 4 kHz, as fast as it runs: the loop, the mock board's exchange, QoS,
+//       statistics and the FMU's SetReal/DoStep/GetReal per cycle, the duties held.
 //   (b) the bare master: the FMU opened and started (fmi2Instantiate, fmi2SetupExperiment,
-//       initialisation), then per step fmi2SetReal, fmi2DoStep, fmi2GetReal through the FMU's
-//       own function pointers, nothing else.
+//       initialisation), then per step fmi2SetReal (the same held inputs), fmi2DoStep,
+//       fmi2GetReal (all outputs) through the FMU's own function pointers, nothing else.
 // CPU time per step: (a) the child's user + system time for 2D s minus that for D s, over the
 // 4000 D cycles between (start-up and the FMU's unpacking cancel); (b) the thread's CPU time
 // over the steps. Instructions per step (callgrind, load-independent): (a) all threads, 2D
-// against D seconds; (b) a ToggleCounting bracket around 2N against N steps.
+// against D seconds; (b) a ToggleCounting bracket around 2N against N steps. Their difference
+// is what the twin's loop costs beyond the FMU.
 //
-// Usage: hiltwin_bench_fmi_loop HILTWIN [seconds=20] [rounds=3] [fmu=<build>/tests/fmus/lag.fmu]
-//        hiltwin_bench_fmi_loop --bare-steps N [fmu]   (one bracket, for callgrind)
+// Usage: hiltwin_bench_fmi_loop HILTWIN [seconds=20] [rounds=3] [CASE (default all)]
+//        hiltwin_bench_fmi_loop --bare-steps N CASE   (one bracket, for callgrind)
+// CASE: lag, relbot or relbot_turning.
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
@@ -26,6 +33,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bench_stats.h"
@@ -38,8 +46,44 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kRateHz = 4000.0;
 constexpr double kStepS = 1.0 / kRateHz;
+// The duties the twin's input profile holds, left and right (exact in the board's n/2048 PWM
+// steps): equal ones drive the RELbot straight, unequal ones turn it.
+constexpr std::array<double, 2> kStraight{0.5, 0.5};
+constexpr std::array<double, 2> kTurning{0.5, 0.25};
 
 volatile double g_sink = 0.0;
+
+// One FMU of the comparison: its file, its plant map (board channels to its ports), the duties
+// the twin's input profile holds, and the inputs the bare master holds: what the map makes of
+// those duties, in the FMU's input order.
+struct Case {
+  const char* name;
+  const char* fmu;
+  std::string map;  ///< the map's text, or empty when map_path names the file
+  const char* map_path;
+  std::array<double, 2> duties;
+  std::vector<double> inputs;
+};
+
+std::vector<Case> Cases() {
+  const std::string lag_map =
+      "[[pwm]]\nchannel = 1\ninput = \"u\"\ngain = 1.0\n\n"
+      "[[encoder]]\nchannel = 1\noutput = \"y\"\nunit = \"rad\"\ncounts_per_unit = 651.9\n";
+  const char* relbot = HILTWIN_BENCH_FMU_DIR "/relbot.fmu";
+  // The RELbot's own map: PWM 2 -> duty_left, PWM 1 (the profile's right) -> duty_right.
+  return {
+      {"lag", HILTWIN_BENCH_FMU_DIR "/lag.fmu", lag_map, nullptr, kTurning, {kTurning[1]}},
+      {"relbot", relbot, "", HILTWIN_RELBOT_MAP, kStraight, {kStraight[0], kStraight[1]}},
+      {"relbot_turning", relbot, "", HILTWIN_RELBOT_MAP, kTurning, {kTurning[0], kTurning[1]}},
+  };
+}
+
+const Case& CaseNamed(const std::vector<Case>& cases, std::string_view name) {
+  for (const Case& c : cases) {
+    if (name == c.name) return c;
+  }
+  throw std::runtime_error("no FMU case '" + std::string(name) + "' (lag, relbot, relbot_turning)");
+}
 
 double ThreadCpuS() {
   timespec t{};
@@ -56,58 +100,77 @@ double ChildrenCpuS() {
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
-// The bare master's steps: the input alternates as a PWM duty would, the output is kept.
+// The bare master's steps: the held inputs set, the step, every output read, as the twin does.
 // Returns false when a call did not return fmi2OK.
-bool BareSteps(const hiltwin::fmi::FmuDirectCalls& fmu, long first, long steps) {
+bool BareSteps(const hiltwin::fmi::FmuDirectCalls& fmu, const std::vector<double>& u,
+               std::vector<double>& y, long steps) {
   bool ok = true;
-  std::array<double, 1> y{};
-  for (long k = first; k < first + steps; ++k) {
-    const std::array<double, 1> u{(k / 1024) % 2 == 0 ? 0.5 : -0.5};
-    ok = fmu.set_real(fmu.component, fmu.input_refs.data(), 1, u.data()) == fmi2OK && ok;
+  for (long k = 0; k < steps; ++k) {
+    ok = fmu.set_real(fmu.component, fmu.input_refs.data(), u.size(), u.data()) == fmi2OK && ok;
     ok = fmu.do_step(fmu.component, static_cast<double>(k) * kStepS, kStepS, fmi2True) ==
              fmi2OK && ok;
-    ok = fmu.get_real(fmu.component, fmu.output_refs.data(), 1, y.data()) == fmi2OK && ok;
+    ok = fmu.get_real(fmu.component, fmu.output_refs.data(), y.size(), y.data()) == fmi2OK &&
+         ok;
   }
   g_sink = g_sink + y[0];
   return ok;
 }
 
-std::unique_ptr<hiltwin::fmi::FmuPlant> StartedFmu(const char* fmu_path) {
-  auto plant = hiltwin::fmi::OpenFmu(fmu_path);
-  if (plant->Info().inputs.size() != 1 || plant->Info().outputs.size() != 1) {
-    throw std::runtime_error(std::string(fmu_path) + ": one Real input and one output needed");
+std::unique_ptr<hiltwin::fmi::FmuPlant> StartedFmu(const Case& c, std::vector<double>& y) {
+  auto plant = hiltwin::fmi::OpenFmu(c.fmu);
+  if (plant->Info().inputs.size() != c.inputs.size() || plant->Info().outputs.empty()) {
+    throw std::runtime_error(std::string(c.fmu) + ": not the ports this benchmark drives");
   }
-  std::array<double, 1> y0{};
-  plant->Start(kStepS, y0);
+  y.assign(plant->Info().outputs.size(), 0.0);
+  plant->Start(kStepS, y);
   return plant;
 }
 
-// `--bare-steps N`: N bare steps between two ToggleCounting() calls.
-int CountedBareSteps(long steps, const char* fmu_path) {
-  const auto plant = StartedFmu(fmu_path);
+// `--bare-steps N CASE`: N bare steps between two ToggleCounting() calls.
+int CountedBareSteps(long steps, const Case& c) {
+  std::vector<double> y;
+  const auto plant = StartedFmu(c, y);
   const hiltwin::fmi::FmuDirectCalls fmu = plant->DirectCalls();
   hiltwin::bench::ToggleCounting();
-  const bool ok = BareSteps(fmu, 0, steps);
+  const bool ok = BareSteps(fmu, c.inputs, y, steps);
   hiltwin::bench::ToggleCounting();
   return ok ? 0 : 3;
 }
 
-double BareCpuNsPerStep(const char* fmu_path, long steps) {
-  const auto plant = StartedFmu(fmu_path);
+double BareCpuNsPerStep(const Case& c, long steps) {
+  std::vector<double> y;
+  const auto plant = StartedFmu(c, y);
   const hiltwin::fmi::FmuDirectCalls fmu = plant->DirectCalls();
-  (void)BareSteps(fmu, 0, steps / 10);  // warm-up
-  std::array<double, 1> y0{};
-  plant->Reset(y0);  // model time 0 again, as the timed steps count from 0
+  (void)BareSteps(fmu, c.inputs, y, steps / 10);  // warm-up
+  plant->Reset(y);  // model time 0 again, as the timed steps count from 0
   const double start = ThreadCpuS();
-  const bool ok = BareSteps(fmu, 0, steps);
+  const bool ok = BareSteps(fmu, c.inputs, y, steps);
   const double end = ThreadCpuS();
   if (!ok) throw std::runtime_error("the bare master's FMU calls failed");
   return (end - start) * 1e9 / static_cast<double>(steps);
 }
 
-std::vector<std::string> TwinArgs(const std::string& hiltwin, const char* fmu_path,
-                                  const fs::path& map, double seconds) {
-  return {hiltwin, "run", "--plant", std::string("fmu:") + fmu_path, "--plant-map", map.string(),
+// The files the twin runs with: the map and the held duties' input profile.
+struct TwinFiles {
+  fs::path map;
+  fs::path input;
+};
+
+TwinFiles WriteTwinFiles(const Case& c, const fs::path& dir) {
+  fs::create_directories(dir);
+  const fs::path own_map = dir / (std::string(c.name) + "_map.toml");
+  TwinFiles files{c.map_path != nullptr ? fs::path(c.map_path) : own_map,
+                  dir / (std::string(c.name) + "_duties.csv")};
+  if (c.map_path == nullptr) std::ofstream(files.map) << c.map;
+  std::ofstream(files.input) << "time,left,right\n0," << c.duties[0] << ',' << c.duties[1]
+                             << "\n100000," << c.duties[0] << ',' << c.duties[1] << '\n';
+  return files;
+}
+
+std::vector<std::string> TwinArgs(const std::string& hiltwin, const Case& c,
+                                  const TwinFiles& files, double seconds) {
+  return {hiltwin,   "run",          "--plant", std::string("fmu:") + c.fmu,
+          "--plant-map", files.map.string(), "--input", files.input.string(),
           "--clock", "virtual", "--duration", std::to_string(seconds), "--no-progress"};
 }
 
@@ -124,14 +187,14 @@ double TwinCpuS(const std::vector<std::string>& args) {
 }
 
 // Instructions per cycle of the twin, all threads, 2D against D seconds (callgrind).
-double TwinInstructionsPerStep(const std::string& hiltwin, const char* fmu_path,
-                               const fs::path& map, double seconds) {
+double TwinInstructionsPerStep(const std::string& hiltwin, const Case& c, const TwinFiles& files,
+                               double seconds) {
   const auto count = [&](double s) {
     const fs::path out = fs::temp_directory_path() / ("hiltwin_fmi_loop_cg_" +
                                                       std::to_string(getpid()));
     std::vector<std::string> args = {"valgrind", "--tool=callgrind",
                                      "--callgrind-out-file=" + out.string()};
-    const auto twin = TwinArgs(hiltwin, fmu_path, map, s);
+    const auto twin = TwinArgs(hiltwin, c, files, s);
     args.insert(args.end(), twin.begin(), twin.end());
     (void)TwinCpuS(args);
     std::ifstream in(out);
@@ -146,70 +209,74 @@ double TwinInstructionsPerStep(const std::string& hiltwin, const char* fmu_path,
                                              count(2 * seconds));
 }
 
-fs::path WriteLagMap(const fs::path& dir) {
-  fs::create_directories(dir);
-  fs::path map = dir / "lag_map.toml";
-  std::ofstream(map) << "[[pwm]]\nchannel = 1\ninput = \"u\"\ngain = 1.0\n\n"
-                        "[[encoder]]\nchannel = 1\noutput = \"y\"\nunit = \"rad\"\n"
-                        "counts_per_unit = 651.9\n";
-  return map;
+const char* Verdict(double ratio) { return ratio <= 3.0 ? "met" : "NOT met"; }
+
+void ReportInstructions(const std::string& hiltwin, const Case& c, const TwinFiles& files,
+                        const char* self) {
+  try {
+    const double twin = TwinInstructionsPerStep(hiltwin, c, files, 1.0);
+    const auto bare_count = [&](long steps) {
+      return hiltwin::bench::CountInstructions({self, "--bare-steps", std::to_string(steps),
+                                                c.name});
+    };
+    const double bare = hiltwin::bench::InstructionsPerItem(4000, bare_count(4000), 8000,
+                                                            bare_count(8000));
+    std::printf("  instructions per step (callgrind): hiltwin run %.0f, bare FMI master (peer) "
+                "%.0f, ratio %.1f (target <= 3: %s); the loop beyond the FMU %.0f\n",
+                twin, bare, twin / bare, Verdict(twin / bare), twin - bare);
+  } catch (const std::exception& e) {
+    std::printf("  instructions per step: not counted (%s)\n", e.what());
+  }
 }
 
-int Report(const std::string& hiltwin, double seconds, int rounds, const char* fmu_path,
-           const char* self) {
+void ReportCase(const std::string& hiltwin, double seconds, int rounds, const Case& c,
+                const char* self) {
   const fs::path dir = fs::temp_directory_path() / ("hiltwin_fmi_loop_" + std::to_string(getpid()));
-  const fs::path map = WriteLagMap(dir);
+  const TwinFiles files = WriteTwinFiles(c, dir);
   const double cycles = seconds * kRateHz;
   std::vector<double> twin_ns;
   std::vector<double> bare_ns;
   std::vector<double> ratio;
   for (int r = 0; r < rounds; ++r) {
-    const double once = TwinCpuS(TwinArgs(hiltwin, fmu_path, map, seconds));
-    const double twice = TwinCpuS(TwinArgs(hiltwin, fmu_path, map, 2 * seconds));
+    const double once = TwinCpuS(TwinArgs(hiltwin, c, files, seconds));
+    const double twice = TwinCpuS(TwinArgs(hiltwin, c, files, 2 * seconds));
     twin_ns.push_back((twice - once) * 1e9 / cycles);
-    bare_ns.push_back(BareCpuNsPerStep(fmu_path, static_cast<long>(cycles)));
+    bare_ns.push_back(BareCpuNsPerStep(c, static_cast<long>(cycles)));
     ratio.push_back(twin_ns.back() / bare_ns.back());
   }
-  std::printf("fmi_loop: %s, %.0f Hz, %g s against %g s of the twin, %d rounds; median (range)\n",
-              fmu_path, kRateHz, 2 * seconds, seconds, rounds);
-  std::printf("  CPU per step: hiltwin run %s, bare FMI master (peer) %s, ratio %s (target <= 3)\n",
-              FormatSpread(hiltwin::bench::SpreadOf(twin_ns), "ns").c_str(),
+  const auto ratio_spread = hiltwin::bench::SpreadOf(ratio);
+  std::printf("fmi_loop %s: %s, %.0f Hz, %g s against %g s of the twin, %d rounds; median "
+              "(range)\n", c.name, c.fmu, kRateHz, 2 * seconds, seconds, rounds);
+  std::printf("  CPU per step: hiltwin run %s, bare FMI master (peer) %s, ratio %s (target <= 3: "
+              "%s)\n", FormatSpread(hiltwin::bench::SpreadOf(twin_ns), "ns").c_str(),
               FormatSpread(hiltwin::bench::SpreadOf(bare_ns), "ns").c_str(),
-              FormatSpread(hiltwin::bench::SpreadOf(ratio), "x", 2).c_str());
-  try {
-    const double twin = TwinInstructionsPerStep(hiltwin, fmu_path, map, 1.0);
-    const auto bare_count = [&](long steps) {
-      return hiltwin::bench::CountInstructions(
-          {self, "--bare-steps", std::to_string(steps), fmu_path});
-    };
-    const double bare = hiltwin::bench::InstructionsPerItem(4000, bare_count(4000), 8000,
-                                                            bare_count(8000));
-    std::printf("  instructions per step (callgrind): hiltwin run %.0f, bare FMI master (peer) "
-                "%.0f, ratio %.1f\n", twin, bare, twin / bare);
-  } catch (const std::exception& e) {
-    std::printf("  instructions per step: not counted (%s)\n", e.what());
-  }
+              FormatSpread(ratio_spread, "x", 2).c_str(), Verdict(ratio_spread.median));
+  ReportInstructions(hiltwin, c, files, self);
   fs::remove_all(dir);
-  return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) try {
-  if (argc >= 3 && std::strcmp(argv[1], "--bare-steps") == 0) {
-    return CountedBareSteps(std::atol(argv[2]), argc > 3 ? argv[3] : HILTWIN_BENCH_FMU);
+  const std::vector<Case> cases = Cases();
+  if (argc >= 4 && std::strcmp(argv[1], "--bare-steps") == 0) {
+    return CountedBareSteps(std::atol(argv[2]), CaseNamed(cases, argv[3]));
   }
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s HILTWIN [seconds=20] [rounds=3] [fmu]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s HILTWIN [seconds=20] [rounds=3] [CASE]\n", argv[0]);
     return 2;
   }
   const double seconds = argc > 2 ? std::atof(argv[2]) : 20.0;
   const int rounds = argc > 3 ? std::atoi(argv[3]) : 3;
   if (!(seconds > 0.0) || rounds <= 0) {
-    std::fprintf(stderr, "usage: %s HILTWIN [seconds > 0] [rounds > 0] [fmu]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s HILTWIN [seconds > 0] [rounds > 0] [CASE]\n", argv[0]);
     return 2;
   }
-  return Report(argv[1], seconds, rounds, argc > 4 ? argv[4] : HILTWIN_BENCH_FMU, argv[0]);
+  for (const Case& c : cases) {
+    if (argc > 4 && argv[4] != std::string_view(c.name)) continue;
+    ReportCase(argv[1], seconds, rounds, c, argv[0]);
+  }
+  return 0;
 } catch (const std::exception& error) {
   std::fprintf(stderr, "hiltwin_bench_fmi_loop: %s\n", error.what());
   return 2;
