@@ -66,6 +66,7 @@ struct Case {
   const char* map_path;
   std::array<double, 2> duties;
   std::vector<double> inputs;
+  bool builtin_peer = false;  ///< also count the built-in RELbot's twin with the same duties
 };
 
 std::vector<Case> Cases() {
@@ -76,8 +77,9 @@ std::vector<Case> Cases() {
   // The RELbot's own map: PWM 2 -> duty_left, PWM 1 (the profile's right) -> duty_right.
   return {
       {"lag", HILTWIN_BENCH_FMU_DIR "/lag.fmu", lag_map, nullptr, kTurning, {kTurning[1]}},
-      {"relbot", relbot, "", HILTWIN_RELBOT_MAP, kStraight, {kStraight[0], kStraight[1]}},
-      {"relbot_turning", relbot, "", HILTWIN_RELBOT_MAP, kTurning, {kTurning[0], kTurning[1]}},
+      {"relbot", relbot, "", HILTWIN_RELBOT_MAP, kStraight, {kStraight[0], kStraight[1]}, true},
+      {"relbot_turning", relbot, "", HILTWIN_RELBOT_MAP, kTurning, {kTurning[0], kTurning[1]},
+       true},
   };
 }
 
@@ -170,11 +172,18 @@ TwinFiles WriteTwinFiles(const Case& c, const fs::path& dir) {
   return files;
 }
 
+// The twin with the case's FMU, or (builtin) the built-in RELbot with its own map.
 std::vector<std::string> TwinArgs(const std::string& hiltwin, const Case& c,
-                                  const TwinFiles& files, double seconds) {
-  return {hiltwin,   "run",          "--plant", std::string("fmu:") + c.fmu,
-          "--plant-map", files.map.string(), "--input", files.input.string(),
-          "--clock", "virtual", "--duration", std::to_string(seconds), "--no-progress"};
+                                  const TwinFiles& files, double seconds, bool builtin = false) {
+  std::vector<std::string> args = {hiltwin, "run", "--input", files.input.string(), "--clock",
+                                   "virtual", "--duration", std::to_string(seconds),
+                                   "--no-progress"};
+  if (!builtin) {
+    const std::vector<std::string> plant = {"--plant", std::string("fmu:") + c.fmu,
+                                            "--plant-map", files.map.string()};
+    args.insert(args.begin() + 2, plant.begin(), plant.end());
+  }
+  return args;
 }
 
 double TwinCpuS(const std::vector<std::string>& args) {
@@ -191,13 +200,13 @@ double TwinCpuS(const std::vector<std::string>& args) {
 
 // Instructions per cycle of the twin, all threads, 2D against D seconds (callgrind).
 double TwinInstructionsPerStep(const std::string& hiltwin, const Case& c, const TwinFiles& files,
-                               double seconds) {
+                               double seconds, bool builtin = false) {
   const auto count = [&](double s) {
     const fs::path out = fs::temp_directory_path() / ("hiltwin_fmi_loop_cg_" +
                                                       std::to_string(getpid()));
     std::vector<std::string> args = {"valgrind", "--tool=callgrind",
                                      "--callgrind-out-file=" + out.string()};
-    const auto twin = TwinArgs(hiltwin, c, files, s);
+    const auto twin = TwinArgs(hiltwin, c, files, s, builtin);
     args.insert(args.end(), twin.begin(), twin.end());
     (void)TwinCpuS(args);
     std::ifstream in(out);
@@ -228,8 +237,14 @@ void ReportInstructions(const std::string& hiltwin, const Case& c, const TwinFil
     const double bare = hiltwin::bench::InstructionsPerItem(4000, bare_count(4000), 8000,
                                                             bare_count(8000));
     std::printf("  instructions per step (callgrind): hiltwin run %.0f, bare FMI master (peer) "
-                "%.0f, ratio %.1f (target <= 3: %s); the loop beyond the FMU %.0f\n",
+                "%.0f, ratio %.2f (target <= 3: %s); the loop beyond the FMU %.0f\n",
                 twin, bare, twin / bare, Verdict(twin / bare), twin - bare);
+    if (c.builtin_peer) {
+      const double builtin = TwinInstructionsPerStep(hiltwin, c, files, 1.0, true);
+      std::printf("  the built-in RELbot's twin, same duties: %.0f instructions per step; the FMU "
+                  "twin costs %+.0f more (its FMU against the built-in model)\n", builtin,
+                  twin - builtin);
+    }
   } catch (const std::exception& e) {
     std::printf("  instructions per step: not counted (%s)\n", e.what());
   }
@@ -243,20 +258,24 @@ void ReportCase(const std::string& hiltwin, double seconds, int rounds, const Ca
   std::vector<double> twin_ns;
   std::vector<double> bare_ns;
   std::vector<double> ratio;
+  std::vector<double> beyond_ns;
   for (int r = 0; r < rounds; ++r) {
     const double once = TwinCpuS(TwinArgs(hiltwin, c, files, seconds));
     const double twice = TwinCpuS(TwinArgs(hiltwin, c, files, 2 * seconds));
     twin_ns.push_back((twice - once) * 1e9 / cycles);
     bare_ns.push_back(BareCpuNsPerStep(c, static_cast<long>(cycles)));
     ratio.push_back(twin_ns.back() / bare_ns.back());
+    beyond_ns.push_back(twin_ns.back() - bare_ns.back());
   }
   const auto ratio_spread = hiltwin::bench::SpreadOf(ratio);
   std::printf("fmi_loop %s: %s, %.0f Hz, %g s against %g s of the twin, %d rounds; median "
               "(range)\n", c.name, c.fmu, kRateHz, 2 * seconds, seconds, rounds);
   std::printf("  CPU per step: hiltwin run %s, bare FMI master (peer) %s, ratio %s (target <= 3: "
-              "%s)\n", FormatSpread(hiltwin::bench::SpreadOf(twin_ns), "ns").c_str(),
+              "%s); the loop beyond the FMU %s\n",
+              FormatSpread(hiltwin::bench::SpreadOf(twin_ns), "ns").c_str(),
               FormatSpread(hiltwin::bench::SpreadOf(bare_ns), "ns").c_str(),
-              FormatSpread(ratio_spread, "x", 2).c_str(), Verdict(ratio_spread.median));
+              FormatSpread(ratio_spread, "x", 2).c_str(), Verdict(ratio_spread.median),
+              FormatSpread(hiltwin::bench::SpreadOf(beyond_ns), "ns").c_str());
   ReportInstructions(hiltwin, c, files, self);
   fs::remove_all(dir);
 }
