@@ -72,8 +72,8 @@ class FmuPlantImpl final : public FmuPlant {
   bool initialised_ = false;   ///< fmi2ExitInitializationMode returned ok
   /// Step may call the FMU: an instance, initialised, not faulted (one test per step).
   bool ready_ = false;
-  std::span<const fmi2ValueReference> step_inputs_;   ///< input_refs_, for Step
-  std::span<const fmi2ValueReference> step_outputs_;  ///< output_refs_, for Step
+  std::span<const fmi2ValueReference> step_inputs_{};   ///< input_refs_, for Step
+  std::span<const fmi2ValueReference> step_outputs_{};  ///< output_refs_, for Step
   fmi2Status worst_ = fmi2OK;  ///< the last failing status: what FMI 2.0 still allows
   plant::PlantStatus status_;  ///< latched: after a fault the FMU is not called again
   double step_s_ = 0.0;
