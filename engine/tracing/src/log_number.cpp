@@ -210,4 +210,28 @@ char* FormatLogNumber(char* first, double value) noexcept {
   return FormatShortest(first, value);
 }
 
+char* FormatLogRow(char* first, const double* values, std::size_t count,
+                   CellMemo* memos) noexcept {
+  constexpr std::size_t kCellRoom = sizeof(CellMemo::text);
+  for (std::size_t c = 0; c < count; ++c) {
+    CellMemo& memo = memos[c];
+    const auto bits = std::bit_cast<std::uint64_t>(values[c]);
+    if (bits == memo.bits) {
+      // A fixed-size copy (two vector moves): the bytes past the text are scratch, which the
+      // comma and the next cell overwrite, as after FormatLogNumber.
+      std::memcpy(first, memo.text, kCellRoom);
+      first += memo.length;
+    } else {
+      char* const end = FormatLogNumber(first, values[c]);
+      std::memcpy(memo.text, first, kCellRoom);
+      memo.bits = bits;
+      memo.length = static_cast<std::size_t>(end - first);
+      first = end;
+    }
+    *first++ = ',';
+  }
+  first[-1] = '\n';
+  return first;
+}
+
 }  // namespace hiltwin::tracing::detail
