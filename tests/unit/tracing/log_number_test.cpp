@@ -110,6 +110,13 @@ void ExpectSameCells(const std::vector<double>& values) {
 
 double FromBits(std::uint64_t bits) { return std::bit_cast<double>(bits); }
 
+constexpr std::int64_t kPow10Test[] = {1,           10,           100,           1'000,
+                                       10'000,      100'000,      1'000'000,     10'000'000,
+                                       100'000'000, 1'000'000'000, 10'000'000'000, 100'000'000'000,
+                                       1'000'000'000'000, 10'000'000'000'000,
+                                       100'000'000'000'000, 1'000'000'000'000'000,
+                                       10'000'000'000'000'000, 100'000'000'000'000'000};
+
 TEST(LogNumberTest, SpecialValuesAreSpelledAsBefore) {
   const double inf = std::numeric_limits<double>::infinity();
   EXPECT_EQ(Cell(std::nan("")), "NaN");
@@ -194,6 +201,44 @@ TEST(LogNumberTest, ShortestIsTheStandardLibrarysText) {
                          123456789012345678901.0, -0.0, 0.0}) {
     EXPECT_EQ(Shortest(v), StdShortest(v));
     EXPECT_EQ(Shortest(-v), StdShortest(-v));
+  }
+}
+
+// FormatShortest's own 128-bit path takes 2^-36 <= |v| < 2^49 (every binary exponent there is
+// drawn evenly, which random bit patterns rarely do) and leaves ties and powers of two to
+// Dragonbox. Mantissas with many trailing zero bits give exact ties and values a few digits
+// long; nextafter neighbours of short decimals give intervals whose ends sit next to a
+// candidate.
+TEST(LogNumberTest, ShortestMatchesTheStandardLibraryAcrossItsOwnRange) {
+  std::mt19937_64 random(3636);
+  std::vector<double> values;
+  for (int exponent = -40; exponent <= 52; ++exponent) {
+    for (int i = 0; i < 12'000; ++i) {
+      const std::uint64_t mantissa = random() & ((std::uint64_t{1} << 52U) - 1U);
+      const int zero_bits = static_cast<int>(random() % 53U);
+      const std::uint64_t bits = static_cast<std::uint64_t>(exponent + 1023) << 52U;
+      values.push_back(FromBits(bits | mantissa));
+      values.push_back(FromBits(bits | ((mantissa >> zero_bits) << zero_bits)));
+    }
+  }
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::uniform_int_distribution<std::int64_t> significand(1, 99'999'999'999'999'999);
+    for (int i = 0; i < 3'000; ++i) {
+      const double v = static_cast<double>(significand(random) % kPow10Test[digits]) *
+                       std::pow(10.0, static_cast<double>(static_cast<int>(random() % 30U)) - 20);
+      values.push_back(v);
+      values.push_back(std::nextafter(v, 0.0));
+      values.push_back(std::nextafter(v, 1e300));
+    }
+  }
+  int mismatches = 0;
+  for (const double v : values) {
+    for (const double signed_v : {v, -v}) {
+      if (Shortest(signed_v) == StdShortest(signed_v)) continue;
+      ADD_FAILURE() << "bits 0x" << std::hex << std::bit_cast<std::uint64_t>(signed_v)
+                    << ": expected " << StdShortest(signed_v) << ", got " << Shortest(signed_v);
+      if (++mismatches == 10) return;
+    }
   }
 }
 
