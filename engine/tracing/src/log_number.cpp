@@ -1,7 +1,5 @@
 #include "log_number.h"
 
-#include <fmt/format.h>  // fmt::detail::dragonbox::to_decimal, exported by libfmt
-
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -163,11 +161,12 @@ std::uint64_t ShiftRight(U128 x, int shift) noexcept {
 
 /// The shortest digits for 2^-36 <= |value| < 2^49 (a twin's states: positions, angles,
 /// speeds), exactly, with 128-bit integers: false (nothing written) outside that range, for a
-/// power of two (its rounding interval is lopsided) and on an exact tie, which Dragonbox
-/// settles. What it computes is what Ryu and Dragonbox define: the fewest digits that read
-/// back as the value (a number strictly inside its rounding interval), the nearest such to it.
-/// In this range no interval bound is a whole number of 17-digit units (below), so whether the
-/// bounds belong to the interval (round-half-even reading) never matters.
+/// power of two (its rounding interval is lopsided) and on an exact tie (FormatShortest leaves
+/// those to the standard library). It computes what Ryu and Dragonbox define: the fewest
+/// digits that read back as the value (a number strictly inside its rounding interval), the
+/// nearest such to it. In this range no interval bound is a whole number of 17-digit units
+/// (below), so whether the bounds belong to the interval (round-half-even reading) never
+/// matters.
 bool ShortestInRange(double value, Decimal& out) noexcept {
   const auto bits = std::bit_cast<std::uint64_t>(value);
   const int binary_exponent = static_cast<int>((bits >> 52U) & 0x7FFU) - 1023;  // E
@@ -206,33 +205,28 @@ bool ShortestInRange(double value, Decimal& out) noexcept {
   // against 10^k, in half units: floor(2N) gives it, and its fraction breaks an equality.
   const std::uint64_t scale = kPow10[k];
   const std::uint64_t rest = twice - 2 * digits * scale;
-  if (rest == scale && !inexact) return false;  // a tie: Dragonbox settles it, as Ryu does
+  if (rest == scale && !inexact) return false;  // a tie: Ryu's own rule settles it
   if (rest >= scale) ++digits;
   out = {digits, k - q};
   return true;
 }
 
-/// The shortest digits of a finite nonzero value (ShortestInRange where it applies, otherwise
-/// fmt's Dragonbox): the same as the standard library's Ryu (the tests compare the two over
-/// many values). Dragonbox comes from fmt's internal namespace because fmt's public API
-/// (format_to "{}") lays the digits out differently from std::to_chars (1e-04 against
-/// 0.0001) and std::to_chars itself costs about three times as much per cell.
-Decimal ShortestDecimal(double value) noexcept {
-  Decimal decimal{};
-  if (ShortestInRange(value, decimal)) return decimal;
-  const auto dragonbox = fmt::detail::dragonbox::to_decimal(value);
-  return {dragonbox.significand, dragonbox.exponent};
-}
-
 }  // namespace
 
 char* FormatShortest(char* first, double value) noexcept {
-  const Decimal decimal = ShortestDecimal(value);
+  Decimal decimal{};
+  // Outside ShortestInRange's range (about one cell in a million in a twin's log: tiny values,
+  // powers of two, ties) the standard library writes the text itself. fmt's Dragonbox, which
+  // this took the digits from before, is fmt's internal API; std::to_chars costs about three
+  // times as much, which no longer matters at that rate.
+  if (!ShortestInRange(value, decimal)) {
+    return std::to_chars(first, first + kMaxNumberChars, value).ptr;
+  }
   const std::uint64_t digits = decimal.digits;
   const int exponent = decimal.exponent;  // value = ±digits · 10^exponent, no trailing zero
-  if (value == 0.0 || exponent >= 0) {
-    // Zero and values >= 2^53 with no fraction: never in a log cell (the callers print them
-    // as whole numbers), so the standard library's layout of trailing zeros is kept as is.
+  if (exponent >= 0) {
+    // Values >= 10^16 or with no fraction: never in a log cell (the callers print whole
+    // numbers as such), so the standard library's layout of trailing zeros is kept as is.
     return std::to_chars(first, first + kMaxNumberChars, value).ptr;
   }
   if (std::signbit(value)) *first++ = '-';

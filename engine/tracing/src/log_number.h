@@ -21,9 +21,10 @@ inline constexpr std::size_t kNumberScratchChars = 8;
 /// FormatShortest. Every text reads back as the same double.
 char* FormatLogNumber(char* first, double value) noexcept;
 
-/// The text std::to_chars(first, last, value) writes for a finite double (same room) (the shortest that
-/// reads back as the same double, fixed or scientific, whichever is shorter, fixed on a tie),
-/// with the digits from Dragonbox, which costs about a third of the standard library's Ryu.
+/// The text std::to_chars(first, last, value) writes for a finite double (same room) (the
+/// shortest that reads back as the same double, fixed or scientific, whichever is shorter,
+/// fixed on a tie). For 2^-36 <= |value| < 2^49 the digits come from one 128-bit product,
+/// about a quarter of the standard library's Ryu; other values go to std::to_chars.
 char* FormatShortest(char* first, double value) noexcept;
 
 /// One column's last cell: the bits of its value and the text FormatLogNumber gave them. A

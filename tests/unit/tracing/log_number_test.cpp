@@ -206,7 +206,7 @@ TEST(LogNumberTest, ShortestIsTheStandardLibrarysText) {
 
 // FormatShortest's own 128-bit path takes 2^-36 <= |v| < 2^49 (every binary exponent there is
 // drawn evenly, which random bit patterns rarely do) and leaves ties and powers of two to
-// Dragonbox. Mantissas with many trailing zero bits give exact ties and values a few digits
+// std::to_chars. Mantissas with many trailing zero bits give exact ties and values a few digits
 // long; nextafter neighbours of short decimals give intervals whose ends sit next to a
 // candidate.
 TEST(LogNumberTest, ShortestMatchesTheStandardLibraryAcrossItsOwnRange) {
