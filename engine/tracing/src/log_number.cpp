@@ -89,7 +89,8 @@ char* WriteUnsigned(char* first, std::uint64_t v) noexcept {
 /// Writes the `count` digits of `digits` from first + 1, then moves the first `whole` of them
 /// left by one and puts the decimal point after them: "d.ddd" in one pass over the digits.
 /// Returns the end.
-char* WriteWithPoint(char* first, std::uint64_t digits, int count, int whole) noexcept {
+[[gnu::always_inline]] inline char* WriteWithPoint(char* first, std::uint64_t digits, int count,
+                                                 int whole) noexcept {
   char* const end = WriteZeroPadded(first + 1, digits, count);
   if (whole == 1) {  // a state's "1.7241130790320105", a duty's "0.7998046875": no memmove
     first[0] = first[1];
@@ -272,6 +273,14 @@ char* FormatLogNumber(char* first, double value) noexcept {
   // value / 2048, whose decimal expansion ends after 11 places) and whole numbers up to 2^53
   // are printed from integers. Each prints the value's exact decimal expansion, which reads
   // back as the very same double, so the file stays bit-exact.
+  if (magnitude >= 9007199254740992.0) return FormatShortest(first, value);
+  // 2^53: every whole double below is exact. Whole numbers first (cycle numbers, encoder
+  // counts): below 10^6 the 6-decimal shortcut would write the same text, for more work.
+  const auto whole = static_cast<std::int64_t>(magnitude);
+  if (static_cast<double>(whole) == magnitude) {
+    if (negative) *first++ = '-';
+    return WriteUnsigned(first, static_cast<std::uint64_t>(whole));
+  }
   if (magnitude < 1e6) {
     const double micros = RoundWhole(magnitude * 1e6);
     if (micros / 1e6 == magnitude) {
@@ -285,12 +294,6 @@ char* FormatLogNumber(char* first, double value) noexcept {
       // n / 2^11 = n · 5^11 / 10^11; below 10^6 · 2^11 · 5^11 < 2^57, no overflow.
       return WriteFixed<11>(first, negative,
                             static_cast<std::uint64_t>(whole_steps) * 48'828'125U);
-    }
-  } else if (magnitude < 9007199254740992.0) {  // 2^53: every whole double below is exact
-    const auto whole = static_cast<std::int64_t>(magnitude);
-    if (static_cast<double>(whole) == magnitude) {
-      if (negative) *first++ = '-';
-      return WriteUnsigned(first, static_cast<std::uint64_t>(whole));
     }
   }
   return FormatShortest(first, value);
