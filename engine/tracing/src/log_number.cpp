@@ -87,17 +87,28 @@ char* WriteUnsigned(char* first, std::uint64_t v) noexcept {
 }
 
 /// Writes the `count` digits of `digits` from first + 1, then moves the first `whole` of them
-/// left by one and puts the decimal point after them: "d.ddd" in one pass over the digits.
-/// Returns the end.
+/// (1 <= whole < count) left by one and puts the decimal point after them: "d.ddd" in one pass
+/// over the digits. Returns the end.
 [[gnu::always_inline]] inline char* WriteWithPoint(char* first, std::uint64_t digits, int count,
-                                                 int whole) noexcept {
+                                                   int whole) noexcept {
   char* const end = WriteZeroPadded(first + 1, digits, count);
-  if (whole == 1) {  // a state's "1.7241130790320105", a duty's "0.7998046875": no memmove
-    first[0] = first[1];
+  if (whole < 8) {
+    // One word: bytes below `whole` from the digits one place to the right, then the point,
+    // the bytes above it as they are (digits, or scratch past the end).
+    std::uint64_t shifted = 0;
+    std::uint64_t in_place = 0;
+    std::memcpy(&shifted, first + 1, 8);
+    std::memcpy(&in_place, first, 8);
+    const unsigned point_bit = 8U * static_cast<unsigned>(whole);
+    const std::uint64_t below = (std::uint64_t{1} << point_bit) - 1U;
+    const std::uint64_t above = ~((below << 8U) | 0xFFU);
+    const std::uint64_t word =
+        (shifted & below) | (std::uint64_t{'.'} << point_bit) | (in_place & above);
+    std::memcpy(first, &word, 8);
   } else {
     std::memmove(first, first + 1, static_cast<std::size_t>(whole));
+    first[whole] = '.';
   }
-  first[whole] = '.';
   return end;
 }
 
