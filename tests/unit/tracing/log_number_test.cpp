@@ -17,7 +17,9 @@
 
 namespace {
 
+using hiltwin::tracing::detail::CellMemo;
 using hiltwin::tracing::detail::FormatLogNumber;
+using hiltwin::tracing::detail::FormatLogRow;
 using hiltwin::tracing::detail::FormatShortest;
 using hiltwin::tracing::detail::kMaxNumberChars;
 using hiltwin::tracing::detail::kNumberScratchChars;
@@ -238,6 +240,38 @@ TEST(LogNumberTest, ShortestMatchesTheStandardLibraryAcrossItsOwnRange) {
       ADD_FAILURE() << "bits 0x" << std::hex << std::bit_cast<std::uint64_t>(signed_v)
                     << ": expected " << StdShortest(signed_v) << ", got " << Shortest(signed_v);
       if (++mismatches == 10) return;
+    }
+  }
+}
+
+// A row's text from FormatLogRow, whose memos copy a column's text while its value keeps its
+// bits, is the row of cells written one by one: across held values, values that change every
+// row, 0 and -0 (equal as doubles, not as bits), NaNs with other payloads, and the first row
+// (the memos start as 0's text).
+TEST(LogNumberTest, RowsWithRepeatedValuesMatchCellByCellFormatting) {
+  constexpr std::size_t kColumns = 6;
+  std::mt19937_64 random(36);
+  const double quiet_nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> pool = {0.0, -0.0, 0.5, -0.3994140625, 1.7241130790320105, 12345,
+                                    quiet_nan, FromBits(std::bit_cast<std::uint64_t>(quiet_nan) | 1U),
+                                    -quiet_nan, 1e-300, 25.00025};
+  std::vector<CellMemo> memos(kColumns);
+  char text[kColumns * (kMaxNumberChars + 1) + kNumberScratchChars];
+  double values[kColumns] = {};
+  int mismatches = 0;
+  for (int row = 0; row < 20'000 && mismatches < 10; ++row) {
+    std::string expected;
+    for (std::size_t c = 0; c < kColumns; ++c) {
+      // Column c keeps its value with probability c / kColumns, else draws one (maybe the same).
+      if (row == 0 || random() % kColumns >= c) values[c] = pool[random() % pool.size()];
+      if (c != 0) expected += ',';
+      expected += Reference(values[c]);
+    }
+    expected += '\n';
+    const std::string actual(text, FormatLogRow(text, values, kColumns, memos.data()));
+    if (actual != expected) {
+      ++mismatches;
+      ADD_FAILURE() << "row " << row << ": expected " << expected << "got " << actual;
     }
   }
 }
