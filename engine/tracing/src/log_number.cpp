@@ -92,7 +92,10 @@ char* WriteUnsigned(char* first, std::uint64_t v) noexcept {
 [[gnu::always_inline]] inline char* WriteWithPoint(char* first, std::uint64_t digits, int count,
                                                    int whole) noexcept {
   char* const end = WriteZeroPadded(first + 1, digits, count);
-  if (whole < 8) {
+  if (whole == 1) {  // a state's "1.7241130790320105", a duty's "0.7998046875"
+    first[0] = first[1];
+    first[1] = '.';
+  } else if (whole < 8) {  // a time's "25.00025", a state's "-10.939231391709034"
     // One word: bytes below `whole` from the digits one place to the right, then the point,
     // the bytes above it as they are (digits, or scratch past the end).
     std::uint64_t shifted = 0;
