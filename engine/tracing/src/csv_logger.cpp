@@ -36,6 +36,12 @@ static_assert((kMaxLogColumns + 1) * (detail::kMaxNumberChars + 1) + detail::kNu
 constexpr std::size_t kMaxQueueCapacityRows = std::size_t{1} << 24;
 // MATLAB's namelengthmax: longer names would be truncated by readtable.
 constexpr std::size_t kMaxColumnNameChars = 63;
+// Rows the writer formats before it hands their slots back (DrainAvailable): 8 KiB of a
+// 15-column row, 1/1024 of the default queue.
+constexpr std::size_t kReleaseBatchRows = 64;
+// The queue's rows start on a cache line, so a 16-double row is exactly two lines and the
+// producer's row never shares a line with the one the writer reads.
+constexpr std::size_t kRowAlignment = 64;
 
 std::string ErrnoText(int err) {
   // strerror is not thread-safe in theory; this runs on set-up and error paths only, and the
@@ -133,6 +139,13 @@ std::pair<std::size_t, int> WriteAll(int fd, const char* data, std::size_t size)
   return {done, 0};
 }
 
+/// The first cache-line boundary in `storage` (which has kRowAlignment bytes to spare).
+double* AlignedRows(double* storage) noexcept {
+  void* start = storage;
+  std::size_t space = kRowAlignment;
+  return static_cast<double*>(std::align(kRowAlignment, sizeof(double), start, space));
+}
+
 }  // namespace
 
 CsvLogger::CsvLogger(CsvLoggerConfig config)
@@ -140,7 +153,10 @@ CsvLogger::CsvLogger(CsvLoggerConfig config)
       row_stride_(1 + config_.columns.size()),
       ring_(config_.queue_capacity_rows),
       // Value-initialised, so every page is touched now rather than in the loop.
-      rows_(std::make_unique<double[]>(config_.queue_capacity_rows * row_stride_)),
+      row_storage_(std::make_unique<double[]>(config_.queue_capacity_rows * row_stride_ +
+                                              kRowAlignment / sizeof(double))),
+      rows_(AlignedRows(row_storage_.get())),
+      cell_memos_(std::make_unique<detail::CellMemo[]>(row_stride_)),
       file_buffer_(std::make_unique<char[]>(kFileBufferBytes)) {
   fd_ = kernel_glue::OpenOutputFile(config_.path, "the log file");
   std::string header;
@@ -205,7 +221,7 @@ bool CsvLogger::TryLog(double time_s, std::span<const double> values) noexcept {
                             std::memory_order_relaxed);
     return false;
   }
-  double* row = rows_.get() + slot * row_stride_;
+  double* row = rows_ + slot * row_stride_;
   row[0] = time_s;
   std::copy(values.begin(), values.end(), row + 1);
   ring_.Publish();
@@ -289,28 +305,26 @@ void CsvLogger::ConfigureWriterThread() {
 void CsvLogger::DrainAvailable() {
   std::size_t available = ring_.Available();
   while (available != 0) {
-    for (; available != 0; --available) {
+    // Slots go back to the producer a batch at a time: one store to the shared index per batch
+    // rather than per row, and a waiting producer (wait_when_full) refills a batch's worth of
+    // rows away from the ones being read instead of the row next to them.
+    const std::size_t batch = std::min(available, kReleaseBatchRows);
+    for (std::size_t r = 0; r < batch; ++r) {
       if (!write_failed_ && kFileBufferBytes - buffered_bytes_ < kMaxLineBytes) WriteBuffer();
       if (write_failed_ || fd_ < 0) {
         // The log has ended (see the header): the row is counted, not written.
-        ring_.Release(1);
         lost_.store(lost_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
         continue;
       }
-      const double* row = rows_.get() + ring_.ReadSlot(0) * row_stride_;
+      const double* row = rows_ + ring_.ReadSlot(r) * row_stride_;
       char* const first = file_buffer_.get() + buffered_bytes_;
-      char* out = detail::FormatLogNumber(first, row[0]);
-      for (std::size_t c = 1; c < row_stride_; ++c) {
-        *out++ = ',';
-        out = detail::FormatLogNumber(out, row[c]);
-      }
-      *out++ = '\n';
-      // Release per row: frees space for the producer as early as possible (a plain store).
-      ring_.Release(1);
-      buffered_bytes_ += static_cast<std::size_t>(out - first);
+      char* const end = detail::FormatLogRow(first, row, row_stride_, cell_memos_.get());
+      buffered_bytes_ += static_cast<std::size_t>(end - first);
       ++buffered_rows_;
     }
-    available = ring_.Available();
+    ring_.Release(batch);
+    available -= batch;
+    if (available == 0) available = ring_.Available();
   }
 }
 

@@ -17,7 +17,9 @@
 
 namespace {
 
+using hiltwin::tracing::detail::CellMemo;
 using hiltwin::tracing::detail::FormatLogNumber;
+using hiltwin::tracing::detail::FormatLogRow;
 using hiltwin::tracing::detail::FormatShortest;
 using hiltwin::tracing::detail::kMaxNumberChars;
 using hiltwin::tracing::detail::kNumberScratchChars;
@@ -110,6 +112,13 @@ void ExpectSameCells(const std::vector<double>& values) {
 
 double FromBits(std::uint64_t bits) { return std::bit_cast<double>(bits); }
 
+constexpr std::int64_t kPow10Test[] = {1,           10,           100,           1'000,
+                                       10'000,      100'000,      1'000'000,     10'000'000,
+                                       100'000'000, 1'000'000'000, 10'000'000'000, 100'000'000'000,
+                                       1'000'000'000'000, 10'000'000'000'000,
+                                       100'000'000'000'000, 1'000'000'000'000'000,
+                                       10'000'000'000'000'000, 100'000'000'000'000'000};
+
 TEST(LogNumberTest, SpecialValuesAreSpelledAsBefore) {
   const double inf = std::numeric_limits<double>::infinity();
   EXPECT_EQ(Cell(std::nan("")), "NaN");
@@ -194,6 +203,76 @@ TEST(LogNumberTest, ShortestIsTheStandardLibrarysText) {
                          123456789012345678901.0, -0.0, 0.0}) {
     EXPECT_EQ(Shortest(v), StdShortest(v));
     EXPECT_EQ(Shortest(-v), StdShortest(-v));
+  }
+}
+
+// FormatShortest's own 128-bit path takes 2^-36 <= |v| < 2^49 (every binary exponent there is
+// drawn evenly, which random bit patterns rarely do) and leaves ties and powers of two to
+// std::to_chars. Mantissas with many trailing zero bits give exact ties and values a few digits
+// long; nextafter neighbours of short decimals give intervals whose ends sit next to a
+// candidate.
+TEST(LogNumberTest, ShortestMatchesTheStandardLibraryAcrossItsOwnRange) {
+  std::mt19937_64 random(3636);
+  std::vector<double> values;
+  for (int exponent = -40; exponent <= 52; ++exponent) {
+    for (int i = 0; i < 12'000; ++i) {
+      const std::uint64_t mantissa = random() & ((std::uint64_t{1} << 52U) - 1U);
+      const int zero_bits = static_cast<int>(random() % 53U);
+      const std::uint64_t bits = static_cast<std::uint64_t>(exponent + 1023) << 52U;
+      values.push_back(FromBits(bits | mantissa));
+      values.push_back(FromBits(bits | ((mantissa >> zero_bits) << zero_bits)));
+    }
+  }
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::uniform_int_distribution<std::int64_t> significand(1, 99'999'999'999'999'999);
+    for (int i = 0; i < 3'000; ++i) {
+      const double v = static_cast<double>(significand(random) % kPow10Test[digits]) *
+                       std::pow(10.0, static_cast<double>(static_cast<int>(random() % 30U)) - 20);
+      values.push_back(v);
+      values.push_back(std::nextafter(v, 0.0));
+      values.push_back(std::nextafter(v, 1e300));
+    }
+  }
+  int mismatches = 0;
+  for (const double v : values) {
+    for (const double signed_v : {v, -v}) {
+      if (Shortest(signed_v) == StdShortest(signed_v)) continue;
+      ADD_FAILURE() << "bits 0x" << std::hex << std::bit_cast<std::uint64_t>(signed_v)
+                    << ": expected " << StdShortest(signed_v) << ", got " << Shortest(signed_v);
+      if (++mismatches == 10) return;
+    }
+  }
+}
+
+// A row's text from FormatLogRow, whose memos copy a column's text while its value keeps its
+// bits, is the row of cells written one by one: across held values, values that change every
+// row, 0 and -0 (equal as doubles, not as bits), NaNs with other payloads, and the first row
+// (the memos start as 0's text).
+TEST(LogNumberTest, RowsWithRepeatedValuesMatchCellByCellFormatting) {
+  constexpr std::size_t kColumns = 6;
+  std::mt19937_64 random(36);
+  const double quiet_nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> pool = {0.0, -0.0, 0.5, -0.3994140625, 1.7241130790320105, 12345,
+                                    quiet_nan, FromBits(std::bit_cast<std::uint64_t>(quiet_nan) | 1U),
+                                    -quiet_nan, 1e-300, 25.00025};
+  std::vector<CellMemo> memos(kColumns);
+  char text[kColumns * (kMaxNumberChars + 1) + kNumberScratchChars];
+  double values[kColumns] = {};
+  int mismatches = 0;
+  for (int row = 0; row < 20'000 && mismatches < 10; ++row) {
+    std::string expected;
+    for (std::size_t c = 0; c < kColumns; ++c) {
+      // Column c keeps its value with probability c / kColumns, else draws one (maybe the same).
+      if (row == 0 || random() % kColumns >= c) values[c] = pool[random() % pool.size()];
+      if (c != 0) expected += ',';
+      expected += Reference(values[c]);
+    }
+    expected += '\n';
+    const std::string actual(text, FormatLogRow(text, values, kColumns, memos.data()));
+    if (actual != expected) {
+      ++mismatches;
+      ADD_FAILURE() << "row " << row << ": expected " << expected << "got " << actual;
+    }
   }
 }
 
