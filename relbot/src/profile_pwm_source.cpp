@@ -1,6 +1,7 @@
 // An input profile played into the PWM reader (profile_pwm_source.h).
 #include "hiltwin/relbot/profile_pwm_source.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -37,17 +38,45 @@ double ProfilePwmSource::FrameOf(std::int64_t t_ns) const noexcept {
   return std::round(static_cast<double>(t_ns) / twin_period_ns_);
 }
 
-void ProfilePwmSource::DutyAt(std::int64_t t_ns,
-                              std::array<double, io::kChannels>& duty_out) noexcept {
+void ProfilePwmSource::Resample(std::int64_t t_ns) noexcept {
   // Sample-and-hold at the controller's rate: the duty the ECS last wrote, on the frame grid.
-  const double sample = std::floor(FrameOf(t_ns) * controller_rate_hz_ / twin_rate_hz_);
+  const double sample = SampleOf(FrameOf(t_ns));
   if (!(sample == last_sample_)) {
     last_duty_ = profile_.At(sample / controller_rate_hz_, cursor_);
     last_sample_ = sample;
   }
-  duty_out.fill(0.0);
-  duty_out[kLeftChannel] = last_duty_.left;
-  duty_out[kRightChannel] = last_duty_.right;
+  held_.fill(0.0);
+  held_[kLeftChannel] = last_duty_.left;
+  held_[kRightChannel] = last_duty_.right;
+  held_from_ns_ = t_ns;
+  held_until_ns_ = FirstNsAfterSample(sample, t_ns);
+}
+
+std::int64_t ProfilePwmSource::FirstNsAfterSample(double sample, std::int64_t t_ns) const noexcept {
+  // Outside the integer frames, or for rates no sample grid is made of, the range stays
+  // empty and every call looks up again (as every call did before the range was kept).
+  if (t_ns < 0 || t_ns >= kIntegerFramesBelowNs || period_ns_ <= 0 ||
+      !(controller_rate_hz_ > 0.0 && twin_rate_hz_ > 0.0) || !(sample >= 0.0) ||
+      !(sample < 0x1p52)) {
+    return t_ns;
+  }
+  // The first frame f with SampleOf(f) >= sample + 1, i.e. f * c / r >= sample + 1 in the
+  // contract's doubles: estimated, then settled by that very test (monotonic in f).
+  const double next = sample + 1.0;
+  const double last_frame = static_cast<double>(kIntegerFramesBelowNs / period_ns_);
+  const auto reaches = [&](double frame) {
+    return frame * controller_rate_hz_ / twin_rate_hz_ >= next;
+  };
+  double frame = std::min(std::trunc(next * twin_rate_hz_ / controller_rate_hz_), last_frame);
+  while (frame > 0.0 && reaches(frame - 1.0)) frame -= 1.0;
+  while (!reaches(frame)) {
+    if (frame >= last_frame) return kIntegerFramesBelowNs;
+    frame += 1.0;
+  }
+  // FrameOf(t) = (2t + P) div 2P >= f  <=>  t >= f * P - floor(P / 2).
+  const std::int64_t first_ns =
+      static_cast<std::int64_t>(frame) * period_ns_ - period_ns_ / 2;
+  return std::clamp(first_ns, t_ns, kIntegerFramesBelowNs);
 }
 
 }  // namespace hiltwin::app
