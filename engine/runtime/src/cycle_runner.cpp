@@ -38,7 +38,7 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   step_status_ = StepStatus::Ok();
   const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
   const io::ExchangeStatus io = task_.Exchange(rules_.live_outputs);
-  io_ns_ = clock_.NowNs() - io_start_ns;
+  SetIoNsOfLastStep(clock_.NowNs() - io_start_ns);
   io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
   peer_stop_seen_ = false;
   if (!io.ok() || io.peer_absent || io.pulse_limit || io.peer_stopped != nullptr) [[unlikely]] {

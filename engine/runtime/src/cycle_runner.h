@@ -77,7 +77,6 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
               const CycleRunnerConfig& config);
 
   scheduler::CycleAction Step(const scheduler::CycleContext& context) noexcept override;
-  [[nodiscard]] kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
   scheduler::CycleAction OnCycle(const scheduler::TimingSample& sample) noexcept override;
 
   /// Thread-safe and lock-free: the loop acts on it after the current cycle, in the order
@@ -135,7 +134,6 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   // runs, so the rules read in Step hold until OnCycle posts events.
   lifecycle::StateRules rules_;
   std::optional<lifecycle::State> rules_state_;  ///< the state rules_ are of (none yet)
-  kernel_glue::TimeNs io_ns_ = 0;
   bool stepped_ = false;
   bool io_fault_ = false;
   StepStatus step_status_;

@@ -40,15 +40,20 @@ class ProfilePwmSource final : public io::PwmSignalSource {
   double twin_rate_hz_;
   /// Frame index of t_ns on the twin's grid (0 before it starts): round(t_ns / period).
   [[nodiscard]] double FrameOf(std::int64_t t_ns) const noexcept;
-  /// The controller's sample at frame `frame` (the contract's expression).
+  /// Frame `frame` in controller samples; its floor is the frame's sample (the contract's
+  /// expression).
+  [[nodiscard]] double FrameRatio(double frame) const noexcept {
+    return frame * controller_rate_hz_ / twin_rate_hz_;
+  }
   [[nodiscard]] double SampleOf(double frame) const noexcept {
-    return std::floor(frame * controller_rate_hz_ / twin_rate_hz_);
+    return std::floor(FrameRatio(frame));
   }
   /// Looks up the sample of t_ns and the range of times that read it.
   void Resample(std::int64_t t_ns) noexcept;
-  /// The first time whose frame reads a sample after `sample` (at most 2^51 ns, where frames
-  /// leave integers; t_ns itself when that cannot be told).
-  [[nodiscard]] std::int64_t FirstNsAfterSample(double sample, std::int64_t t_ns) const noexcept;
+  /// Ends the held range at the first time whose frame reads a sample after `sample` (at most
+  /// 2^51 ns, where frames leave integers; empty when that cannot be told), and notes that
+  /// frame's end and sample.
+  void HoldUntilNextSample(double sample, std::int64_t t_ns) noexcept;
 
   std::int64_t period_ns_;  ///< whole nanoseconds, as the board counts them
   double twin_period_ns_;   ///< the same, as a double
@@ -64,6 +69,12 @@ class ProfilePwmSource final : public io::PwmSignalSource {
   std::int64_t held_from_ns_ = 0;
   std::int64_t held_until_ns_ = 0;
   std::array<double, io::kChannels> held_{};
+  // The frame [held_until_ns_, next_frame_end_ns_) reads next_sample_ (empty: not known).
+  std::int64_t next_frame_end_ns_ = 0;
+  double next_sample_ = 0.0;
+  bool ranges_;                ///< the rates make a sample grid (positive and finite)
+  double frames_per_sample_;   ///< an estimate only: the exact test settles every boundary
+  double last_frame_;          ///< the last frame below 2^51 ns
 };
 
 }  // namespace hiltwin::app
