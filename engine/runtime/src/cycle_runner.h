@@ -106,6 +106,10 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   /// Offers this cycle's events to the lifecycle; false when there were none (the state is
   /// unchanged, the common case).
   bool PostEvents(const scheduler::TimingSample& sample) noexcept;
+  /// The events of a cycle that had some, in the order the report's cause needs.
+  [[gnu::noinline]] void HandleEvents(std::uint64_t cycle, bool plan_done) noexcept;
+  /// The QoS part of a cycle that missed or skipped releases (out of the common path).
+  [[gnu::noinline]] void RecordMisses(const scheduler::TimingSample& sample) noexcept;
   void NoteFault(lifecycle::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
   /// Counts and traces an exchange that was not plainly ok (out of the common cycle's path).
   [[gnu::cold, gnu::noinline]] void NoteExchange(const io::ExchangeStatus& io,
