@@ -18,6 +18,11 @@ namespace {
 // rounding cannot cross a half. Integers spare a division and a call of round() per frame.
 constexpr std::int64_t kIntegerFramesBelowNs = std::int64_t{1} << 51;
 
+// The last frame counted in integers: frame * period stays at or below 2^51 ns (period > 0).
+constexpr std::int64_t LastIntegerFrame(std::int64_t period_ns) {
+  return kIntegerFramesBelowNs / period_ns;
+}
+
 }  // namespace
 
 ProfilePwmSource::ProfilePwmSource(const InputProfile& profile, double controller_rate_hz,
@@ -31,7 +36,7 @@ ProfilePwmSource::ProfilePwmSource(const InputProfile& profile, double controlle
       ranges_(period_ns_ > 0 && controller_rate_hz > 0.0 && twin_rate_hz > 0.0 &&
               std::isfinite(controller_rate_hz) && std::isfinite(twin_rate_hz)),
       frames_per_sample_(ranges_ ? twin_rate_hz / controller_rate_hz : 0.0),
-      last_frame_(ranges_ ? static_cast<double>(kIntegerFramesBelowNs / period_ns_) : 0.0) {}
+      last_frame_(ranges_ ? static_cast<double>(LastIntegerFrame(period_ns_)) : 0.0) {}
 
 double ProfilePwmSource::FrameOf(std::int64_t t_ns) const noexcept {
   if (t_ns < 0) return 0.0;
