@@ -167,6 +167,25 @@ InputProfile InputProfile::FromKnots(std::string name, std::vector<ProfileKnot> 
   return InputProfile(std::move(name), std::move(knots));
 }
 
+// The upper bound is the one index with knot[index - 1] <= local_s < knot[index] (the ends
+// counting as -inf and +inf), so a hint that passes this test is the search's answer.
+[[gnu::always_inline]] inline bool InputProfile::IsKnotAfter(double local_s,
+                                                            std::size_t index) const noexcept {
+  return index <= knots_.size() && (index == 0 || knots_[index - 1].time_s <= local_s) &&
+         (index == knots_.size() || local_s < knots_[index].time_s);
+}
+
+// Inline in At, which a player calls at every controller sample.
+[[gnu::always_inline]] inline std::size_t InputProfile::KnotAfter(
+    double local_s, std::size_t hint) const noexcept {
+  if (IsKnotAfter(local_s, hint)) return hint;  // still in the same segment
+  if (IsKnotAfter(local_s, hint + 1)) return hint + 1;  // moved on into the next one
+  const auto it = std::upper_bound(
+      knots_.begin(), knots_.end(), local_s,
+      [](double t, const ProfileKnot& knot) { return t < knot.time_s; });
+  return static_cast<std::size_t>(it - knots_.begin());
+}
+
 Duty InputProfile::At(double t_s) const noexcept {
   std::size_t cursor = 0;
   return At(t_s, cursor);
@@ -189,22 +208,6 @@ Duty InputProfile::At(double t_s, std::size_t& cursor) const noexcept {
   const double f = (local_s - a.time_s) / (b.time_s - a.time_s);
   return Duty{a.duty.left + f * (b.duty.left - a.duty.left),
               a.duty.right + f * (b.duty.right - a.duty.right)};
-}
-
-// The upper bound is the one index with knot[index - 1] <= local_s < knot[index] (the ends
-// counting as -inf and +inf), so a hint that passes this test is the search's answer.
-bool InputProfile::IsKnotAfter(double local_s, std::size_t index) const noexcept {
-  return index <= knots_.size() && (index == 0 || knots_[index - 1].time_s <= local_s) &&
-         (index == knots_.size() || local_s < knots_[index].time_s);
-}
-
-std::size_t InputProfile::KnotAfter(double local_s, std::size_t hint) const noexcept {
-  if (IsKnotAfter(local_s, hint)) return hint;  // still in the same segment
-  if (IsKnotAfter(local_s, hint + 1)) return hint + 1;  // moved on into the next one
-  const auto it = std::upper_bound(
-      knots_.begin(), knots_.end(), local_s,
-      [](double t, const ProfileKnot& knot) { return t < knot.time_s; });
-  return static_cast<std::size_t>(it - knots_.begin());
 }
 
 std::span<const std::string_view> BuiltinProfileNames() noexcept { return kBuiltinNames; }

@@ -1,6 +1,7 @@
 // An input profile played into the PWM reader (profile_pwm_source.h).
 #include "hiltwin/relbot/profile_pwm_source.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -17,6 +18,11 @@ namespace {
 // rounding cannot cross a half. Integers spare a division and a call of round() per frame.
 constexpr std::int64_t kIntegerFramesBelowNs = std::int64_t{1} << 51;
 
+// The last frame counted in integers: frame * period stays at or below 2^51 ns (period > 0).
+constexpr std::int64_t LastIntegerFrame(std::int64_t period_ns) {
+  return kIntegerFramesBelowNs / period_ns;
+}
+
 }  // namespace
 
 ProfilePwmSource::ProfilePwmSource(const InputProfile& profile, double controller_rate_hz,
@@ -26,7 +32,11 @@ ProfilePwmSource::ProfilePwmSource(const InputProfile& profile, double controlle
       twin_rate_hz_(twin_rate_hz),
       period_ns_(kernel_glue::PeriodNsFromRateHz(twin_rate_hz)),
       twin_period_ns_(static_cast<double>(period_ns_)),
-      last_sample_(std::numeric_limits<double>::quiet_NaN()) {}
+      last_sample_(std::numeric_limits<double>::quiet_NaN()),
+      ranges_(period_ns_ > 0 && controller_rate_hz > 0.0 && twin_rate_hz > 0.0 &&
+              std::isfinite(controller_rate_hz) && std::isfinite(twin_rate_hz)),
+      frames_per_sample_(ranges_ ? twin_rate_hz / controller_rate_hz : 0.0),
+      last_frame_(ranges_ ? static_cast<double>(LastIntegerFrame(period_ns_)) : 0.0) {}
 
 double ProfilePwmSource::FrameOf(std::int64_t t_ns) const noexcept {
   if (t_ns < 0) return 0.0;
@@ -37,17 +47,50 @@ double ProfilePwmSource::FrameOf(std::int64_t t_ns) const noexcept {
   return std::round(static_cast<double>(t_ns) / twin_period_ns_);
 }
 
-void ProfilePwmSource::DutyAt(std::int64_t t_ns,
-                              std::array<double, io::kChannels>& duty_out) noexcept {
+void ProfilePwmSource::Resample(std::int64_t t_ns) noexcept {
   // Sample-and-hold at the controller's rate: the duty the ECS last wrote, on the frame grid.
-  const double sample = std::floor(FrameOf(t_ns) * controller_rate_hz_ / twin_rate_hz_);
+  // A player going forward frame by frame lands in the frame the held range ended at, whose
+  // sample was found with that end.
+  const double sample = t_ns >= held_until_ns_ && t_ns < next_frame_end_ns_
+                            ? next_sample_
+                            : SampleOf(FrameOf(t_ns));
   if (!(sample == last_sample_)) {
     last_duty_ = profile_.At(sample / controller_rate_hz_, cursor_);
     last_sample_ = sample;
   }
-  duty_out.fill(0.0);
-  duty_out[kLeftChannel] = last_duty_.left;
-  duty_out[kRightChannel] = last_duty_.right;
+  held_.fill(0.0);
+  held_[kLeftChannel] = last_duty_.left;
+  held_[kRightChannel] = last_duty_.right;
+  held_from_ns_ = t_ns;
+  HoldUntilNextSample(sample, t_ns);
+}
+
+void ProfilePwmSource::HoldUntilNextSample(double sample, std::int64_t t_ns) noexcept {
+  // Outside the integer frames, or for rates no sample grid is made of, the range stays
+  // empty and every call looks up again (as every call did before the range was kept).
+  held_until_ns_ = t_ns;
+  next_frame_end_ns_ = t_ns;
+  if (!ranges_ || t_ns < 0 || t_ns >= kIntegerFramesBelowNs || !(sample < 0x1p52)) return;
+  // The first frame f with SampleOf(f) >= sample + 1, i.e. f * c / r >= sample + 1 in the
+  // contract's doubles: estimated, then settled by that very test (monotonic in f).
+  const double next = sample + 1.0;
+  double frame = std::min(std::trunc(next * frames_per_sample_), last_frame_);
+  while (frame > 0.0 && FrameRatio(frame - 1.0) >= next) frame -= 1.0;
+  double ratio = FrameRatio(frame);
+  while (!(ratio >= next)) {
+    if (frame >= last_frame_) {
+      held_until_ns_ = kIntegerFramesBelowNs;
+      return;
+    }
+    frame += 1.0;
+    ratio = FrameRatio(frame);
+  }
+  // FrameOf(t) = (2t + P) div 2P >= f  <=>  t >= f * P - floor(P / 2).
+  const std::int64_t first_ns = static_cast<std::int64_t>(frame) * period_ns_ - period_ns_ / 2;
+  if (first_ns <= t_ns) return;  // cannot be (t_ns reads an earlier sample): stay empty
+  held_until_ns_ = first_ns;
+  next_frame_end_ns_ = std::min(first_ns + period_ns_, kIntegerFramesBelowNs);
+  next_sample_ = std::floor(ratio);
 }
 
 }  // namespace hiltwin::app

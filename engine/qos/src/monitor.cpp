@@ -123,6 +123,10 @@ QosMonitor::QosMonitor(const QosConfig& config) : config_(config) {
       std::max<std::uint64_t>(64, std::bit_ceil(std::uint64_t{max_k}));
   ring_words_.assign(capacity_bits / 64, 0);
   ring_mask_ = capacity_bits - 1;
+  rest_after_ = max_k;
+  unplanned_ratio_ = std::any_of(engines_.begin(), engines_.end(), [](const Engine& engine) {
+    return engine.kind == RuleKind::kMissRatio && engine.miss_budget == 0;
+  });
   live_distance_.store(min_distance, std::memory_order_relaxed);
 }
 
@@ -213,7 +217,32 @@ std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
       engine.miss_budget > 0 ? BudgetDistance(engine) : RatioDistance(engine);
 }
 
-bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
+bool QosMonitor::AtRest() const noexcept {
+  if (met_run_ < rest_after_ || unplanned_ratio_) return false;
+  for (std::size_t i = 0; i < engines_.size(); ++i) {
+    if (engines_[i].kind == RuleKind::kMissRatio && status_[i].violated) return false;
+  }
+  return true;
+}
+
+void QosMonitor::LeaveRest() noexcept {
+  quiet_ = false;
+  // Every bit a window can still read (the last rest_after_ judged cycles) is a met one.
+  std::fill(ring_words_.begin(), ring_words_.end(), 0);
+  // The m most recent met cycles are the last m judged ones (m <= k <= rest_after_), oldest
+  // first; only the order from met_head on is ever read.
+  const auto last = static_cast<std::int64_t>(judged_cycles_) - 1;
+  for (Engine& engine : engines_) {
+    const std::size_t m = engine.met_ring.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      engine.met_ring[i] = last - static_cast<std::int64_t>(m - 1 - i);
+    }
+    engine.met_head = 0;
+  }
+}
+
+bool QosMonitor::RecordInFull(std::uint64_t cycle, bool missed) noexcept {
+  if (quiet_) LeaveRest();
   run_all_ = missed ? run_all_ + 1 : 0;
   max_run_all_ = std::max(max_run_all_, run_all_);
   if (cycle < config_.grace_cycles) {
@@ -228,6 +257,7 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
   misses_ += missed ? 1U : 0U;
   run_ = missed ? run_ + 1 : 0;
   max_run_ = std::max(max_run_, run_);
+  met_run_ = missed ? 0 : met_run_ + 1;
 
   std::uint32_t min_distance = kNeverFails;
   bool any_violated = false;
@@ -259,6 +289,7 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
     min_distance = std::min(min_distance, status.distance_to_failure);
   }
   SetBit(t, missed);
+  quiet_ = !missed && AtRest();
 
   live_releases_.store(releases_recorded(), std::memory_order_relaxed);
   live_all_misses_.store(all_misses(), std::memory_order_relaxed);

@@ -38,7 +38,7 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
   step_status_ = StepStatus::Ok();
   const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
   const io::ExchangeStatus io = task_.Exchange(rules_.live_outputs);
-  io_ns_ = clock_.NowNs() - io_start_ns;
+  SetIoNsOfLastStep(clock_.NowNs() - io_start_ns);
   io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
   peer_stop_seen_ = false;
   if (!io.ok() || io.peer_absent || io.pulse_limit || io.peer_stopped != nullptr) [[unlikely]] {
@@ -112,14 +112,18 @@ scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sampl
 
 [[gnu::always_inline]] inline void CycleRunner::RecordQos(
     const scheduler::TimingSample& sample) noexcept {
+  qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
+  if (sample.missed || sample.releases_skipped > 0) [[unlikely]] RecordMisses(sample);
+}
+
+void CycleRunner::RecordMisses(const scheduler::TimingSample& sample) noexcept {
   // Skipped releases are misses too, but once the monitor says abort the run has ended:
   // releases after that one are not judged.
-  qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
   for (std::uint32_t i = 1; i <= sample.releases_skipped && !qos_abort_; ++i) {
     qos_abort_ = monitor_.Record(sample.cycle + i, true);
   }
   // A rule's violation count can only rise on a miss: the common cycle skips the loop.
-  if (sample.missed || sample.releases_skipped > 0) TraceViolations(sample.cycle);
+  TraceViolations(sample.cycle);
 }
 
 void CycleRunner::TraceViolations(std::uint64_t cycle) noexcept {
@@ -191,11 +195,14 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
                      !plan_done && !peer_stop_seen_ && !commands_.MaybeNonEmpty() &&
                      !kernel_glue::StopRequested();
   if (quiet) return false;
+  HandleEvents(sample.cycle, plan_done);
+  return true;
+}
+
+void CycleRunner::HandleEvents(std::uint64_t cycle, bool plan_done) noexcept {
   // Faults first: when several causes meet in one cycle the report names the one that makes
   // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
-  const auto handle = [this, &sample](Event event) {
-    HandleTraced(lifecycle_, event, sample.cycle);
-  };
+  const auto handle = [this, cycle](Event event) { HandleTraced(lifecycle_, event, cycle); };
   if (io_fault_) handle(Event::kIoFault);
   if (step_status_.code == StepStatus::Code::kModelFault) handle(Event::kModelFault);
   if (qos_abort_) handle(Event::kQosAbort);
@@ -204,8 +211,7 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
     handle(Event::kFinishReached);
   }
   if (peer_stop_seen_) handle(Event::kPeerStopped);
-  HandleCommands(sample.cycle);
-  return true;
+  HandleCommands(cycle);
 }
 
 void CycleRunner::HandleCommands(std::uint64_t cycle) noexcept {

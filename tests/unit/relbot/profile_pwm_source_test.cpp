@@ -69,5 +69,43 @@ TEST(ProfilePwmSource, PlaysTheControllersSamplesBitForBitInAnyOrder) {
   }
 }
 
+// The source plays a held sample again for any time in the range it knows the sample covers
+// (up to the first nanosecond of the next sample's first frame): every nanosecond around
+// those boundaries, times off the frame grid walked forward, and rate pairs whose samples
+// change every frame or at uneven frames must still read the contract's duty.
+TEST(ProfilePwmSource, AHeldSampleEndsAtTheNanosecondTheNextOneStarts) {
+  const InputProfile profile = OpenLoopProfile();
+  for (const auto& [controller_hz, twin_hz] :
+       {std::pair{1000.0, 4000.0}, std::pair{1000.0, 7000.0}, std::pair{3000.0, 7000.0},
+        std::pair{333.0, 4000.0}, std::pair{5000.0, 4000.0}, std::pair{50000.0, 3.0},
+        std::pair{1.0, 50000.0}, std::pair{4000.0, 4000.0}}) {
+    ProfilePwmSource source(profile, controller_hz, twin_hz);
+    const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(twin_hz);
+    std::array<double, io::kChannels> duty{};
+    const auto expect_plays = [&](std::int64_t t_ns) {
+      source.DutyAt(t_ns, duty);
+      const Duty expected = FromScratch(profile, controller_hz, twin_hz, t_ns);
+      ASSERT_EQ(duty[kLeftChannel], expected.left) << t_ns << " ns, " << controller_hz << " Hz";
+      ASSERT_EQ(duty[kRightChannel], expected.right) << t_ns << " ns, " << controller_hz;
+    };
+    // Every nanosecond across the half-period edges of the first frames and of frames
+    // around 1.7 s (on a ramp of the profile), forward.
+    for (const std::int64_t first_frame :
+         {std::int64_t{0}, std::int64_t{1'700'000'000} / period_ns}) {
+      for (std::int64_t f = first_frame; f < first_frame + 12; ++f) {
+        const std::int64_t edge = f * period_ns + period_ns / 2;
+        for (std::int64_t t = edge - 3; t <= edge + 3; ++t) expect_plays(t);
+      }
+    }
+    // Off the grid, forward over 40 s (a step of 37.129 us against any period).
+    for (std::int64_t t = 0; t < 40'000'000'000; t += 37'129) expect_plays(t);
+    // Up to where frames leave integers, and across it.
+    const std::int64_t top = std::int64_t{1} << 51;
+    for (std::int64_t t = top - 4 * period_ns; t < top + 2 * period_ns; t += period_ns / 3 + 1) {
+      expect_plays(t);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hiltwin::app

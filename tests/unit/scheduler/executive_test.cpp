@@ -343,14 +343,12 @@ TEST(Executive, IoTimeIsReportedApartFromComputeTime) {
    public:
     explicit IoTask(kernel_glue::Clock& c) : clock_(c) {}
     CycleAction Step(const CycleContext& ctx) noexcept override {
-      io_ns_ = 12'000 + static_cast<TimeNs>(ctx.cycle);
+      SetIoNsOfLastStep(12'000 + static_cast<TimeNs>(ctx.cycle));
       clock_.SpendNs(30'000);
       return CycleAction::kContinue;
     }
-    TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
    private:
     kernel_glue::Clock& clock_;
-    TimeNs io_ns_ = 0;
   };
   VirtualClock clock;
   Executive executive(clock, Config(kP, 5));
