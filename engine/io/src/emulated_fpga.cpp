@@ -1,5 +1,7 @@
 #include "hiltwin/io/emulated_fpga.h"
 
+#include <bit>
+
 #include "hiltwin/io/conversions.h"
 
 namespace hiltwin::io {
@@ -19,6 +21,7 @@ void EmulatedFpga::ResetState() noexcept {
   data_frames_ = 0;
   for (auto& emulator : emulators_) emulator.Reset();
   pwm_values_.fill(0);
+  pwm_memo_valid_ = false;
   counts_.fill(0);
   pins_out_.fill(false);
   lines_.Reset();
@@ -73,6 +76,11 @@ void EmulatedFpga::TakeRequest(const FrameBytes& mosi) noexcept {
 void EmulatedFpga::ActOn(const FrameBytes& request_bytes) noexcept {
   if (request_bytes[0] == static_cast<std::uint8_t>(Opcode::kAll)) {
     TakeAll(request_bytes);
+    return;
+  }
+  if (IsNoopRequest(request_bytes)) {
+    // The driver's fetch: what Decode, HandleRequest and Encode give for a valid NOOP.
+    EncodeNoop(request_bytes[1], WithStateBits(0), answer_register_);
     return;
   }
   Frame request;
@@ -171,9 +179,10 @@ ChannelWords EmulatedFpga::HandleAll(ChannelWords request_words) noexcept {
 
 ChannelWords EmulatedFpga::SampleTwin(ChannelWords encoder_words, std::int64_t t_ns) noexcept {
   bool limited = false;
+  const bool stuck = faults_.stick_encoder;
   for (std::size_t c = 0; c < kChannels; ++c) {
     const EncWord target = UnpackEnc(ChannelWord(encoder_words, c));
-    emulators_[c].SetStuck(faults_.stick_encoder);
+    emulators_[c].SetStuck(stuck);
     limited = !emulators_[c].StartPeriod(target.counts, t_ns) || limited;
     pins_out_[c] = target.pin;
   }
@@ -181,12 +190,26 @@ ChannelWords EmulatedFpga::SampleTwin(ChannelWords encoder_words, std::int64_t t
   PublishPeriod();
   duty_scratch_.fill(0.0);
   if (pwm_source_ != nullptr) pwm_source_->DutyAt(t_ns, duty_scratch_);
+  // Exact memoisation: the reader's values and the answer's words are functions of the four
+  // duties and the input pins alone; with duties bit-identical to the previous frame's (and the
+  // pins unchanged: SetDigitalInputs clears pwm_memo_valid_), they are the ones already held.
+  std::uint64_t changed = pwm_memo_valid_ ? 0 : 1;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    changed |= std::bit_cast<std::uint64_t>(duty_scratch_[c]) ^ duty_bits_[c];
+  }
+  if (changed != 0) MeasurePwm();
+  return pwm_words_;
+}
+
+void EmulatedFpga::MeasurePwm() noexcept {
   ChannelWords pwm_words = 0;
   for (std::size_t c = 0; c < kChannels; ++c) {
+    duty_bits_[c] = std::bit_cast<std::uint64_t>(duty_scratch_[c]);
     pwm_values_[c] = PwmReaderValue(duty_scratch_[c]);
     pwm_words |= PlaceChannelWord(c, PackPwm(PwmWordFromValue(pwm_values_[c], pins_in_[c])));
   }
-  return pwm_words;
+  pwm_words_ = pwm_words;
+  pwm_memo_valid_ = true;
 }
 
 ChannelWords EmulatedFpga::SampleEcs(ChannelWords pwm_words, std::int64_t t_ns) noexcept {

@@ -160,10 +160,8 @@ void ForEachChannel(F&& f) noexcept {
   EachChannel(f, std::make_index_sequence<kChannels>{});
 }
 
-constexpr std::uint16_t kPwmNegativeBit = 0x8000;
-constexpr std::uint16_t kPinBit = 0x4000;
-constexpr std::uint16_t kValueMask = 0x3FFF;
-constexpr std::uint16_t kEncReservedBit = 0x8000;
+constexpr std::uint16_t kValueMask = kWordValueMask;
+constexpr std::uint16_t kEncReservedBit = kWordBit15;
 
 // The channel words of a frame: all four are packed and checked without a branch per field, the
 // lanes the opcode does not carry then cleared; false when a carried field does not fit its bits.
@@ -325,24 +323,6 @@ std::uint8_t Crc8(const std::uint8_t* data, std::size_t size) noexcept {
   return static_cast<std::uint8_t>(crc ^ 0xFFU);
 }
 
-std::uint16_t PackPwm(const PwmWord& word) noexcept {
-  return static_cast<std::uint16_t>((word.negative ? kPwmNegativeBit : 0U) |
-                                    (word.pin ? kPinBit : 0U) | (word.magnitude & kValueMask));
-}
-std::uint16_t PackEnc(const EncWord& word) noexcept {
-  return static_cast<std::uint16_t>((word.pin ? kPinBit : 0U) |
-                                    (static_cast<std::uint16_t>(word.counts) & kValueMask));
-}
-PwmWord UnpackPwm(std::uint16_t bits) noexcept {
-  return PwmWord{static_cast<std::uint16_t>(bits & kValueMask), (bits & kPwmNegativeBit) != 0,
-                 (bits & kPinBit) != 0};
-}
-EncWord UnpackEnc(std::uint16_t bits) noexcept {
-  int value = bits & kValueMask;
-  if ((value & 0x2000) != 0) value -= 0x4000;  // sign-extend the 14-bit field
-  return EncWord{static_cast<std::int16_t>(value), (bits & kPinBit) != 0};
-}
-
 FrameError Encode(const Frame& frame, Direction direction, Image host_image,
                   FrameBytes& out) noexcept {
   const auto op = static_cast<unsigned>(frame.opcode);
@@ -404,6 +384,20 @@ FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
     case Payload::kNone: break;
   }
   return FrameError::kOk;
+}
+
+void EncodeNoop(std::uint8_t sequence, std::uint8_t status, FrameBytes& out) noexcept {
+  // What Encode writes for a NOOP (Payload::kNone): zeros but for bytes 1, 10 and the CRC.
+  out = FrameBytes{};
+  out[1] = sequence;
+  out[kStatusOffset] = status;
+  out[kCrcOffset] = EmptyFrameCrc(out);
+}
+
+bool IsNoopRequest(const FrameBytes& in) noexcept {
+  // Decode's checks for a NOOP request: CRC, status byte 0, bytes 2..9 zero (reserved).
+  return in[0] == static_cast<std::uint8_t>(Opcode::kNoop) && in[kStatusOffset] == 0 &&
+         GetBody(in) == 0 && EmptyFrameCrc(in) == in[kCrcOffset];
 }
 
 constexpr auto kAllOpcode = static_cast<unsigned>(Opcode::kAll);

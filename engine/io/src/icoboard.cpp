@@ -79,8 +79,8 @@ bool IcoBoardLink::EncodeFetch() noexcept {
   // The fetch: a NOOP with its own sequence number, whose transfer carries the answer to the
   // request in tx_ (the board answers one transfer late; docs/spi-protocol.md, "Pipelined
   // answers").
-  fetch_.sequence = ++sequence_;
-  return Encode(fetch_, Direction::kRequest, image_, fetch_tx_) == FrameError::kOk;
+  EncodeNoop(++sequence_, 0, fetch_tx_);
+  return true;
 }
 
 ExchangeStatus IcoBoardLink::EncodeFault() noexcept {
