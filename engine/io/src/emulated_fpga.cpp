@@ -60,6 +60,13 @@ void EmulatedFpga::SendAnswer(FrameBytes& miso) noexcept {
 }
 
 void EmulatedFpga::TakeRequest(const FrameBytes& mosi) noexcept {
+  if (IsNoopRequest(mosi)) {
+    // The driver's fetch (no request fault applies to a NOOP): what Decode, HandleRequest and
+    // Encode give for a valid NOOP.
+    answer_register_data_ = false;
+    EncodeNoop(mosi[1], WithStateBits(0), answer_register_);
+    return;
+  }
   const bool data = mosi[0] != static_cast<std::uint8_t>(Opcode::kNoop);
   answer_register_data_ = data;
   if (data && faults_.corrupt_requests > 0) {
@@ -76,11 +83,6 @@ void EmulatedFpga::TakeRequest(const FrameBytes& mosi) noexcept {
 void EmulatedFpga::ActOn(const FrameBytes& request_bytes) noexcept {
   if (request_bytes[0] == static_cast<std::uint8_t>(Opcode::kAll)) {
     TakeAll(request_bytes);
-    return;
-  }
-  if (IsNoopRequest(request_bytes)) {
-    // The driver's fetch: what Decode, HandleRequest and Encode give for a valid NOOP.
-    EncodeNoop(request_bytes[1], WithStateBits(0), answer_register_);
     return;
   }
   Frame request;
@@ -180,11 +182,13 @@ ChannelWords EmulatedFpga::HandleAll(ChannelWords request_words) noexcept {
 ChannelWords EmulatedFpga::SampleTwin(ChannelWords encoder_words, std::int64_t t_ns) noexcept {
   bool limited = false;
   const bool stuck = faults_.stick_encoder;
+  ChannelWords rest = encoder_words;  // channel 0 in the top lane, shifted out first
   for (std::size_t c = 0; c < kChannels; ++c) {
-    const EncWord target = UnpackEnc(ChannelWord(encoder_words, c));
+    const auto word = static_cast<std::uint16_t>(rest >> 48U);
+    rest <<= 16U;
     emulators_[c].SetStuck(stuck);
-    limited = !emulators_[c].StartPeriod(target.counts, t_ns) || limited;
-    pins_out_[c] = target.pin;
+    limited = !emulators_[c].StartPeriod(EncCountsOfWord(word), t_ns) || limited;
+    pins_out_[c] = WordPin(word);
   }
   pulse_limit_ = limited;
   PublishPeriod();
@@ -206,9 +210,9 @@ void EmulatedFpga::MeasurePwm() noexcept {
   for (std::size_t c = 0; c < kChannels; ++c) {
     duty_bits_[c] = std::bit_cast<std::uint64_t>(duty_scratch_[c]);
     pwm_values_[c] = PwmReaderValue(duty_scratch_[c]);
-    pwm_words |= PlaceChannelWord(c, PackPwm(PwmWordFromValue(pwm_values_[c], pins_in_[c])));
+    pwm_words = (pwm_words << 16U) | PackPwm(PwmWordFromValue(pwm_values_[c], pins_in_[c]));
   }
-  pwm_words_ = pwm_words;
+  pwm_words_ = pwm_words;  // channel 0 in the top lane
   pwm_memo_valid_ = true;
 }
 

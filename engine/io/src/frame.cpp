@@ -117,10 +117,10 @@ std::uint32_t GetU32(const FrameBytes& in, std::size_t offset) noexcept {
 // Word-wide packing: the four channel words (bytes 2..9, big-endian) as one 64-bit body, the
 // word of channel c in bits 63-16c..48-16c. The compilers turn these two into one load or store
 // and a byte swap.
-std::uint64_t GetBody(const FrameBytes& in) noexcept {
+inline std::uint64_t GetBody(const FrameBytes& in) noexcept {
   return (std::uint64_t{GetU32(in, kPayloadOffset)} << 32U) | GetU32(in, kPayloadOffset + 4);
 }
-void PutBody(FrameBytes& out, std::uint64_t body) noexcept {
+inline void PutBody(FrameBytes& out, std::uint64_t body) noexcept {
   PutU32(out, kPayloadOffset, static_cast<std::uint32_t>(body >> 32U));
   PutU32(out, kPayloadOffset + 4, static_cast<std::uint32_t>(body & 0xFFFF'FFFFU));
 }
@@ -221,9 +221,11 @@ FrameError CheckPayload(const FrameBytes& in, Payload payload, std::uint64_t car
   return FrameError::kOk;
 }
 
-/// What every frame is checked for first, in this order: CRC, opcode, status byte.
-FrameError CheckHeader(const FrameBytes& in, Direction direction) noexcept {
-  const std::uint8_t crc = GetBody(in) == 0 ? EmptyFrameCrc(in) : FrameCrc(in);
+/// What every frame is checked for first, in this order: CRC, opcode, status byte. `body` is
+/// GetBody(in).
+inline FrameError CheckHeader(const FrameBytes& in, std::uint64_t body,
+                              Direction direction) noexcept {
+  const std::uint8_t crc = body == 0 ? EmptyFrameCrc(in) : FrameCrc(in);
   if (crc != in[kCrcOffset]) return FrameError::kChecksum;
   if (in[0] > static_cast<std::uint8_t>(Opcode::kTest)) return FrameError::kOpcode;
   const std::uint8_t status = in[kStatusOffset];
@@ -359,7 +361,7 @@ FrameError Encode(const Frame& frame, Direction direction, Image host_image,
 
 FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
                   Frame& out) noexcept {
-  const FrameError header = CheckHeader(in, direction);
+  const FrameError header = CheckHeader(in, GetBody(in), direction);
   if (header != FrameError::kOk) return header;
   const unsigned op = in[0];
   const std::uint8_t status = in[kStatusOffset];
@@ -416,10 +418,10 @@ FrameError EncodeAll(const AllFrame& frame, Direction direction, Image host_imag
 
 FrameError DecodeAll(const FrameBytes& in, Direction direction, Image host_image,
                      AllFrame& out) noexcept {
-  const FrameError header = CheckHeader(in, direction);
+  const std::uint64_t words = GetBody(in);
+  const FrameError header = CheckHeader(in, words, direction);
   if (header != FrameError::kOk) return header;
   if (in[0] != kAllOpcode) return FrameError::kOpcode;
-  const std::uint64_t words = GetBody(in);
   const Payload payload = kPayloads[PayloadIndex(kAllOpcode, direction, host_image)];
   const FrameError error = CheckWords(words, payload, kCarriedLanes[kAllOpcode]);
   if (error != FrameError::kOk) return error;

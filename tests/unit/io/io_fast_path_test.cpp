@@ -177,7 +177,9 @@ TEST(IoFastPath, EncoderEmulatorNoChangePeriodsMatchTheGeneralPlan) {
       // Mostly whole periods and held targets (the fast path), sometimes early or late
       // sampling, small and large moves, a stuck line.
       const unsigned r = static_cast<unsigned>(rng() % 100);
-      t_ns += r < 80 ? step_ns : static_cast<std::int64_t>(rng() % (2 * step_ns)) - step_ns / 4;
+      const auto span = static_cast<std::uint64_t>(2 * step_ns);
+      const auto jitter = static_cast<std::int64_t>(rng() % span);
+      t_ns += r < 80 ? step_ns : jitter - step_ns / 4;
       if (r % 7 == 0) target += static_cast<std::int64_t>(rng() % 201) - 100;
       if (r == 3) target += static_cast<std::int64_t>(rng() % 40'000) - 20'000;
       const bool stuck = r == 5 || r == 6;

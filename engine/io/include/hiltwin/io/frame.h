@@ -205,6 +205,22 @@ constexpr std::uint16_t kWordBit15 = 0x8000;
 constexpr std::uint16_t kWordPinBit = 0x4000;
 constexpr std::uint16_t kWordValueMask = 0x3FFF;
 
+/// A channel word's fields one by one, as UnpackPwm/UnpackEnc give them, without building the
+/// struct (the per-cycle loops): the digital pin; the signed PWM value (PwmValueFromWord of
+/// UnpackPwm); the encoder counts, the 14-bit field sign-extended (its bit 13 moved to bit 15,
+/// then shifted back arithmetically).
+[[nodiscard]] constexpr bool WordPin(std::uint16_t bits) noexcept {
+  return (bits & kWordPinBit) != 0;
+}
+[[nodiscard]] constexpr std::int32_t PwmValueOfWord(std::uint16_t bits) noexcept {
+  const std::int32_t magnitude = bits & kWordValueMask;
+  return (bits & kWordBit15) != 0 ? -magnitude : magnitude;
+}
+[[nodiscard]] constexpr std::int16_t EncCountsOfWord(std::uint16_t bits) noexcept {
+  const auto high = static_cast<std::int16_t>(static_cast<std::uint16_t>(bits << 2U));
+  return static_cast<std::int16_t>(high >> 2);
+}
+
 /// Packs/unpacks channel words (exposed for the board model and tests); inline, as the drivers
 /// and the board pack four of them per cycle.
 [[nodiscard]] inline std::uint16_t PackPwm(const PwmWord& word) noexcept {
@@ -221,9 +237,7 @@ constexpr std::uint16_t kWordValueMask = 0x3FFF;
                  (bits & kWordPinBit) != 0};
 }
 [[nodiscard]] inline EncWord UnpackEnc(std::uint16_t bits) noexcept {
-  int value = bits & kWordValueMask;
-  if ((value & 0x2000) != 0) value -= 0x4000;  // sign-extend the 14-bit field
-  return EncWord{static_cast<std::int16_t>(value), (bits & kWordPinBit) != 0};
+  return EncWord{EncCountsOfWord(bits), WordPin(bits)};
 }
 
 }  // namespace hiltwin::io
