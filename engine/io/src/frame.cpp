@@ -70,7 +70,8 @@ std::uint8_t EmptyFrameCrc(const FrameBytes& bytes) noexcept {
 // What bytes 2..9 hold, per opcode, direction and host image: decided by a lookup, not by
 // branches per frame.
 constexpr std::size_t PayloadIndex(unsigned op, Direction direction, Image image) noexcept {
-  return op * 4 + static_cast<std::size_t>(direction) * 2 + static_cast<std::size_t>(image);
+  return std::size_t{op} * 4 + static_cast<std::size_t>(direction) * 2 +
+         static_cast<std::size_t>(image);
 }
 constexpr Payload PayloadRule(unsigned op, Direction direction, Image host_image) noexcept {
   switch (static_cast<Opcode>(op)) {
