@@ -1,5 +1,7 @@
 #include "hiltwin/io/emulated_fpga.h"
 
+#include <bit>
+
 #include "hiltwin/io/conversions.h"
 
 namespace hiltwin::io {
@@ -19,6 +21,7 @@ void EmulatedFpga::ResetState() noexcept {
   data_frames_ = 0;
   for (auto& emulator : emulators_) emulator.Reset();
   pwm_values_.fill(0);
+  pwm_memo_valid_ = false;
   counts_.fill(0);
   pins_out_.fill(false);
   lines_.Reset();
@@ -57,6 +60,13 @@ void EmulatedFpga::SendAnswer(FrameBytes& miso) noexcept {
 }
 
 void EmulatedFpga::TakeRequest(const FrameBytes& mosi) noexcept {
+  if (IsNoopRequest(mosi)) {
+    // The driver's fetch (no request fault applies to a NOOP): what Decode, HandleRequest and
+    // Encode give for a valid NOOP.
+    answer_register_data_ = false;
+    EncodeNoop(mosi[1], WithStateBits(0), answer_register_);
+    return;
+  }
   const bool data = mosi[0] != static_cast<std::uint8_t>(Opcode::kNoop);
   answer_register_data_ = data;
   if (data && faults_.corrupt_requests > 0) {
@@ -171,22 +181,39 @@ ChannelWords EmulatedFpga::HandleAll(ChannelWords request_words) noexcept {
 
 ChannelWords EmulatedFpga::SampleTwin(ChannelWords encoder_words, std::int64_t t_ns) noexcept {
   bool limited = false;
+  const bool stuck = faults_.stick_encoder;
+  ChannelWords rest = encoder_words;  // channel 0 in the top lane, shifted out first
   for (std::size_t c = 0; c < kChannels; ++c) {
-    const EncWord target = UnpackEnc(ChannelWord(encoder_words, c));
-    emulators_[c].SetStuck(faults_.stick_encoder);
-    limited = !emulators_[c].StartPeriod(target.counts, t_ns) || limited;
-    pins_out_[c] = target.pin;
+    const auto word = static_cast<std::uint16_t>(rest >> 48U);
+    rest <<= 16U;
+    emulators_[c].SetStuck(stuck);
+    limited = !emulators_[c].StartPeriod(EncCountsOfWord(word), t_ns) || limited;
+    pins_out_[c] = WordPin(word);
   }
   pulse_limit_ = limited;
   PublishPeriod();
   duty_scratch_.fill(0.0);
   if (pwm_source_ != nullptr) pwm_source_->DutyAt(t_ns, duty_scratch_);
+  // Exact memoisation: the reader's values and the answer's words are functions of the four
+  // duties and the input pins alone; with duties bit-identical to the previous frame's (and the
+  // pins unchanged: SetDigitalInputs clears pwm_memo_valid_), they are the ones already held.
+  std::uint64_t changed = pwm_memo_valid_ ? 0 : 1;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    changed |= std::bit_cast<std::uint64_t>(duty_scratch_[c]) ^ duty_bits_[c];
+  }
+  if (changed != 0) MeasurePwm();
+  return pwm_words_;
+}
+
+void EmulatedFpga::MeasurePwm() noexcept {
   ChannelWords pwm_words = 0;
   for (std::size_t c = 0; c < kChannels; ++c) {
+    duty_bits_[c] = std::bit_cast<std::uint64_t>(duty_scratch_[c]);
     pwm_values_[c] = PwmReaderValue(duty_scratch_[c]);
-    pwm_words |= PlaceChannelWord(c, PackPwm(PwmWordFromValue(pwm_values_[c], pins_in_[c])));
+    pwm_words = (pwm_words << 16U) | PackPwm(PwmWordFromValue(pwm_values_[c], pins_in_[c]));
   }
-  return pwm_words;
+  pwm_words_ = pwm_words;  // channel 0 in the top lane
+  pwm_memo_valid_ = true;
 }
 
 ChannelWords EmulatedFpga::SampleEcs(ChannelWords pwm_words, std::int64_t t_ns) noexcept {

@@ -70,7 +70,8 @@ std::uint8_t EmptyFrameCrc(const FrameBytes& bytes) noexcept {
 // What bytes 2..9 hold, per opcode, direction and host image: decided by a lookup, not by
 // branches per frame.
 constexpr std::size_t PayloadIndex(unsigned op, Direction direction, Image image) noexcept {
-  return op * 4 + static_cast<std::size_t>(direction) * 2 + static_cast<std::size_t>(image);
+  return std::size_t{op} * 4 + static_cast<std::size_t>(direction) * 2 +
+         static_cast<std::size_t>(image);
 }
 constexpr Payload PayloadRule(unsigned op, Direction direction, Image host_image) noexcept {
   switch (static_cast<Opcode>(op)) {
@@ -117,10 +118,10 @@ std::uint32_t GetU32(const FrameBytes& in, std::size_t offset) noexcept {
 // Word-wide packing: the four channel words (bytes 2..9, big-endian) as one 64-bit body, the
 // word of channel c in bits 63-16c..48-16c. The compilers turn these two into one load or store
 // and a byte swap.
-std::uint64_t GetBody(const FrameBytes& in) noexcept {
+inline std::uint64_t GetBody(const FrameBytes& in) noexcept {
   return (std::uint64_t{GetU32(in, kPayloadOffset)} << 32U) | GetU32(in, kPayloadOffset + 4);
 }
-void PutBody(FrameBytes& out, std::uint64_t body) noexcept {
+inline void PutBody(FrameBytes& out, std::uint64_t body) noexcept {
   PutU32(out, kPayloadOffset, static_cast<std::uint32_t>(body >> 32U));
   PutU32(out, kPayloadOffset + 4, static_cast<std::uint32_t>(body & 0xFFFF'FFFFU));
 }
@@ -160,10 +161,8 @@ void ForEachChannel(F&& f) noexcept {
   EachChannel(f, std::make_index_sequence<kChannels>{});
 }
 
-constexpr std::uint16_t kPwmNegativeBit = 0x8000;
-constexpr std::uint16_t kPinBit = 0x4000;
-constexpr std::uint16_t kValueMask = 0x3FFF;
-constexpr std::uint16_t kEncReservedBit = 0x8000;
+constexpr std::uint16_t kValueMask = kWordValueMask;
+constexpr std::uint16_t kEncReservedBit = kWordBit15;
 
 // The channel words of a frame: all four are packed and checked without a branch per field, the
 // lanes the opcode does not carry then cleared; false when a carried field does not fit its bits.
@@ -223,9 +222,11 @@ FrameError CheckPayload(const FrameBytes& in, Payload payload, std::uint64_t car
   return FrameError::kOk;
 }
 
-/// What every frame is checked for first, in this order: CRC, opcode, status byte.
-FrameError CheckHeader(const FrameBytes& in, Direction direction) noexcept {
-  const std::uint8_t crc = GetBody(in) == 0 ? EmptyFrameCrc(in) : FrameCrc(in);
+/// What every frame is checked for first, in this order: CRC, opcode, status byte. `body` is
+/// GetBody(in).
+inline FrameError CheckHeader(const FrameBytes& in, std::uint64_t body,
+                              Direction direction) noexcept {
+  const std::uint8_t crc = body == 0 ? EmptyFrameCrc(in) : FrameCrc(in);
   if (crc != in[kCrcOffset]) return FrameError::kChecksum;
   if (in[0] > static_cast<std::uint8_t>(Opcode::kTest)) return FrameError::kOpcode;
   const std::uint8_t status = in[kStatusOffset];
@@ -325,24 +326,6 @@ std::uint8_t Crc8(const std::uint8_t* data, std::size_t size) noexcept {
   return static_cast<std::uint8_t>(crc ^ 0xFFU);
 }
 
-std::uint16_t PackPwm(const PwmWord& word) noexcept {
-  return static_cast<std::uint16_t>((word.negative ? kPwmNegativeBit : 0U) |
-                                    (word.pin ? kPinBit : 0U) | (word.magnitude & kValueMask));
-}
-std::uint16_t PackEnc(const EncWord& word) noexcept {
-  return static_cast<std::uint16_t>((word.pin ? kPinBit : 0U) |
-                                    (static_cast<std::uint16_t>(word.counts) & kValueMask));
-}
-PwmWord UnpackPwm(std::uint16_t bits) noexcept {
-  return PwmWord{static_cast<std::uint16_t>(bits & kValueMask), (bits & kPwmNegativeBit) != 0,
-                 (bits & kPinBit) != 0};
-}
-EncWord UnpackEnc(std::uint16_t bits) noexcept {
-  int value = bits & kValueMask;
-  if ((value & 0x2000) != 0) value -= 0x4000;  // sign-extend the 14-bit field
-  return EncWord{static_cast<std::int16_t>(value), (bits & kPinBit) != 0};
-}
-
 FrameError Encode(const Frame& frame, Direction direction, Image host_image,
                   FrameBytes& out) noexcept {
   const auto op = static_cast<unsigned>(frame.opcode);
@@ -379,7 +362,7 @@ FrameError Encode(const Frame& frame, Direction direction, Image host_image,
 
 FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
                   Frame& out) noexcept {
-  const FrameError header = CheckHeader(in, direction);
+  const FrameError header = CheckHeader(in, GetBody(in), direction);
   if (header != FrameError::kOk) return header;
   const unsigned op = in[0];
   const std::uint8_t status = in[kStatusOffset];
@@ -406,6 +389,20 @@ FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
   return FrameError::kOk;
 }
 
+void EncodeNoop(std::uint8_t sequence, std::uint8_t status, FrameBytes& out) noexcept {
+  // What Encode writes for a NOOP (Payload::kNone): zeros but for bytes 1, 10 and the CRC.
+  out = FrameBytes{};
+  out[1] = sequence;
+  out[kStatusOffset] = status;
+  out[kCrcOffset] = EmptyFrameCrc(out);
+}
+
+bool IsNoopRequest(const FrameBytes& in) noexcept {
+  // Decode's checks for a NOOP request: CRC, status byte 0, bytes 2..9 zero (reserved).
+  return in[0] == static_cast<std::uint8_t>(Opcode::kNoop) && in[kStatusOffset] == 0 &&
+         GetBody(in) == 0 && EmptyFrameCrc(in) == in[kCrcOffset];
+}
+
 constexpr auto kAllOpcode = static_cast<unsigned>(Opcode::kAll);
 
 FrameError EncodeAll(const AllFrame& frame, Direction direction, Image host_image,
@@ -422,10 +419,10 @@ FrameError EncodeAll(const AllFrame& frame, Direction direction, Image host_imag
 
 FrameError DecodeAll(const FrameBytes& in, Direction direction, Image host_image,
                      AllFrame& out) noexcept {
-  const FrameError header = CheckHeader(in, direction);
+  const std::uint64_t words = GetBody(in);
+  const FrameError header = CheckHeader(in, words, direction);
   if (header != FrameError::kOk) return header;
   if (in[0] != kAllOpcode) return FrameError::kOpcode;
-  const std::uint64_t words = GetBody(in);
   const Payload payload = kPayloads[PayloadIndex(kAllOpcode, direction, host_image)];
   const FrameError error = CheckWords(words, payload, kCarriedLanes[kAllOpcode]);
   if (error != FrameError::kOk) return error;

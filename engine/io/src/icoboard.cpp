@@ -79,8 +79,8 @@ bool IcoBoardLink::EncodeFetch() noexcept {
   // The fetch: a NOOP with its own sequence number, whose transfer carries the answer to the
   // request in tx_ (the board answers one transfer late; docs/spi-protocol.md, "Pipelined
   // answers").
-  fetch_.sequence = ++sequence_;
-  return Encode(fetch_, Direction::kRequest, image_, fetch_tx_) == FrameError::kOk;
+  EncodeNoop(++sequence_, 0, fetch_tx_);
+  return true;
 }
 
 ExchangeStatus IcoBoardLink::EncodeFault() noexcept {
@@ -278,15 +278,17 @@ ExchangeStatus IcoBoardInverse::Exchange(
     const std::array<std::int32_t, kChannels>& encoder_counts_out, TwinInputs& in) noexcept {
   bool over_limit = false;
   ChannelWords words = 0;
+  // |change| > limit as one unsigned comparison: |change| < 2^33 and 0 <= limit < 2^14.
+  const auto limit_span = 2 * static_cast<std::uint64_t>(counts_limit_);
   for (std::size_t c = 0; c < kChannels; ++c) {
     const std::int64_t counts = encoder_counts_out[c];
     const std::int64_t change = counts - last_counts_[c];
-    if (change > counts_limit_ || -change > counts_limit_) {
+    if (static_cast<std::uint64_t>(change + counts_limit_) > limit_span) {
       ++counters_.counts_over_limit;
       over_limit = true;
     }
     const EncWord word{static_cast<std::int16_t>(WrapToRelative(counts)), pins_out_[c]};
-    words |= PlaceChannelWord(c, PackEnc(word));
+    words = (words << 16U) | PackEnc(word);  // channel 0 ends in the top lane
   }
   AllFrame answer;
   ExchangeStatus status = TransactAll(words, answer);
@@ -295,11 +297,13 @@ ExchangeStatus IcoBoardInverse::Exchange(
   // Only an acknowledged request is known to have moved the board's target; after a failed one
   // the next change is still measured from the last position the board confirmed.
   for (std::size_t c = 0; c < kChannels; ++c) last_counts_[c] = encoder_counts_out[c];
+  ChannelWords rest = answer.words;  // channel 0 in the top lane, shifted out first
   for (std::size_t c = 0; c < kChannels; ++c) {
-    const PwmWord word = UnpackPwm(ChannelWord(answer.words, c));
-    in.pwm[c] = PwmValueFromWord(word);
+    const auto word = static_cast<std::uint16_t>(rest >> 48U);
+    rest <<= 16U;
+    in.pwm[c] = PwmValueOfWord(word);
     in.duty[c] = PwmToDuty(in.pwm[c]);
-    in.pins[c] = word.pin;
+    in.pins[c] = WordPin(word);
   }
   in.board_status = answer.status;
   if ((answer.status & kStatusPulseLimit) != 0) {

@@ -162,6 +162,14 @@ enum class FrameError : std::uint8_t {
 [[nodiscard]] FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
                                 Frame& out) noexcept;
 
+/// Encode() of the NOOP frame numbered `sequence` with status byte `status` (0 in requests;
+/// kStatusMask bits only), from the CRC tables directly: the driver's fetch and the board's
+/// answer to it, in every exchange. Cannot fail.
+void EncodeNoop(std::uint8_t sequence, std::uint8_t status, FrameBytes& out) noexcept;
+/// True exactly when Decode(in, Direction::kRequest, any image) accepts `in` as a NOOP: the
+/// bytes EncodeNoop(in[1], 0) writes.
+[[nodiscard]] bool IsNoopRequest(const FrameBytes& in) noexcept;
+
 /// The four channel words of a frame (the PackPwm/PackEnc bits) as one value in wire order:
 /// channel c's word in bits 63-16c..48-16c, so bytes 2..9 of the frame are its big-endian bytes.
 /// Word-wide packing for the per-cycle ALL frames.
@@ -192,10 +200,44 @@ struct AllFrame {
 [[nodiscard]] FrameError DecodeAll(const FrameBytes& in, Direction direction, Image host_image,
                                    AllFrame& out) noexcept;
 
-/// Packs/unpacks channel words (exposed for the board model and tests).
-[[nodiscard]] std::uint16_t PackPwm(const PwmWord& word) noexcept;
-[[nodiscard]] std::uint16_t PackEnc(const EncWord& word) noexcept;
-[[nodiscard]] PwmWord UnpackPwm(std::uint16_t bits) noexcept;
-[[nodiscard]] EncWord UnpackEnc(std::uint16_t bits) noexcept;
+/// Channel word bits: PWM direction (1 = negative) or encoder reserved bit, digital pin, value.
+constexpr std::uint16_t kWordBit15 = 0x8000;
+constexpr std::uint16_t kWordPinBit = 0x4000;
+constexpr std::uint16_t kWordValueMask = 0x3FFF;
+
+/// A channel word's fields one by one, as UnpackPwm/UnpackEnc give them, without building the
+/// struct (the per-cycle loops): the digital pin; the signed PWM value (PwmValueFromWord of
+/// UnpackPwm); the encoder counts, the 14-bit field sign-extended (its bit 13 moved to bit 15,
+/// then shifted back arithmetically).
+[[nodiscard]] constexpr bool WordPin(std::uint16_t bits) noexcept {
+  return (bits & kWordPinBit) != 0;
+}
+[[nodiscard]] constexpr std::int32_t PwmValueOfWord(std::uint16_t bits) noexcept {
+  const std::int32_t magnitude = bits & kWordValueMask;
+  return (bits & kWordBit15) != 0 ? -magnitude : magnitude;
+}
+[[nodiscard]] constexpr std::int16_t EncCountsOfWord(std::uint16_t bits) noexcept {
+  const auto high = static_cast<std::int16_t>(static_cast<std::uint16_t>(bits << 2U));
+  return static_cast<std::int16_t>(high >> 2);
+}
+
+/// Packs/unpacks channel words (exposed for the board model and tests); inline, as the drivers
+/// and the board pack four of them per cycle.
+[[nodiscard]] inline std::uint16_t PackPwm(const PwmWord& word) noexcept {
+  return static_cast<std::uint16_t>((word.negative ? kWordBit15 : 0U) |
+                                    (word.pin ? kWordPinBit : 0U) |
+                                    (word.magnitude & kWordValueMask));
+}
+[[nodiscard]] inline std::uint16_t PackEnc(const EncWord& word) noexcept {
+  return static_cast<std::uint16_t>((word.pin ? kWordPinBit : 0U) |
+                                    (static_cast<std::uint16_t>(word.counts) & kWordValueMask));
+}
+[[nodiscard]] inline PwmWord UnpackPwm(std::uint16_t bits) noexcept {
+  return PwmWord{static_cast<std::uint16_t>(bits & kWordValueMask), (bits & kWordBit15) != 0,
+                 (bits & kWordPinBit) != 0};
+}
+[[nodiscard]] inline EncWord UnpackEnc(std::uint16_t bits) noexcept {
+  return EncWord{EncCountsOfWord(bits), WordPin(bits)};
+}
 
 }  // namespace hiltwin::io

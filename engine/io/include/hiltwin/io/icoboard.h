@@ -109,7 +109,7 @@ class IcoBoardLink {
   std::array<EncoderUnwrapper, kChannels> unwrappers_{};      ///< ECS: relative -> absolute
 
  private:
-  /// Numbers and encodes the NOOP fetch into fetch_tx_; false if it does not encode.
+  /// Numbers and encodes the NOOP fetch into fetch_tx_ (a NOOP always encodes: true).
   bool EncodeFetch() noexcept;
   ExchangeStatus EncodeFault() noexcept;
   /// The request in tx_ and its fetch, one bus transaction; `check` judges rx_ as the answer.
@@ -124,7 +124,6 @@ class IcoBoardLink {
 
   Frame request_{};
   Frame answer_{};
-  Frame fetch_{};  ///< the NOOP fetch; only its sequence number changes
   FrameBytes tx_{};
   FrameBytes fetch_tx_{};
   FrameBytes request_rx_{};  ///< MISO of the request transfer (answers the previous fetch)
