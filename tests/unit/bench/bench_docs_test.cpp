@@ -121,7 +121,8 @@ TEST(BenchDocs, TheLoopSpeedTableIsTheBenchmarksOutput) {
       target = std::stod(digits);
     }
     EXPECT_EQ(line[6].str(), hiltwin::bench::VerdictOf({name, figure, target})) << name;
-    // The section's table states each figure in its "before" column as the prose writes counts.
+    // The section's table states each figure in its first ("after") column as the prose writes
+    // counts.
     EXPECT_NE(section.find("| " + name + " | **" + Count(figure) + "** |"), std::string::npos)
         << name << ": " << Count(figure);
   }
