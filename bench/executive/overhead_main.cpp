@@ -70,17 +70,14 @@ class TimedEmptyTask final : public sched::CyclicTask {
   explicit TimedEmptyTask(hiltwin::kernel_glue::Clock& clock) : clock_(clock) {}
   sched::CycleAction Step(const sched::CycleContext& context) noexcept override {
     const hiltwin::kernel_glue::TimeNs start_ns = clock_.NowNs();
-    io_ns_ = clock_.NowNs() - start_ns;
+    SetIoNsOfLastStep(clock_.NowNs() - start_ns);
     const hiltwin::kernel_glue::TimeNs extra_ns = injector_.ExtraNs(context.cycle);
     if (extra_ns > 0) clock_.SpendNs(extra_ns);
     return sched::CycleAction::kContinue;
   }
-  hiltwin::kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
-
  private:
   hiltwin::kernel_glue::Clock& clock_;
   hiltwin::runtime::OverrunInjector injector_;
-  hiltwin::kernel_glue::TimeNs io_ns_ = 0;
 };
 
 /// A run task with no I/O and no model.

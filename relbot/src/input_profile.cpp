@@ -167,7 +167,31 @@ InputProfile InputProfile::FromKnots(std::string name, std::vector<ProfileKnot> 
   return InputProfile(std::move(name), std::move(knots));
 }
 
+// The upper bound is the one index with knot[index - 1] <= local_s < knot[index] (the ends
+// counting as -inf and +inf), so a hint that passes this test is the search's answer.
+[[gnu::always_inline]] inline bool InputProfile::IsKnotAfter(double local_s,
+                                                            std::size_t index) const noexcept {
+  return index <= knots_.size() && (index == 0 || knots_[index - 1].time_s <= local_s) &&
+         (index == knots_.size() || local_s < knots_[index].time_s);
+}
+
+// Inline in At, which a player calls at every controller sample.
+[[gnu::always_inline]] inline std::size_t InputProfile::KnotAfter(
+    double local_s, std::size_t hint) const noexcept {
+  if (IsKnotAfter(local_s, hint)) return hint;  // still in the same segment
+  if (IsKnotAfter(local_s, hint + 1)) return hint + 1;  // moved on into the next one
+  const auto it = std::upper_bound(
+      knots_.begin(), knots_.end(), local_s,
+      [](double t, const ProfileKnot& knot) { return t < knot.time_s; });
+  return static_cast<std::size_t>(it - knots_.begin());
+}
+
 Duty InputProfile::At(double t_s) const noexcept {
+  std::size_t cursor = 0;
+  return At(t_s, cursor);
+}
+
+Duty InputProfile::At(double t_s, std::size_t& cursor) const noexcept {
   if (!std::isfinite(t_s)) return Duty{};
   if (t_s <= 0.0) return knots_.front().duty;
   const double period = period_s();
@@ -175,13 +199,12 @@ Duty InputProfile::At(double t_s) const noexcept {
   if (!(local_s < period) || local_s < 0.0) local_s = 0.0;  // rounding at a period boundary
   // First knot strictly after local_s: the segment [it-1, it] holds local_s, and at a step
   // (two knots with one time) it-1 is the later knot, so the profile is right-continuous.
-  const auto it = std::upper_bound(
-      knots_.begin(), knots_.end(), local_s,
-      [](double t, const ProfileKnot& knot) { return t < knot.time_s; });
-  if (it == knots_.begin()) return knots_.front().duty;
-  if (it == knots_.end()) return knots_.back().duty;
-  const ProfileKnot& a = *(it - 1);
-  const ProfileKnot& b = *it;
+  const std::size_t it = KnotAfter(local_s, cursor);
+  cursor = it;
+  if (it == 0) return knots_.front().duty;
+  if (it == knots_.size()) return knots_.back().duty;
+  const ProfileKnot& a = knots_[it - 1];
+  const ProfileKnot& b = knots_[it];
   const double f = (local_s - a.time_s) / (b.time_s - a.time_s);
   return Duty{a.duty.left + f * (b.duty.left - a.duty.left),
               a.duty.right + f * (b.duty.right - a.duty.right)};

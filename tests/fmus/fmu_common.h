@@ -23,6 +23,8 @@ typedef struct {
   /* Model scratch: the exact transition over one step, cached for its step size. */
   double cached_h_s;
   double phi[4];
+  /* Model scratch of relbot_model.c: its 12 states and its coefficients. */
+  double work[32];
 } FmuInstance;
 
 /* Supplied by the model. */

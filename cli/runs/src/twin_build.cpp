@@ -133,7 +133,9 @@ std::unique_ptr<Twin> BuildTwin(const TwinRunOptions& o, kernel_glue::TimeNs per
       twin->backend->AttachPwmSource(twin->pwm_source.get());
   twin->input_name =
       profile_drives ? twin->profile->name() : "the controller on " + o.session.io_text;
-  twin->driver = std::make_unique<io::IcoBoardInverse>(twin->backend->bus());
+  // Nothing reads the twin's transfer times (the executive times its I/O step): no clock reads.
+  twin->driver =
+      std::make_unique<io::IcoBoardInverse>(twin->backend->bus(), io::UntimedTransfers());
   InitBoard(*twin->driver, period_ns);
   twin->task.emplace(*twin->driver, *twin->plant, std::move(made.bound), step_s, y0);
   return twin;

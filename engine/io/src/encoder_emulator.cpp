@@ -23,8 +23,10 @@ std::uint32_t MaxCountsPerStep(std::int64_t step_ns, std::uint32_t divider) noex
   return MaxPulsesPerPeriod(SubticksPerStep(step_ns, divider));
 }
 
-PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
-                     std::int32_t resolution) noexcept {
+namespace {
+// Table 4.1, inlined into StartPeriod: it runs for every channel of every ALL frame.
+inline PulsePlan PlanTable41(std::int32_t old_counts, std::int32_t new_counts,
+                             std::int32_t resolution) noexcept {
   const std::int32_t half = resolution / 2;
   const std::int32_t difference = new_counts - old_counts;  // in (-resolution, resolution)
   PulsePlan plan;
@@ -40,6 +42,12 @@ PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
     plan = {static_cast<std::uint32_t>(resolution + difference), +1, DifferenceCase::kD};
   }
   return plan;
+}
+}  // namespace
+
+PulsePlan PlanPulses(std::int32_t old_counts, std::int32_t new_counts,
+                     std::int32_t resolution) noexcept {
+  return PlanTable41(old_counts, new_counts, resolution);
 }
 
 std::uint32_t PulseSegment::EdgesBy(std::int64_t t_ns) const noexcept {
@@ -75,6 +83,7 @@ bool EncoderEmulator::Configure(std::int64_t step_ns, std::uint32_t clock_divide
   step_ns_ = step_ns;
   segment_.subticks = subticks;
   segment_.divider = clock_divider;
+  period_ns_ = std::int64_t{clock_divider} * kNsPerFpgaClock * subticks;
   return true;
 }
 
@@ -83,34 +92,37 @@ void EncoderEmulator::Reset() noexcept {
   segment_.pulses = 0;
   segment_.direction = 0;
   segment_.start_ns = 0;
+  end_counts_ = 0;
   last_case_ = DifferenceCase::kNone;
   limit_events_ = 0;
 }
 
-bool EncoderEmulator::StartPeriod(std::int32_t target_counts, std::int64_t t_ns) noexcept {
+bool EncoderEmulator::PlanPeriod(std::int32_t target_counts, std::int64_t t_ns) noexcept {
   // The position reached so far: the whole previous period normally, part of it when the
-  // sampling moment came early (wire backend, wall-clock jitter).
-  const std::int32_t reached = segment_.PositionAt(t_ns);
+  // sampling moment came early (wire backend, wall-clock jitter). Once the period is over,
+  // EdgesBy() is all the pulses, so the position is end_counts_ (exact, no arithmetic redone).
+  const std::int32_t reached = ReachedAt(t_ns);
   segment_.start_counts = reached;
   segment_.start_ns = t_ns;
+  end_counts_ = reached;
   if (stuck_) {
     segment_.pulses = 0;
     segment_.direction = 0;
     return true;
   }
-  const PulsePlan plan = PlanPulses(reached, WrapToRelative(target_counts));
+  const PulsePlan plan = PlanTable41(reached, WrapToRelative(target_counts), kEncoderResolution);
   last_case_ = plan.difference_case;
   segment_.direction = plan.direction;
   // At most one edge per sub-tick, and never half a turn: a move of 8192 on the 14-bit wrapping
   // position reads as -8192, so its direction would be a guess (the gateware caps the same way).
   const std::uint32_t most = MaxPulsesPerPeriod(segment_.subticks);
-  if (plan.pulses > most) {
-    segment_.pulses = most;
-    ++limit_events_;
-    return false;
-  }
-  segment_.pulses = plan.pulses;
-  return true;
+  const bool within = plan.pulses <= most;
+  segment_.pulses = within ? plan.pulses : most;
+  if (!within) ++limit_events_;
+  // PositionAt(start + period) of the segment just set: all its pulses emitted.
+  end_counts_ =
+      WrapToRelative(std::int64_t{reached} + plan.direction * std::int64_t{segment_.pulses});
+  return within;
 }
 
 QuadratureLevels LevelsAt(std::int64_t counts) noexcept {

@@ -62,20 +62,39 @@ IcoBoardLink::IcoBoardLink(SpiBus& bus, Image image, const kernel_glue::Clock* c
     : spi_(bus, clock), image_(image) {}
 
 ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
-  ExchangeStatus status;
   request.sequence = ++sequence_;
-  // The fetch: a NOOP with its own sequence number, whose transfer carries the answer to
-  // `request` (the board answers one transfer late; docs/spi-protocol.md, "Pipelined answers").
-  Frame fetch;
-  fetch.sequence = ++sequence_;
-  if (Encode(request, Direction::kRequest, image_, tx_) != FrameError::kOk ||
-      Encode(fetch, Direction::kRequest, image_, fetch_tx_) != FrameError::kOk) {
-    ++counters_.faults;
-    status.code = ExchangeStatus::Code::kFault;
-    status.reason = "request field out of range (driver bug)";
-    return status;
-  }
-  const KindCounters kind = CountersOfKind(counters_, request.opcode);
+  const bool encoded = Encode(request, Direction::kRequest, image_, tx_) == FrameError::kOk;
+  if (!EncodeFetch() || !encoded) return EncodeFault();
+  return TransferAndCheck(request.opcode, [&] { return CheckAnswer(request, answer); });
+}
+
+ExchangeStatus IcoBoardLink::TransactAll(ChannelWords words, AllFrame& answer) noexcept {
+  const AllFrame request{++sequence_, 0, words};
+  const bool encoded = EncodeAll(request, Direction::kRequest, image_, tx_) == FrameError::kOk;
+  if (!EncodeFetch() || !encoded) return EncodeFault();
+  return TransferAndCheck(Opcode::kAll, [&] { return CheckAllAnswer(request.sequence, answer); });
+}
+
+bool IcoBoardLink::EncodeFetch() noexcept {
+  // The fetch: a NOOP with its own sequence number, whose transfer carries the answer to the
+  // request in tx_ (the board answers one transfer late; docs/spi-protocol.md, "Pipelined
+  // answers").
+  EncodeNoop(++sequence_, 0, fetch_tx_);
+  return true;
+}
+
+ExchangeStatus IcoBoardLink::EncodeFault() noexcept {
+  ++counters_.faults;
+  ExchangeStatus status;
+  status.code = ExchangeStatus::Code::kFault;
+  status.reason = "request field out of range (driver bug)";
+  return status;
+}
+
+template <typename Check>
+ExchangeStatus IcoBoardLink::TransferAndCheck(Opcode opcode, Check&& check) noexcept {
+  ExchangeStatus status;
+  const KindCounters kind = CountersOfKind(counters_, opcode);
   ++*kind.sent;
   // The request transfer's MISO answers the previous exchange's fetch: no information.
   const TransferStatus transfer = spi_.TransferPair(tx_, request_rx_, fetch_tx_, rx_);
@@ -84,7 +103,7 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   // right now (hung, or just restarting) does not make that answer invalid. The first data
   // exchange reports the peer as a fault if it is still gone, so nothing is hidden.
   const bool peer_lost_at_init =
-      transfer.result == BusResult::kPeerLost && request.opcode == Opcode::kInit;
+      transfer.result == BusResult::kPeerLost && opcode == Opcode::kInit;
   // A lost wire peer is a fault, but this side's own board still took the request: the
   // answer is checked all the same, so a caller can tell that its safe outputs arrived.
   // A corrupted wire is the same kind of fault, at INIT too: nothing read from it is trusted.
@@ -99,7 +118,7 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   }
   status.peer_absent = transfer.result == BusResult::kPeerAbsent || peer_lost_at_init;
   if (transfer.result == BusResult::kPeerStopped) status.peer_stopped = transfer.reason;
-  const ExchangeStatus checked = CheckAnswer(request, answer);
+  const ExchangeStatus checked = check();
   if (!checked.ok()) {
     status.code = checked.code;
     status.reason = checked.reason;
@@ -116,15 +135,37 @@ ExchangeStatus IcoBoardLink::Transact(Frame& request, Frame& answer) noexcept {
   return status;
 }
 
+ExchangeStatus IcoBoardLink::CheckAllAnswer(std::uint8_t sequence, AllFrame& answer) noexcept {
+  // Anything but an ALL frame fails a check of the general path (idle, damaged, rejected, stale
+  // or another opcode): judged there, with the same counters and reasons.
+  if (rx_[0] != static_cast<std::uint8_t>(Opcode::kAll)) {
+    request_.opcode = Opcode::kAll;
+    request_.sequence = sequence;
+    return CheckAnswer(request_, answer_);
+  }
+  // Byte 0 is 3: the MISO is not idle (all zeros or all ones).
+  const FrameError error = DecodeAll(rx_, Direction::kAnswer, image_, answer);
+  return Judge(error, answer.status, answer.sequence == sequence, true, true);
+}
+
 ExchangeStatus IcoBoardLink::CheckAnswer(const Frame& request, Frame& answer) noexcept {
-  ExchangeStatus status;
   if (IsIdle(rx_)) {
     ++counters_.frames_missed;
+    ExchangeStatus status;
     status.code = ExchangeStatus::Code::kMissed;
     status.reason = "no answer from the board (MISO idle)";
     return status;
   }
   const FrameError error = Decode(rx_, Direction::kAnswer, image_, answer);
+  const bool data = request.opcode != Opcode::kInit && request.opcode != Opcode::kTest &&
+                    request.opcode != Opcode::kNoop && request.opcode != Opcode::kReset;
+  return Judge(error, answer.status, answer.sequence == request.sequence,
+               answer.opcode == request.opcode, data);
+}
+
+ExchangeStatus IcoBoardLink::Judge(FrameError error, std::uint8_t answer_status,
+                                   bool same_sequence, bool same_opcode, bool data) noexcept {
+  ExchangeStatus status;
   if (error != FrameError::kOk) {
     ++counters_.frames_corrupted;
     status.code = ExchangeStatus::Code::kCorrupted;
@@ -133,27 +174,25 @@ ExchangeStatus IcoBoardLink::CheckAnswer(const Frame& request, Frame& answer) no
   }
   // Rejection first: the board echoes the damaged request's opcode and sequence bytes, so a flip
   // there must not read as a stale answer or an answer to another opcode.
-  if ((answer.status & kStatusRequestRejected) != 0) {
+  if ((answer_status & kStatusRequestRejected) != 0) {
     ++counters_.frames_corrupted;
     status.code = ExchangeStatus::Code::kCorrupted;
     status.reason = "the board rejected the request (damaged on the way)";
     return status;
   }
-  if (answer.sequence != request.sequence) {
+  if (!same_sequence) {
     ++counters_.frames_missed;
     status.code = ExchangeStatus::Code::kMissed;
     status.reason = "stale answer (sequence number of an earlier request)";
     return status;
   }
-  if (answer.opcode != request.opcode) {
+  if (!same_opcode) {
     ++counters_.frames_corrupted;
     status.code = ExchangeStatus::Code::kCorrupted;
     status.reason = "answer to a different opcode";
     return status;
   }
-  const bool data = request.opcode != Opcode::kInit && request.opcode != Opcode::kTest &&
-                    request.opcode != Opcode::kNoop && request.opcode != Opcode::kReset;
-  if (data && (answer.status & kStatusInitialised) == 0) {
+  if (data && (answer_status & kStatusInitialised) == 0) {
     ++counters_.faults;
     status.code = ExchangeStatus::Code::kFault;
     status.reason = "the board is not initialised (reset or power loss): run INIT again";
@@ -222,6 +261,7 @@ InitResult IcoBoardLink::Init(std::int64_t step_ns) {
   initialised_ = true;
   step_ns_ = step_ns;
   clock_divider_ = init.clock_divider;
+  counts_limit_ = MaxCountsPerStep(step_ns_, clock_divider_);
   return result;
 }
 
@@ -236,31 +276,37 @@ ExchangeStatus IcoBoardLink::Test(const std::array<std::uint8_t, 8>& pattern,
 
 ExchangeStatus IcoBoardInverse::Exchange(
     const std::array<std::int32_t, kChannels>& encoder_counts_out, TwinInputs& in) noexcept {
-  const std::uint32_t limit = MaxCountsPerStep(step_ns_, clock_divider_);
   bool over_limit = false;
-  request_.opcode = Opcode::kAll;
+  ChannelWords words = 0;
+  // |change| > limit as one unsigned comparison: |change| < 2^33 and 0 <= limit < 2^14.
+  const auto limit_span = 2 * static_cast<std::uint64_t>(counts_limit_);
   for (std::size_t c = 0; c < kChannels; ++c) {
     const std::int64_t counts = encoder_counts_out[c];
     const std::int64_t change = counts - last_counts_[c];
-    if (change > limit || -change > limit) {
+    if (static_cast<std::uint64_t>(change + counts_limit_) > limit_span) {
       ++counters_.counts_over_limit;
       over_limit = true;
     }
-    request_.enc[c] = EncWord{static_cast<std::int16_t>(WrapToRelative(counts)), pins_out_[c]};
+    const EncWord word{static_cast<std::int16_t>(WrapToRelative(counts)), pins_out_[c]};
+    words = (words << 16U) | PackEnc(word);  // channel 0 ends in the top lane
   }
-  ExchangeStatus status = Transact(request_, answer_);
+  AllFrame answer;
+  ExchangeStatus status = TransactAll(words, answer);
   status.pulse_limit = over_limit;
   if (!status.ok()) return status;
   // Only an acknowledged request is known to have moved the board's target; after a failed one
   // the next change is still measured from the last position the board confirmed.
   for (std::size_t c = 0; c < kChannels; ++c) last_counts_[c] = encoder_counts_out[c];
+  ChannelWords rest = answer.words;  // channel 0 in the top lane, shifted out first
   for (std::size_t c = 0; c < kChannels; ++c) {
-    in.pwm[c] = PwmValueFromWord(answer_.pwm[c]);
+    const auto word = static_cast<std::uint16_t>(rest >> 48U);
+    rest <<= 16U;
+    in.pwm[c] = PwmValueOfWord(word);
     in.duty[c] = PwmToDuty(in.pwm[c]);
-    in.pins[c] = answer_.pwm[c].pin;
+    in.pins[c] = WordPin(word);
   }
-  in.board_status = answer_.status;
-  if ((answer_.status & kStatusPulseLimit) != 0) {
+  in.board_status = answer.status;
+  if ((answer.status & kStatusPulseLimit) != 0) {
     ++counters_.pulse_limit_events;
     status.pulse_limit = true;
   }
@@ -269,21 +315,23 @@ ExchangeStatus IcoBoardInverse::Exchange(
 
 ExchangeStatus IcoBoard::Exchange(const std::array<std::int32_t, kChannels>& pwm_out,
                                   EcsInputs& in) noexcept {
-  request_.opcode = Opcode::kAll;
+  ChannelWords words = 0;
   for (std::size_t c = 0; c < kChannels; ++c) {
     std::int32_t value = pwm_out[c];
     if (value < kPwmValueMin) value = kPwmValueMin;
     if (value > kPwmValueMax) value = kPwmValueMax;
-    request_.pwm[c] = PwmWordFromValue(value, pins_out_[c]);
+    words |= PlaceChannelWord(c, PackPwm(PwmWordFromValue(value, pins_out_[c])));
   }
-  const ExchangeStatus status = Transact(request_, answer_);
+  AllFrame answer;
+  const ExchangeStatus status = TransactAll(words, answer);
   if (!status.ok()) return status;
   for (std::size_t c = 0; c < kChannels; ++c) {
-    in.counts[c] = answer_.enc[c].counts;
+    const EncWord word = UnpackEnc(ChannelWord(answer.words, c));
+    in.counts[c] = word.counts;
     in.absolute_counts[c] = unwrappers_[c].Update(in.counts[c]);
-    in.pins[c] = answer_.enc[c].pin;
+    in.pins[c] = word.pin;
   }
-  in.board_status = answer_.status;
+  in.board_status = answer.status;
   return status;
 }
 

@@ -29,8 +29,17 @@ const char* ToString(StopCause cause) noexcept {
   return "?";
 }
 
+namespace {
+// Never advanced: reads 0 if anything reads it; TimedSpi recognises it by its address.
+const kernel_glue::VirtualClock kUntimedClock{0};
+}  // namespace
+
+const kernel_glue::Clock* UntimedTransfers() noexcept { return &kUntimedClock; }
+
 TimedSpi::TimedSpi(SpiBus& bus, const kernel_glue::Clock* clock) noexcept
-    : bus_(bus), clock_(clock != nullptr ? clock : &monotonic_) {}
+    : bus_(bus),
+      clock_(clock != nullptr ? clock : &monotonic_),
+      timed_(clock != UntimedTransfers()) {}
 
 BusStatus SpiBus::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
                                 const FrameBytes& fetch, FrameBytes& answer) noexcept {
@@ -40,12 +49,12 @@ BusStatus SpiBus::TransferPair(const FrameBytes& request, FrameBytes& request_mi
 }
 
 TransferStatus TimedSpi::Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept {
-  const kernel_glue::TimeNs start_ns = clock_->NowNs();
+  const kernel_glue::TimeNs start_ns = timed_ ? clock_->NowNs() : 0;
   return Record(start_ns, bus_.Transfer(mosi, miso));
 }
 
-TransferStatus TimedSpi::TransferPair(const FrameBytes& request, FrameBytes& request_miso,
-                                      const FrameBytes& fetch, FrameBytes& answer) noexcept {
+TransferStatus TimedSpi::TimedTransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                           const FrameBytes& fetch, FrameBytes& answer) noexcept {
   const kernel_glue::TimeNs start_ns = clock_->NowNs();
   return Record(start_ns, bus_.TransferPair(request, request_miso, fetch, answer));
 }
@@ -53,7 +62,7 @@ TransferStatus TimedSpi::TransferPair(const FrameBytes& request, FrameBytes& req
 TransferStatus TimedSpi::Record(kernel_glue::TimeNs start_ns, const BusStatus& bus_status) noexcept {
   TransferStatus status;
   status.start_ns = start_ns;
-  status.duration_ns = clock_->NowNs() - start_ns;
+  status.duration_ns = timed_ ? clock_->NowNs() - start_ns : 0;
   status.result = bus_status.result;
   status.reason = bus_status.reason;
   ++timing_.transfers;

@@ -123,6 +123,10 @@ QosMonitor::QosMonitor(const QosConfig& config) : config_(config) {
       std::max<std::uint64_t>(64, std::bit_ceil(std::uint64_t{max_k}));
   ring_words_.assign(capacity_bits / 64, 0);
   ring_mask_ = capacity_bits - 1;
+  rest_after_ = max_k;
+  unplanned_ratio_ = std::any_of(engines_.begin(), engines_.end(), [](const Engine& engine) {
+    return engine.kind == RuleKind::kMissRatio && engine.miss_budget == 0;
+  });
   live_distance_.store(min_distance, std::memory_order_relaxed);
 }
 
@@ -133,9 +137,9 @@ bool QosMonitor::Bit(std::uint64_t index) const noexcept {
 
 void QosMonitor::SetBit(std::uint64_t index, bool value) noexcept {
   const std::uint64_t slot = index & ring_mask_;
-  const std::uint64_t mask = std::uint64_t{1} << (slot & 63);
+  const std::uint64_t shift = slot & 63;
   std::uint64_t& word = ring_words_[slot >> 6];
-  word = value ? (word | mask) : (word & ~mask);
+  word = (word & ~(std::uint64_t{1} << shift)) | (std::uint64_t{value} << shift);
 }
 
 void QosMonitor::MarkViolation(std::size_t rule, std::uint64_t cycle) noexcept {
@@ -151,9 +155,7 @@ void QosMonitor::MarkViolation(std::size_t rule, std::uint64_t cycle) noexcept {
 }
 
 std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
-  if (engine.miss_budget > 0) {
-    return ClampDistance(engine.miss_budget > misses_ ? engine.miss_budget - misses_ : 0);
-  }
+  if (engine.miss_budget > 0) return BudgetDistance(engine);
   // No plan: the ratio is judged over the cycles run so far. Smallest j >= 1 with
   // (M + j)·100 >= P·(T + j), i.e. j >= (P·T - 100·M) / (100 - P).
   const double pct = engine.max_miss_pct;
@@ -210,10 +212,37 @@ std::uint32_t QosMonitor::RatioDistance(const Engine& engine) const noexcept {
       abort_rule_ = rule;
     }
   }
-  status.distance_to_failure = RatioDistance(engine);
+  // With a plan (every timed run) the distance is the budget left: no call for it.
+  status.distance_to_failure =
+      engine.miss_budget > 0 ? BudgetDistance(engine) : RatioDistance(engine);
 }
 
-bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
+bool QosMonitor::AtRest() const noexcept {
+  if (met_run_ < rest_after_ || unplanned_ratio_) return false;
+  for (std::size_t i = 0; i < engines_.size(); ++i) {
+    if (engines_[i].kind == RuleKind::kMissRatio && status_[i].violated) return false;
+  }
+  return true;
+}
+
+void QosMonitor::LeaveRest() noexcept {
+  quiet_ = false;
+  // Every bit a window can still read (the last rest_after_ judged cycles) is a met one.
+  std::fill(ring_words_.begin(), ring_words_.end(), 0);
+  // The m most recent met cycles are the last m judged ones (m <= k <= rest_after_), oldest
+  // first; only the order from met_head on is ever read.
+  const auto last = static_cast<std::int64_t>(judged_cycles_) - 1;
+  for (Engine& engine : engines_) {
+    const std::size_t m = engine.met_ring.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      engine.met_ring[i] = last - static_cast<std::int64_t>(m - 1 - i);
+    }
+    engine.met_head = 0;
+  }
+}
+
+bool QosMonitor::RecordInFull(std::uint64_t cycle, bool missed) noexcept {
+  if (quiet_) LeaveRest();
   run_all_ = missed ? run_all_ + 1 : 0;
   max_run_all_ = std::max(max_run_all_, run_all_);
   if (cycle < config_.grace_cycles) {
@@ -225,17 +254,15 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
   }
   const std::uint64_t t = judged_cycles_;  // judged index of this cycle
   ++judged_cycles_;
-  if (missed) {
-    ++misses_;
-    ++run_;
-    max_run_ = std::max(max_run_, run_);
-  } else {
-    run_ = 0;
-  }
+  misses_ += missed ? 1U : 0U;
+  run_ = missed ? run_ + 1 : 0;
+  max_run_ = std::max(max_run_, run_);
+  met_run_ = missed ? 0 : met_run_ + 1;
 
   std::uint32_t min_distance = kNeverFails;
   bool any_violated = false;
-  for (std::size_t i = 0; i < engines_.size(); ++i) {
+  const std::size_t rules = engines_.size();
+  for (std::size_t i = 0; i < rules; ++i) {
     Engine& engine = engines_[i];
     RuleStatus& status = status_[i];
     bool violated_now = false;
@@ -250,7 +277,11 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
             violated_now ? 0 : ClampDistance(engine.allowed_misses + 1 - run_);
         break;
       case RuleKind::kMissRatio:
-        UpdateRatioRule(engine, status, i, cycle);
+        // A met cycle can only lower the ratio: a rule that holds still holds, its budget and
+        // distance (under a plan) are unchanged, so only a miss or a violated rule is worked.
+        if (missed || status.violated || engine.miss_budget == 0) {
+          UpdateRatioRule(engine, status, i, cycle);
+        }
         break;
     }
     if (violated_now) MarkViolation(i, cycle);
@@ -258,6 +289,7 @@ bool QosMonitor::Record(std::uint64_t cycle, bool missed) noexcept {
     min_distance = std::min(min_distance, status.distance_to_failure);
   }
   SetBit(t, missed);
+  quiet_ = !missed && AtRest();
 
   live_releases_.store(releases_recorded(), std::memory_order_relaxed);
   live_all_misses_.store(all_misses(), std::memory_order_relaxed);

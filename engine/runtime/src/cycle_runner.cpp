@@ -28,43 +28,29 @@ CycleRunner::CycleRunner(RunTask& task, kernel_glue::Clock& clock,
       violations_seen_(monitor.rules().size(), 0) {}
 
 scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context) noexcept {
-  rules_ = lifecycle_.rules();
+  // The rules change only with the state, which changes a few times a run.
+  const lifecycle::State state = lifecycle_.state();
+  if (!rules_state_ || *rules_state_ != state) [[unlikely]] {
+    rules_state_ = state;
+    rules_ = lifecycle::RulesOf(state);
+  }
   stepped_ = false;
-  peer_stop_seen_ = false;
   step_status_ = StepStatus::Ok();
   const kernel_glue::TimeNs io_start_ns = clock_.NowNs();
   const io::ExchangeStatus io = task_.Exchange(rules_.live_outputs);
-  io_ns_ = clock_.NowNs() - io_start_ns;
+  SetIoNsOfLastStep(clock_.NowNs() - io_start_ns);
   io_fault_ = io.code == io::ExchangeStatus::Code::kFault;
-  if (io_fault_) {
-    TraceIoError(context.cycle, tracing::IoErrorKind::kFault);
-    NoteFault(StopReason::kIoFault, context.cycle, io.reason);
-    return scheduler::CycleAction::kContinue;  // OnCycle still records the cycle, then stops
+  peer_stop_seen_ = false;
+  if (!io.ok() || io.peer_absent || io.pulse_limit || io.peer_stopped != nullptr) [[unlikely]] {
+    NoteExchange(io, context.cycle);
+    if (io_fault_) return scheduler::CycleAction::kContinue;  // OnCycle records, then stops
   }
-  if (!io.ok()) {
-    ++counts_.io_errors;  // the task held its inputs
-    TraceIoError(context.cycle, tracing::IoErrorKind::kHeldInputs);
-  }
-  if (io.peer_absent) {
-    ++counts_.peer_absent_cycles;
-    TraceIoError(context.cycle, tracing::IoErrorKind::kPeerAbsent);
-  }
-  if (io.pulse_limit) {
-    ++counts_.pulse_limit_cycles;
-    TraceIoError(context.cycle, tracing::IoErrorKind::kPulseLimit);
-  }
-  peer_stop_seen_ = io.peer_stopped != nullptr;
-  if (peer_stop_seen_ && peer_stopped_ == nullptr) peer_stopped_ = io.peer_stopped;
   if (!rules_.steps_model) {
     ++counts_.paused_cycles;
     return scheduler::CycleAction::kContinue;
   }
   step_status_ = task_.Step(context);
-  const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(context.cycle);
-  if (extra_ns > 0) {
-    HILTWIN_TRACE(overrun_injected, context.cycle, extra_ns);
-    clock_.SpendNs(extra_ns);
-  }
+  if (!injector_.empty()) InjectOverrun(context.cycle);
   if (!virtual_compute_ns_.empty()) {
     clock_.SpendNs(virtual_compute_ns_[context.cycle % virtual_compute_ns_.size()]);
   }
@@ -74,6 +60,36 @@ scheduler::CycleAction CycleRunner::Step(const scheduler::CycleContext& context)
     stepped_ = true;
   }
   return scheduler::CycleAction::kContinue;
+}
+
+void CycleRunner::NoteExchange(const io::ExchangeStatus& io, std::uint64_t cycle) noexcept {
+  if (io_fault_) {
+    TraceIoError(cycle, tracing::IoErrorKind::kFault);
+    NoteFault(StopReason::kIoFault, cycle, io.reason);
+    return;  // the step is not run on stale inputs: nothing else of this exchange counts
+  }
+  if (!io.ok()) {
+    ++counts_.io_errors;  // the task held its inputs
+    TraceIoError(cycle, tracing::IoErrorKind::kHeldInputs);
+  }
+  if (io.peer_absent) {
+    ++counts_.peer_absent_cycles;
+    TraceIoError(cycle, tracing::IoErrorKind::kPeerAbsent);
+  }
+  if (io.pulse_limit) {
+    ++counts_.pulse_limit_cycles;
+    TraceIoError(cycle, tracing::IoErrorKind::kPulseLimit);
+  }
+  peer_stop_seen_ = io.peer_stopped != nullptr;
+  if (peer_stop_seen_ && peer_stopped_ == nullptr) peer_stopped_ = io.peer_stopped;
+}
+
+void CycleRunner::InjectOverrun(std::uint64_t cycle) noexcept {
+  const kernel_glue::TimeNs extra_ns = injector_.ExtraNs(cycle);
+  if (extra_ns > 0) {
+    HILTWIN_TRACE(overrun_injected, cycle, extra_ns);
+    clock_.SpendNs(extra_ns);
+  }
 }
 
 scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sample) noexcept {
@@ -96,14 +112,18 @@ scheduler::CycleAction CycleRunner::OnCycle(const scheduler::TimingSample& sampl
 
 [[gnu::always_inline]] inline void CycleRunner::RecordQos(
     const scheduler::TimingSample& sample) noexcept {
+  qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
+  if (sample.missed || sample.releases_skipped > 0) [[unlikely]] RecordMisses(sample);
+}
+
+void CycleRunner::RecordMisses(const scheduler::TimingSample& sample) noexcept {
   // Skipped releases are misses too, but once the monitor says abort the run has ended:
   // releases after that one are not judged.
-  qos_abort_ = monitor_.Record(sample.cycle, sample.missed);
   for (std::uint32_t i = 1; i <= sample.releases_skipped && !qos_abort_; ++i) {
     qos_abort_ = monitor_.Record(sample.cycle + i, true);
   }
   // A rule's violation count can only rise on a miss: the common cycle skips the loop.
-  if (sample.missed || sample.releases_skipped > 0) TraceViolations(sample.cycle);
+  TraceViolations(sample.cycle);
 }
 
 void CycleRunner::TraceViolations(std::uint64_t cycle) noexcept {
@@ -175,11 +195,14 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
                      !plan_done && !peer_stop_seen_ && !commands_.MaybeNonEmpty() &&
                      !kernel_glue::StopRequested();
   if (quiet) return false;
+  HandleEvents(sample.cycle, plan_done);
+  return true;
+}
+
+void CycleRunner::HandleEvents(std::uint64_t cycle, bool plan_done) noexcept {
   // Faults first: when several causes meet in one cycle the report names the one that makes
   // the outputs unsafe. Every event goes to the lifecycle from here and nowhere else.
-  const auto handle = [this, &sample](Event event) {
-    HandleTraced(lifecycle_, event, sample.cycle);
-  };
+  const auto handle = [this, cycle](Event event) { HandleTraced(lifecycle_, event, cycle); };
   if (io_fault_) handle(Event::kIoFault);
   if (step_status_.code == StepStatus::Code::kModelFault) handle(Event::kModelFault);
   if (qos_abort_) handle(Event::kQosAbort);
@@ -188,8 +211,7 @@ void CycleRunner::Log(const scheduler::TimingSample& sample) noexcept {
     handle(Event::kFinishReached);
   }
   if (peer_stop_seen_) handle(Event::kPeerStopped);
-  HandleCommands(sample.cycle);
-  return true;
+  HandleCommands(cycle);
 }
 
 void CycleRunner::HandleCommands(std::uint64_t cycle) noexcept {

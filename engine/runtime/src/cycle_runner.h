@@ -77,7 +77,6 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
               const CycleRunnerConfig& config);
 
   scheduler::CycleAction Step(const scheduler::CycleContext& context) noexcept override;
-  [[nodiscard]] kernel_glue::TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
   scheduler::CycleAction OnCycle(const scheduler::TimingSample& sample) noexcept override;
 
   /// Thread-safe and lock-free: the loop acts on it after the current cycle, in the order
@@ -107,7 +106,16 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   /// Offers this cycle's events to the lifecycle; false when there were none (the state is
   /// unchanged, the common case).
   bool PostEvents(const scheduler::TimingSample& sample) noexcept;
+  /// The events of a cycle that had some, in the order the report's cause needs.
+  [[gnu::noinline]] void HandleEvents(std::uint64_t cycle, bool plan_done) noexcept;
+  /// The QoS part of a cycle that missed or skipped releases (out of the common path).
+  [[gnu::noinline]] void RecordMisses(const scheduler::TimingSample& sample) noexcept;
   void NoteFault(lifecycle::StopReason kind, std::uint64_t cycle, const char* reason) noexcept;
+  /// Counts and traces an exchange that was not plainly ok (out of the common cycle's path).
+  [[gnu::cold, gnu::noinline]] void NoteExchange(const io::ExchangeStatus& io,
+                                                 std::uint64_t cycle) noexcept;
+  /// Spends the injected extra compute time of `cycle`, if any (only with --inject-overrun).
+  [[gnu::noinline]] void InjectOverrun(std::uint64_t cycle) noexcept;
 
   RunTask& task_;
   kernel_glue::Clock& clock_;
@@ -129,7 +137,7 @@ class CycleRunner final : public scheduler::CyclicTask, public scheduler::CycleO
   // This cycle, from Step to OnCycle. Only the loop thread changes the state while the loop
   // runs, so the rules read in Step hold until OnCycle posts events.
   lifecycle::StateRules rules_;
-  kernel_glue::TimeNs io_ns_ = 0;
+  std::optional<lifecycle::State> rules_state_;  ///< the state rules_ are of (none yet)
   bool stepped_ = false;
   bool io_fault_ = false;
   StepStatus step_status_;

@@ -1,8 +1,8 @@
 #include "hiltwin/scheduler/log_linear_histogram.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
+#include <limits>
 
 namespace hiltwin::scheduler {
 namespace {
@@ -10,28 +10,11 @@ namespace {
 constexpr std::int64_t kSubBuckets = std::int64_t{1} << LogLinearHistogram::kSubBucketBits;
 // Values below 2*kSubBuckets get one bucket each (exact); above, each power of two gets
 // kSubBuckets buckets of width 2^shift.
-constexpr std::int64_t kExactLimit = 2 * kSubBuckets;
-constexpr std::size_t kExactBuckets = static_cast<std::size_t>(kExactLimit);
-constexpr int kMaxShift = LogLinearHistogram::kMaxValueBits - LogLinearHistogram::kSubBucketBits;
-constexpr std::size_t kBucketCount =
-    kExactBuckets + static_cast<std::size_t>(kMaxShift) * static_cast<std::size_t>(kSubBuckets);
+constexpr std::size_t kExactBuckets = static_cast<std::size_t>(2 * kSubBuckets);
 
 }  // namespace
 
-LogLinearHistogram::LogLinearHistogram() : counts_(kBucketCount, 0) {}
-
-std::size_t LogLinearHistogram::BucketCount() noexcept { return kBucketCount; }
-
-std::size_t LogLinearHistogram::BucketIndex(std::int64_t value_ns) noexcept {
-  if (value_ns < kExactLimit) return value_ns < 0 ? 0 : static_cast<std::size_t>(value_ns);
-  const auto v = static_cast<std::uint64_t>(value_ns);
-  const int msb = 63 - std::countl_zero(v);
-  const int shift = msb - kSubBucketBits;  // ≥ 1 here
-  if (shift > kMaxShift) return kBucketCount - 1;
-  const auto mantissa = static_cast<std::size_t>(v >> shift);  // in [kSubBuckets, 2*kSubBuckets)
-  return kExactBuckets + static_cast<std::size_t>(shift - 1) * static_cast<std::size_t>(kSubBuckets) +
-         (mantissa - static_cast<std::size_t>(kSubBuckets));
-}
+LogLinearHistogram::LogLinearHistogram() : counts_(BucketCount(), 0) {}
 
 std::int64_t LogLinearHistogram::BucketLow(std::size_t index) noexcept {
   if (index < kExactBuckets) return static_cast<std::int64_t>(index);
@@ -48,22 +31,11 @@ std::int64_t LogLinearHistogram::BucketHigh(std::size_t index) noexcept {
   return BucketLow(index) + (std::int64_t{1} << shift);
 }
 
-void LogLinearHistogram::Record(std::int64_t value_ns) noexcept {
-  if (value_ns < 0) value_ns = 0;
-  ++counts_[BucketIndex(value_ns)];
-  if (count_ == 0) {
-    min_ns_ = max_ns_ = value_ns;
-  } else {
-    min_ns_ = std::min(min_ns_, value_ns);
-    max_ns_ = std::max(max_ns_, value_ns);
-  }
-  ++count_;
-}
-
 void LogLinearHistogram::Reset() noexcept {
   std::fill(counts_.begin(), counts_.end(), 0);
   count_ = 0;
-  min_ns_ = max_ns_ = 0;
+  min_ns_ = std::numeric_limits<std::int64_t>::max();
+  max_ns_ = 0;
 }
 
 std::int64_t LogLinearHistogram::ValueAtQuantile(double q) const noexcept {

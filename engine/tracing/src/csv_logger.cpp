@@ -8,9 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
-#include <cmath>
 #include <cstring>
 #include <set>
 #include <stdexcept>
@@ -18,6 +16,7 @@
 #include <utility>
 
 #include "hiltwin/kernel_glue/output_file.h"
+#include "log_number.h"
 
 namespace hiltwin::tracing {
 namespace {
@@ -25,15 +24,24 @@ namespace {
 // Large enough that the writer makes one write() per few hundred rows, small enough to stay
 // out of the way of the loop's locked memory budget.
 constexpr std::size_t kFileBufferBytes = std::size_t{256} * 1024;
-// Room for the longest row: a cell is at most 24 characters (to_chars' shortest double; the
-// fixed-point shortcuts print fewer) plus its comma, rounded up to 32, and the newline. The
-// buffer is written out before a row might not fit.
+// Room for the longest row: a cell is at most detail::kMaxNumberChars = 24 characters (the
+// shortest double; the fixed-point shortcuts print fewer) plus its comma, rounded up to 32,
+// and the newline. The buffer is written out before a row might not fit.
 constexpr std::size_t kMaxLineBytes = (kMaxLogColumns + 1) * 32 + 2;
+static_assert((kMaxLogColumns + 1) * (detail::kMaxNumberChars + 1) + detail::kNumberScratchChars <=
+                  kMaxLineBytes,
+              "the widest row and the scratch its last cell may write fit in kMaxLineBytes");
 // Keeps the preallocated queue below ~8 GiB even at the widest row; a larger request is a
 // typo, not a plan.
 constexpr std::size_t kMaxQueueCapacityRows = std::size_t{1} << 24;
 // MATLAB's namelengthmax: longer names would be truncated by readtable.
 constexpr std::size_t kMaxColumnNameChars = 63;
+// Rows the writer formats before it hands their slots back (DrainAvailable): 8 KiB of a
+// 15-column row, 1/1024 of the default queue.
+constexpr std::size_t kReleaseBatchRows = 64;
+// The queue's rows start on a cache line, so a 16-double row is exactly two lines and the
+// producer's row never shares a line with the one the writer reads.
+constexpr std::size_t kRowAlignment = 64;
 
 std::string ErrnoText(int err) {
   // strerror is not thread-safe in theory; this runs on set-up and error paths only, and the
@@ -131,56 +139,11 @@ std::pair<std::size_t, int> WriteAll(int fd, const char* data, std::size_t size)
   return {done, 0};
 }
 
-/// Prints `units` · 10^-decimals (units < 10^18) with its trailing zeros and a bare decimal
-/// point removed, e.g. 4.99975, 12, -0.5, -0.
-char* FormatFixed(char* first, char* last, bool negative, std::uint64_t units, int decimals) noexcept {
-  if (negative) *first++ = '-';
-  std::uint64_t scale = 1;
-  for (int i = 0; i < decimals; ++i) scale *= 10U;
-  first = std::to_chars(first, last, units / scale).ptr;
-  std::uint64_t fraction = units % scale;
-  if (fraction == 0) return first;
-  while (fraction % 10U == 0) {
-    fraction /= 10U;
-    --decimals;
-  }
-  *first++ = '.';
-  char* const end = first + decimals;
-  for (char* p = end; p != first; fraction /= 10U) *--p = static_cast<char>('0' + fraction % 10U);
-  return end;
-}
-
-// Shortest text that parses back to the same double; NaN/Inf spelled the way MATLAB writes
-// them (strtod reads them too).
-char* FormatDouble(char* first, char* last, double value) noexcept {
-  if (std::isnan(value)) return std::copy_n("NaN", 3, first);
-  if (std::isinf(value)) {
-    if (value < 0) *first++ = '-';
-    return std::copy_n("Inf", 3, first);
-  }
-  // Shortest round-trip formatting of a double costs ~350 instructions, and the writer thread
-  // formats every cell of every row. Three exact shortcuts cover most cells of a twin's log:
-  // values with at most 6 decimals (time stamps, microseconds, counters), multiples of 2^-11
-  // (PWM duty is value / 2048, whose decimal expansion ends after 11 places) and whole
-  // numbers up to 2^53 are printed from integers. Each prints the value's exact decimal
-  // expansion, which reads back as the very same double, so the file stays bit-exact.
-  const double magnitude = std::fabs(value);
-  const bool negative = std::signbit(value);
-  if (magnitude < 1e6) {
-    const double micros = std::nearbyint(magnitude * 1e6);
-    if (micros / 1e6 == magnitude) {
-      return FormatFixed(first, last, negative, static_cast<std::uint64_t>(micros), 6);
-    }
-    const double steps = magnitude * 2048.0;  // exact: a power-of-two scale
-    if (steps == std::floor(steps)) {
-      // n / 2^11 = n · 5^11 / 10^11; below 10^6 · 2^11 · 5^11 < 2^57, no overflow.
-      return FormatFixed(first, last, negative, static_cast<std::uint64_t>(steps) * 48'828'125U, 11);
-    }
-  } else if (magnitude < 9007199254740992.0) {  // 2^53: every whole double below is exact
-    const auto whole = static_cast<std::int64_t>(value);
-    if (static_cast<double>(whole) == value) return std::to_chars(first, last, whole).ptr;
-  }
-  return std::to_chars(first, last, value).ptr;
+/// The first cache-line boundary in `storage` (which has kRowAlignment bytes to spare).
+double* AlignedRows(double* storage) noexcept {
+  void* start = storage;
+  std::size_t space = kRowAlignment;
+  return static_cast<double*>(std::align(kRowAlignment, sizeof(double), start, space));
 }
 
 }  // namespace
@@ -190,7 +153,10 @@ CsvLogger::CsvLogger(CsvLoggerConfig config)
       row_stride_(1 + config_.columns.size()),
       ring_(config_.queue_capacity_rows),
       // Value-initialised, so every page is touched now rather than in the loop.
-      rows_(std::make_unique<double[]>(config_.queue_capacity_rows * row_stride_)),
+      row_storage_(std::make_unique<double[]>(config_.queue_capacity_rows * row_stride_ +
+                                              kRowAlignment / sizeof(double))),
+      rows_(AlignedRows(row_storage_.get())),
+      cell_memos_(std::make_unique<detail::CellMemo[]>(row_stride_)),
       file_buffer_(std::make_unique<char[]>(kFileBufferBytes)) {
   fd_ = kernel_glue::OpenOutputFile(config_.path, "the log file");
   std::string header;
@@ -255,7 +221,7 @@ bool CsvLogger::TryLog(double time_s, std::span<const double> values) noexcept {
                             std::memory_order_relaxed);
     return false;
   }
-  double* row = rows_.get() + slot * row_stride_;
+  double* row = rows_ + slot * row_stride_;
   row[0] = time_s;
   std::copy(values.begin(), values.end(), row + 1);
   ring_.Publish();
@@ -339,29 +305,26 @@ void CsvLogger::ConfigureWriterThread() {
 void CsvLogger::DrainAvailable() {
   std::size_t available = ring_.Available();
   while (available != 0) {
-    for (; available != 0; --available) {
+    // Slots go back to the producer a batch at a time: one store to the shared index per batch
+    // rather than per row, and a waiting producer (wait_when_full) refills a batch's worth of
+    // rows away from the ones being read instead of the row next to them.
+    const std::size_t batch = std::min(available, kReleaseBatchRows);
+    for (std::size_t r = 0; r < batch; ++r) {
       if (!write_failed_ && kFileBufferBytes - buffered_bytes_ < kMaxLineBytes) WriteBuffer();
       if (write_failed_ || fd_ < 0) {
         // The log has ended (see the header): the row is counted, not written.
-        ring_.Release(1);
         lost_.store(lost_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
         continue;
       }
-      const double* row = rows_.get() + ring_.ReadSlot(0) * row_stride_;
+      const double* row = rows_ + ring_.ReadSlot(r) * row_stride_;
       char* const first = file_buffer_.get() + buffered_bytes_;
-      char* const last = first + kMaxLineBytes;
-      char* out = FormatDouble(first, last, row[0]);
-      for (std::size_t c = 1; c < row_stride_; ++c) {
-        *out++ = ',';
-        out = FormatDouble(out, last, row[c]);
-      }
-      *out++ = '\n';
-      // Release per row: frees space for the producer as early as possible (a plain store).
-      ring_.Release(1);
-      buffered_bytes_ += static_cast<std::size_t>(out - first);
+      char* const end = detail::FormatLogRow(first, row, row_stride_, cell_memos_.get());
+      buffered_bytes_ += static_cast<std::size_t>(end - first);
       ++buffered_rows_;
     }
-    available = ring_.Available();
+    ring_.Release(batch);
+    available -= batch;
+    if (available == 0) available = ring_.Available();
   }
 }
 

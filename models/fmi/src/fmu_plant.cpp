@@ -114,6 +114,8 @@ void FmuPlantImpl::BuildPorts() {
     }
   }
   initial_inputs_.assign(input_refs_.size(), 0.0);
+  step_inputs_ = input_refs_;  // the vectors do not change after this: their views stay valid
+  step_outputs_ = output_refs_;
 }
 
 void FmuPlantImpl::SetInitialInputs(std::span<const double> u0) {
@@ -155,6 +157,7 @@ void FmuPlantImpl::Instantiate() {
                      "guid " + md_.guid + ": export the FMU again");
   }
   initialised_ = false;
+  ready_ = false;
   worst_ = fmi2OK;
 }
 
@@ -173,6 +176,7 @@ void FmuPlantImpl::Initialise(std::span<double> y0) {
   }
   Check(fn_.exit_initialization_mode(component_), "fmi2ExitInitializationMode");
   initialised_ = true;
+  ready_ = true;
   if (!output_refs_.empty()) {
     Check(fn_.get_real(component_, output_refs_.data(), output_refs_.size(), y0.data()),
           "fmi2GetReal");
@@ -202,6 +206,7 @@ void FmuPlantImpl::Reset(std::span<double> y0) {
                      "no further call to it: open the FMU again");
   }
   initialised_ = false;
+  ready_ = false;
   Check(fn_.reset(component_), "fmi2Reset");
   worst_ = fmi2OK;
   Initialise(y0);
@@ -210,35 +215,45 @@ void FmuPlantImpl::Reset(std::span<double> y0) {
 
 PlantStatus FmuPlantImpl::Latch(StepCall call, fmi2Status status) noexcept {
   worst_ = status;
+  ready_ = false;
   status_ = PlantStatus::Fault(StepFaultReason(call, status));
   return status_;
 }
 
-PlantStatus FmuPlantImpl::Step(std::span<const double> u, std::span<double> y) noexcept {
-  if (!status_.ok()) {
-    return status_;  // FMI 2.0 allows no further doStep after an error; the fault stays
-  }
-  if (component_ == nullptr || !initialised_ || u.size() != input_refs_.size() ||
-      y.size() != output_refs_.size()) {
+PlantStatus FmuPlantImpl::Refuse() noexcept {
+  if (status_.ok()) {  // otherwise the fault stays: FMI 2.0 allows no further doStep after one
+    ready_ = false;
     status_ = PlantStatus::Fault("FMU plant stepped before Start or with the wrong port count");
-    return status_;
   }
+  return status_;
+}
+
+// The per-step path: one flag for "started, initialised, not faulted" and the port counts
+// checked against views fixed at construction; the FMU's three calls take their arguments from
+// locals, so nothing is reloaded after a call.
+PlantStatus FmuPlantImpl::Step(std::span<const double> u, std::span<double> y) noexcept {
+  if (!ready_ || u.size() != step_inputs_.size() || y.size() != step_outputs_.size())
+      [[unlikely]] {
+    return Refuse();
+  }
+  const fmi2Component component = component_;
   fmi2Status status = fmi2OK;
-  if (!input_refs_.empty()) {
-    status = fn_.set_real(component_, input_refs_.data(), input_refs_.size(), u.data());
-    if (!Succeeded(status)) {
+  if (!step_inputs_.empty()) {
+    status = fn_.set_real(component, step_inputs_.data(), step_inputs_.size(), u.data());
+    if (!Succeeded(status)) [[unlikely]] {
       return Latch(StepCall::kSetReal, status);
     }
   }
-  const double t_s = static_cast<double>(steps_) * step_s_;
-  status = fn_.do_step(component_, t_s, step_s_, fmi2True);
-  if (!Succeeded(status)) {
+  // Model time k h, never accumulated; steps_ < 2^63, so the signed conversion is the same.
+  const double t_s = static_cast<double>(static_cast<std::int64_t>(steps_)) * step_s_;
+  status = fn_.do_step(component, t_s, step_s_, fmi2True);
+  if (!Succeeded(status)) [[unlikely]] {
     return Latch(StepCall::kDoStep, status);
   }
   ++steps_;
-  if (!output_refs_.empty()) {
-    status = fn_.get_real(component_, output_refs_.data(), output_refs_.size(), y.data());
-    if (!Succeeded(status)) {
+  if (!step_outputs_.empty()) {
+    status = fn_.get_real(component, step_outputs_.data(), step_outputs_.size(), y.data());
+    if (!Succeeded(status)) [[unlikely]] {
       return Latch(StepCall::kGetReal, status);
     }
   }
@@ -257,6 +272,7 @@ void FmuPlantImpl::Finish() noexcept {
     }
     component_ = nullptr;
     initialised_ = false;
+    ready_ = false;
   }
   try {
     log_.Drain();

@@ -52,6 +52,7 @@ class FmuPlantImpl final : public FmuPlant {
   void Check(fmi2Status status, const char* call);
   void CheckOutputSpan(std::span<double> y0, const char* call) const;
   plant::PlantStatus Latch(StepCall call, fmi2Status status) noexcept;
+  plant::PlantStatus Refuse() noexcept;
 
   std::string fmu_name_;  ///< the path as given, for messages
   UnpackedFmu unpacked_;
@@ -69,6 +70,10 @@ class FmuPlantImpl final : public FmuPlant {
 
   fmi2Component component_ = nullptr;
   bool initialised_ = false;   ///< fmi2ExitInitializationMode returned ok
+  /// Step may call the FMU: an instance, initialised, not faulted (one test per step).
+  bool ready_ = false;
+  std::span<const fmi2ValueReference> step_inputs_{};   ///< input_refs_, for Step
+  std::span<const fmi2ValueReference> step_outputs_{};  ///< output_refs_, for Step
   fmi2Status worst_ = fmi2OK;  ///< the last failing status: what FMI 2.0 still allows
   plant::PlantStatus status_;  ///< latched: after a fault the FMU is not called again
   double step_s_ = 0.0;

@@ -198,21 +198,31 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
   // ("backlog behind k=N (preempted by hiltwin-hog ...)"), not as "invisible". Unless the
   // guest itself lost its CPU for longer than a burst (hypervisor steal: one 27 ms stall at
   // 4 kHz leaves 108 catch-up cycles behind it, seen beside five other helpers' builds): then
-  // the class order is the host's.
+  // the class order is the host's. So it is when many short unseen stalls add up to more
+  // cycles than half the hog's bursts (2026-11-30, a VM whose wake-up latency had risen tenfold:
+  // 156 invisible cycles of their own against the hog's 250, beside Chromium tests).
+  // The cycles the bursts cover: 2 s at 4 kHz, 3 ms in every 100 ms (240).
+  const std::size_t expected_cycles = std::size_t{kTraceSeconds} * kRateHz * kSpinMs /
+                                      (kSpinMs + kSleepMs);
   std::int64_t longest_invisible_ns = 0;
+  std::int64_t invisible_own_cycles = 0;
+  for (const json& cause : jitter["causes"]) {
+    if (cause["class"] != "invisible") continue;
+    invisible_own_cycles =
+        cause["cycles"].get<std::int64_t>() - cause["backlog_cycles"].get<std::int64_t>();
+  }
   for (const json& cycle : jitter["notable"]) {
     if (cycle["cause"]["class"] != "invisible") continue;
     longest_invisible_ns =
         std::max(longest_invisible_ns, cycle["cause"]["duration_ns"].get<std::int64_t>());
   }
-  if (longest_invisible_ns <= std::int64_t{kSpinMs} * 1'000'000) {
+  if (longest_invisible_ns <= std::int64_t{kSpinMs} * 1'000'000 &&
+      invisible_own_cycles <= static_cast<std::int64_t>(expected_cycles / 2)) {
     EXPECT_EQ(jitter["causes"][0]["class"], "preempted") << jitter["causes"].dump(2);
   } else {
     RecordProperty("top_class_unchecked_invisible_stall_ns", std::to_string(longest_invisible_ns));
+    RecordProperty("top_class_unchecked_invisible_cycles", std::to_string(invisible_own_cycles));
   }
-  // The cycles the bursts cover: 2 s at 4 kHz, 3 ms in every 100 ms (240).
-  const std::size_t expected_cycles = std::size_t{kTraceSeconds} * kRateHz * kSpinMs /
-                                      (kSpinMs + kSleepMs);
   std::int64_t hog_cycles = 0;
   std::int64_t other_named_max = 0;
   std::string other_named;

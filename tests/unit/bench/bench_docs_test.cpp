@@ -1,5 +1,5 @@
-// The cost figures docs/tracing.md and docs/telemetry.md state are the ones the benchmarks
-// printed, as docs/BENCHMARKS.md quotes their output: a re-run whose output is pasted without
+// The cost figures docs/tracing.md and docs/telemetry.md state, and docs/BENCHMARKS.md's loop
+// speed table, are the ones the benchmarks printed, as docs/BENCHMARKS.md quotes their output: a re-run whose output is pasted without
 // updating the prose (or prose changed without a run) fails here. No figure is written in this
 // file; each is read from the quoted output, in the format the benchmark prints.
 #include <gtest/gtest.h>
@@ -7,11 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "cycle/cycle_table.h"
 #include "fakes/test_paths.h"
 
 namespace {
@@ -94,6 +96,38 @@ TEST(BenchDocs, TheTelemetryCostStatedIsTheBenchmarksOutput) {
   EXPECT_NE(section.find("**" + added + " instructions**"), std::string::npos) << added;
   EXPECT_NE(benchmarks.find("**+" + added + " instructions**"), std::string::npos)
       << "the summary row";
+}
+
+TEST(BenchDocs, TheLoopSpeedTableIsTheBenchmarksOutput) {
+  const std::string benchmarks = Read(HILTWIN_BENCHMARKS_DOC);
+  const std::string section = Section(benchmarks, "## Loop speed (issue 36)");
+  // hiltwin_bench_cycle's table lines, e.g. "  whole virtual-clock cycle (no log)    5287.4
+  // 100.0 %   <= 1,800  NOT met": name, instructions per cycle, share, target, verdict.
+  const auto lines = Matches(section, R"(^  (\S.*?) +([0-9]+\.[0-9]) +([0-9]+\.[0-9]) % +)"
+                                      R"((<= ([0-9,]+)|-)  (met|NOT met|-)$)");
+  ASSERT_EQ(lines.size(), 8U) << "the benchmark's table in docs/BENCHMARKS.md";
+  ASSERT_EQ(lines.back()[1].str().rfind("whole virtual-clock cycle", 0), 0U) << "last: whole";
+  const double whole = std::stod(lines.back()[2]);
+  for (const auto& line : lines) {
+    const std::string name = line[1];
+    const double figure = std::stod(line[2]);
+    // The share and the verdict are the table's arithmetic of the printed figure: an edited
+    // figure without its share, or a share from another run, fails here.
+    EXPECT_NEAR(std::stod(line[3]), hiltwin::bench::SharePct(figure, whole), 0.06) << name;
+    std::optional<double> target;
+    if (line[5].matched) {
+      std::string digits = line[5];
+      digits.erase(std::remove(digits.begin(), digits.end(), ','), digits.end());
+      target = std::stod(digits);
+    }
+    EXPECT_EQ(line[6].str(), hiltwin::bench::VerdictOf({name, figure, target})) << name;
+    // The section's table states each figure in its first ("after") column as the prose writes
+    // counts.
+    EXPECT_NE(section.find("| " + name + " | **" + Count(figure) + "** |"), std::string::npos)
+        << name << ": " << Count(figure);
+  }
+  EXPECT_NE(benchmarks.find("**" + Count(whole) + " instructions per cycle**"), std::string::npos)
+      << "the summary row: " << Count(whole);
 }
 
 }  // namespace

@@ -201,6 +201,32 @@ TEST(FmuPlantLifecycle, MisuseIsRefusedNotCrashed) {
   plant->Finish();  // idempotent, and fine without Start
 }
 
+// Step's one "ready" flag stands for three conditions (an instance, initialised, no fault):
+// each way of losing one refuses the step, and a wrong port count latches like an FMU fault.
+TEST(FmuPlantLifecycle, StepIsRefusedAfterFinishAndAfterAWrongPortCount) {
+  const auto plant = OpenFmu(TestFmu("msd"));
+  std::array<double, 2> y{};
+  const std::array<double, 1> force{1.0};
+  plant->Start(kStepS, y);
+  ASSERT_TRUE(plant->Step(force, y).ok());
+  plant->Finish();
+  EXPECT_EQ(plant->Step(force, y).code, plant::PlantStatus::Code::kFault);  // no instance
+  plant->Start(kStepS, y);
+  ASSERT_TRUE(plant->Step(force, y).ok());
+  std::array<double, 1> too_few{};
+  const plant::PlantStatus wrong = plant->Step(force, too_few);
+  EXPECT_EQ(wrong.code, plant::PlantStatus::Code::kFault);
+  EXPECT_STREQ(wrong.reason, "FMU plant stepped before Start or with the wrong port count");
+  const std::array<double, 2> too_many{};
+  EXPECT_EQ(plant->Step(too_many, y).code, plant::PlantStatus::Code::kFault);
+  const plant::PlantStatus stays = plant->Step(force, y);  // right counts again: the fault stays
+  EXPECT_EQ(stays.code, plant::PlantStatus::Code::kFault);
+  EXPECT_STREQ(stays.reason, wrong.reason);
+  plant->Reset(y);  // Reset clears it, from the initial state and model time 0
+  ASSERT_TRUE(plant->Step(force, y).ok());
+  EXPECT_NEAR(y[0], MsdResponse(force[0], kStepS).x_m, 1e-12);
+}
+
 TEST(FmuPlantFault, AnErrorStatusIsAFaultNamingTheCallAndItStays) {
   std::vector<std::string> lines;
   FmuOptions options;

@@ -31,7 +31,7 @@ class FakePlant final : public Plant {
     for (std::size_t i = 0; i < y.size(); ++i) {
       y[i] = initial + gain * u[i % u.size()] + slope * static_cast<double>(steps_);
     }
-    if (steps_ == nan_at) y[0] = std::numeric_limits<double>::quiet_NaN();
+    if (steps_ == nan_at) y[nan_index] = nan_value;
     return PlantStatus::Ok();
   }
   void Reset(std::span<double> y0) override { Start(step_s_, y0); }
@@ -45,6 +45,8 @@ class FakePlant final : public Plant {
   std::uint64_t fault_at = 0;  ///< 0: never
   std::uint64_t finish_at = 0;
   std::uint64_t nan_at = 0;
+  std::size_t nan_index = 0;  ///< the output nan_at overwrites, with nan_value
+  double nan_value = std::numeric_limits<double>::quiet_NaN();
 
  private:
   PlantInfo info_;

@@ -3,7 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "fake_plant.h"
 #include "fakes/alloc_counter.h"
@@ -157,6 +160,36 @@ TEST(PlantTwinTask, FaultsFinishesAndNonFiniteOutputsBecomeStepStatuses) {
   EXPECT_EQ(diverged.code, runtime::StepStatus::Code::kModelFault);
   EXPECT_THAT(diverged.reason, ::testing::HasSubstr("non-finite"));
   EXPECT_EQ(nan.task->encoder_next()[1], 0);  // no count computed from a NaN
+}
+
+// Every non-finite value (either infinity, quiet and signalling NaNs of either sign, any
+// payload) in any output, routed to an encoder or not, is a model fault; the finite extremes
+// of an output no encoder follows (its largest, smallest, denormal, signed zero) are not.
+TEST(PlantTwinTask, EveryNonFiniteOutputAndNoFiniteOneIsAFault) {
+  using Limits = std::numeric_limits<double>;
+  const double payload_nan = std::bit_cast<double>(std::uint64_t{0x7ff0'0000'0000'0001});
+  const double negative_nan = std::bit_cast<double>(std::uint64_t{0xfff8'0000'0000'0000});
+  for (const std::size_t index : {std::size_t{0}, std::size_t{1}}) {
+    for (const double bad : {Limits::infinity(), -Limits::infinity(), Limits::quiet_NaN(),
+                             Limits::signaling_NaN(), payload_nan, negative_nan}) {
+      Rig rig;
+      rig.plant.nan_at = 2;
+      rig.plant.nan_index = index;
+      rig.plant.nan_value = bad;
+      EXPECT_EQ(rig.Cycle(0).code, runtime::StepStatus::Code::kOk);
+      const runtime::StepStatus status = rig.Cycle(1);
+      EXPECT_EQ(status.code, runtime::StepStatus::Code::kModelFault) << index << " " << bad;
+      EXPECT_THAT(status.reason, ::testing::HasSubstr("non-finite")) << index << " " << bad;
+    }
+  }
+  for (const double fine : {Limits::max(), -Limits::max(), Limits::min(), Limits::denorm_min(),
+                            -Limits::denorm_min(), -0.0, 1e300}) {
+    Rig rig;
+    rig.plant.nan_at = 1;
+    rig.plant.nan_index = 1;  // "v": no encoder follows it, so no count can be out of range
+    rig.plant.nan_value = fine;
+    EXPECT_EQ(rig.Cycle(0).code, runtime::StepStatus::Code::kOk) << fine;
+  }
 }
 
 // The board represents a change of less than half an encoder turn (8192 counts) per period;

@@ -152,11 +152,15 @@ std::vector<Case> Cases() {
       {"k1000/bernoulli 6%", k1000, Bernoulli(0.06, 3 * n, 9)},
       {"k1000/bursts", k1000, Bursts(400, 30, 3 * n, 10)},
       {"k1000/saturating", k1000, Saturating(950, 1000, 3 * n, 2 * n + 17)},
+      // Met runs longer than the longest window put the monitor at rest; the bursts after
+      // them must find the miss bits and met rings as if every cycle had been worked.
+      {"k1000/rests", k1000, Bursts(1500, 40, 4 * n, 16)},
       {"loose/bernoulli 50%", loose, Bernoulli(0.5, n, 11)},
       {"loose/periodic 2", loose, Periodic(2, 1, n)},
       {"words/bernoulli", words, Bernoulli(0.03, n, 12)},
       {"words/saturating 64", words, Saturating(63, 64, n, n - 100)},
       {"words/saturating 128", words, Saturating(120, 128, n, 3 * n / 4)},
+      {"words/rests", words, Bursts(200, 70, n, 17)},
       {"ratio/bernoulli 2%", ratio, Bernoulli(0.02, n, 13)},
       {"ratio/bursts", ratio, Bursts(150, 7, n, 14)},
       {"ratio/all missed", ratio, Sequence(300, true)},

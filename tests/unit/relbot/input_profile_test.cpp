@@ -106,6 +106,34 @@ TEST(InputProfile, EvaluationAllocatesNothing) {
   EXPECT_NE(sum, 0.0);
 }
 
+// A cursor only saves the search: the duty is At(t)'s, bit for bit, whatever the order of
+// the times and whatever the cursor held.
+TEST(InputProfile, ACursorGivesTheSameDutyForwardBackwardAndAtRandom) {
+  const InputProfile profile = OpenLoopProfile();
+  const auto expect_same = [&profile](double t, std::size_t& cursor) {
+    const Duty a = profile.At(t);
+    const Duty b = profile.At(t, cursor);
+    ASSERT_EQ(a.left, b.left) << t;
+    ASSERT_EQ(a.right, b.right) << t;
+  };
+  std::size_t cursor = 0;
+  for (int k = 0; k < 80'000; ++k) expect_same(k * 1e-3, cursor);  // forward over 2 periods
+  for (int k = 80'000; k >= 0; k -= 7) expect_same(k * 1e-3, cursor);  // backward
+  std::uint64_t seed = 12345;
+  for (int k = 0; k < 20'000; ++k) {  // at random, steps and period ends included
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double t = static_cast<double>(seed >> 11) * 0x1p-53 * 100.0 - 1.0;
+    expect_same(k % 5 == 0 ? std::round(t) : t, cursor);
+  }
+  const std::size_t n = profile.knots().size();
+  for (const double t : {1.0, 8.0, 13.0, 34.5, 35.5, 36.0, 72.0, 0.0, -1.0, 1e9}) {
+    for (std::size_t start : {std::size_t{0}, std::size_t{3}, n, n + 1,
+                              std::numeric_limits<std::size_t>::max()}) {
+      expect_same(t, start);
+    }
+  }
+}
+
 TEST(InputProfile, FromKnotsValidates) {
   EXPECT_THROW((void)InputProfile::FromKnots("x", {{0.0, {0.0, 0.0}}}), ProfileError);
   EXPECT_THROW((void)InputProfile::FromKnots("x", {{0.0, {0.0, 0.0}}, {0.0, {0.0, 0.0}}}),

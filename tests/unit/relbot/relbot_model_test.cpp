@@ -219,6 +219,74 @@ TEST(RelbotModel, StateIsFiniteTurnsFalseOnANonFiniteState) {
   EXPECT_FALSE(model.StateIsFinite());
 }
 
+TEST(RelbotModel, StateIsFiniteFindsInfAndNanInEveryStateAndOnlyThere) {
+  RelbotModel model(RelbotParams{}, Integrator::kRk4, kStepS);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kMax = std::numeric_limits<double>::max();
+  // Finite extremes whose sum overflows are still finite, negative zeros too.
+  model.set_state(RelbotState::Constant(kMax));
+  EXPECT_TRUE(model.StateIsFinite());
+  model.set_state(RelbotState::Constant(-kMax));
+  EXPECT_TRUE(model.StateIsFinite());
+  model.set_state(RelbotState::Constant(-0.0));
+  EXPECT_TRUE(model.StateIsFinite());
+  model.set_state(RelbotState::Constant(std::numeric_limits<double>::denorm_min()));
+  EXPECT_TRUE(model.StateIsFinite());
+  for (int i = 0; i < kRelbotStateSize; ++i) {
+    for (const double bad : {kInf, -kInf, std::numeric_limits<double>::quiet_NaN()}) {
+      RelbotState x = RelbotState::Constant(kMax);
+      x[i] = bad;
+      model.set_state(x);
+      EXPECT_FALSE(model.StateIsFinite()) << "state " << i << " = " << bad;
+    }
+  }
+}
+
+// RelbotModel::Step inlines the equations, holds the drive over the step and reuses the
+// heading's cosine and sine while the heading is unchanged: it must step bit for bit as the
+// generic integrators do with RelbotDerivative. Straight driving (the heading stays exactly
+// 0, every stage reuses), turning (a new heading each stage), saturated and NaN duties, a
+// replaced state and a reset.
+TEST(RelbotModel, StepsBitForBitAsTheGenericIntegratorWithTheDerivative) {
+  const RelbotParams params;
+  const RelbotCoefficients c = MakeRelbotCoefficients(params);
+  for (const Integrator method : {Integrator::kEuler, Integrator::kRk2, Integrator::kRk4}) {
+    RelbotModel model(params, method, kStepS);
+    RelbotState x = RelbotState::Zero();
+    const auto step_both = [&](double left, double right) {
+      model.Step(left, right);
+      const double l = SaturateDuty(left);
+      const double r = SaturateDuty(right);
+      const auto f = [&c, l, r](const RelbotState& state, RelbotState& dxdt) noexcept {
+        RelbotDerivative(c, state, l, r, dxdt);
+      };
+      IntegrateStep(method, f, x, kStepS);
+    };
+    constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+    for (int k = 0; k < 4000; ++k) {
+      const double t = k * kStepS;
+      const double left = t < 0.3 ? 0.7 : (t < 0.6 ? 0.8 : -0.4 + 2.0 * std::sin(9.0 * t));
+      const double right = t < 0.3 ? 0.7 : (t < 0.6 ? -0.5 : (k % 977 == 0 ? kNan : 0.3));
+      step_both(left, right);
+      ASSERT_EQ(model.state(), x) << IntegratorName(method) << " step " << k;
+      if (t < 0.3) {
+        ASSERT_EQ(x[s::kHeadingRad], 0.0);  // driving straight
+      }
+    }
+    EXPECT_GT(std::abs(x[s::kHeadingRad]), 0.1);  // it did turn
+    RelbotState moved = x;
+    moved[s::kHeadingRad] = -2.5;  // a heading the model has not met
+    model.set_state(moved);
+    x = moved;
+    for (int k = 0; k < 100; ++k) step_both(0.2, 0.9);
+    EXPECT_EQ(model.state(), x) << IntegratorName(method);
+    model.Reset();
+    x.setZero();
+    for (int k = 0; k < 100; ++k) step_both(0.5, 0.5);
+    EXPECT_EQ(model.state(), x) << IntegratorName(method);
+  }
+}
+
 // Integrates the equations directly (no constructor check) and says whether the state grew
 // without bound within `duration_s` at full duty.
 bool Diverges(Integrator method, double step_s, double duration_s) {

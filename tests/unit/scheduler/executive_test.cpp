@@ -172,6 +172,68 @@ TEST(Executive, CatchUpRunsEveryReleaseLateAndJudgesEachByItsOwnDeadline) {
   EXPECT_EQ(executive.stats().releases_skipped, 0U);
 }
 
+/// A virtual clock that counts the sleeps the executive enters, and those for a release that
+/// had already passed (a system call for nothing on the real clock).
+class SleepCountingClock final : public kernel_glue::Clock {
+ public:
+  [[nodiscard]] TimeNs NowNs() const noexcept override { return inner_.NowNs(); }
+  void SleepUntilNs(TimeNs deadline_ns) noexcept override {
+    ++sleeps;
+    if (deadline_ns < inner_.NowNs()) ++sleeps_for_passed_releases;
+    inner_.SleepUntilNs(deadline_ns);
+  }
+  void SpendNs(TimeNs duration_ns) noexcept override { inner_.SpendNs(duration_ns); }
+  [[nodiscard]] bool IsVirtual() const noexcept override { return true; }
+  int sleeps = 0;
+  int sleeps_for_passed_releases = 0;
+
+ private:
+  VirtualClock inner_;
+};
+
+/// Which cycles slept: the clock's sleep count as each cycle ends.
+class SleepObserver final : public CycleObserver {
+ public:
+  explicit SleepObserver(const SleepCountingClock& clock) : clock_(clock) {}
+  CycleAction OnCycle(const TimingSample& sample) noexcept override {
+    if (clock_.sleeps != seen_) slept.push_back(sample.cycle);
+    seen_ = clock_.sleeps;
+    return CycleAction::kContinue;
+  }
+  std::vector<std::uint64_t> slept;
+
+ private:
+  const SleepCountingClock& clock_;
+  int seen_ = 0;
+};
+
+TEST(Executive, CatchUpCyclesEnterNoSleepFutureReleasesStillDo) {
+  SleepCountingClock clock;
+  Executive executive(clock, Config(kP, 30, OverrunPolicy::kCatchUp));
+  SleepObserver observer(clock);
+  executive.AddObserver(observer);
+  RecordingObserver samples;
+  executive.AddObserver(samples);
+  // A stall of 5.5 periods in cycle 10: it ends after the releases of cycles 11 to 15.
+  InjectedTask task(clock, {{10, 550'000}});
+  EXPECT_EQ(executive.Run(task), StopCause::kCycleLimit);
+  std::vector<std::uint64_t> expected;
+  for (std::uint64_t k = 0; k < 30; ++k) {
+    if (k < 11 || k > 15) expected.push_back(k);
+  }
+  EXPECT_EQ(observer.slept, expected);  // the five catch-up cycles slept not at all
+  EXPECT_EQ(clock.sleeps_for_passed_releases, 0);
+  EXPECT_EQ(clock.sleeps, 25);
+  for (std::uint64_t k = 11; k <= 15; ++k) {  // each started the moment the one before ended
+    EXPECT_EQ(samples.samples[k].wake_ns, samples.samples[k - 1].end_ns) << k;
+    EXPECT_EQ(samples.samples[k].start_ns, samples.samples[k].wake_ns) << k;
+  }
+  EXPECT_EQ(samples.samples[16].wake_ns, samples.samples[16].release_ns);  // slept to it
+  // Wake-up latency still holds only the cycles whose release found the loop asleep.
+  EXPECT_EQ(executive.stats().wake_latency.Summary().count, 25U);
+  EXPECT_EQ(executive.stats().response.Summary().max_ns, 550'000);
+}
+
 TEST(Executive, SkipReanchorsAndCountsSkippedReleasesAsMisses) {
   VirtualClock clock;
   Executive executive(clock, Config(kP, 12, OverrunPolicy::kSkip));
@@ -281,14 +343,12 @@ TEST(Executive, IoTimeIsReportedApartFromComputeTime) {
    public:
     explicit IoTask(kernel_glue::Clock& c) : clock_(c) {}
     CycleAction Step(const CycleContext& ctx) noexcept override {
-      io_ns_ = 12'000 + static_cast<TimeNs>(ctx.cycle);
+      SetIoNsOfLastStep(12'000 + static_cast<TimeNs>(ctx.cycle));
       clock_.SpendNs(30'000);
       return CycleAction::kContinue;
     }
-    TimeNs IoNsOfLastStep() const noexcept override { return io_ns_; }
    private:
     kernel_glue::Clock& clock_;
-    TimeNs io_ns_ = 0;
   };
   VirtualClock clock;
   Executive executive(clock, Config(kP, 5));

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <climits>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -67,6 +69,95 @@ TEST(LogLinearHistogram, HugeAndNegativeValuesAreClampedNotLost) {
   EXPECT_EQ(h.count(), 2U);
   EXPECT_EQ(h.ValueAtQuantile(0.0), 0);
   EXPECT_EQ(h.ValueAtQuantile(1.0), std::int64_t{1} << 50);  // exact max survives
+}
+
+// The bucket index before it became branch-free (issue 36), kept as the reference.
+std::size_t ReferenceBucketIndex(std::int64_t value_ns) {
+  constexpr std::int64_t kSub = std::int64_t{1} << LogLinearHistogram::kSubBucketBits;
+  if (value_ns < 2 * kSub) return value_ns < 0 ? 0 : static_cast<std::size_t>(value_ns);
+  const auto v = static_cast<std::uint64_t>(value_ns);
+  const int shift = 63 - std::countl_zero(v) - LogLinearHistogram::kSubBucketBits;
+  if (shift > LogLinearHistogram::kMaxValueBits - LogLinearHistogram::kSubBucketBits) {
+    return LogLinearHistogram::BucketCount() - 1;
+  }
+  const auto mantissa = static_cast<std::size_t>(v >> shift);
+  return static_cast<std::size_t>(2 * kSub) +
+         static_cast<std::size_t>(shift - 1) * static_cast<std::size_t>(kSub) +
+         (mantissa - static_cast<std::size_t>(kSub));
+}
+
+TEST(LogLinearHistogram, BucketIndexEqualsTheReferenceEverywhere) {
+  for (std::int64_t v = -1000; v < (std::int64_t{1} << 20); ++v) {
+    ASSERT_EQ(LogLinearHistogram::BucketIndex(v), ReferenceBucketIndex(v)) << v;
+  }
+  for (int bit = 20; bit < 63; ++bit) {  // every power of two and its neighbours
+    const std::int64_t p = std::int64_t{1} << bit;
+    for (const std::int64_t v : {p - 1, p, p + 1, p + p / 3}) {
+      ASSERT_EQ(LogLinearHistogram::BucketIndex(v), ReferenceBucketIndex(v)) << v;
+    }
+  }
+  std::mt19937_64 rng(36);
+  for (int i = 0; i < 1'000'000; ++i) {
+    const auto v = static_cast<std::int64_t>(rng() >> (rng() % 64));
+    ASSERT_EQ(LogLinearHistogram::BucketIndex(v), ReferenceBucketIndex(v)) << v;
+  }
+  EXPECT_EQ(LogLinearHistogram::BucketIndex(INT64_MIN), 0U);
+  EXPECT_EQ(LogLinearHistogram::BucketIndex(INT64_MAX), LogLinearHistogram::BucketCount() - 1);
+}
+
+TEST(TimingStats, EmptyAndResetReadAsZeroWhateverWasRecorded) {
+  TimingStats s;
+  EXPECT_EQ(s.max_ns(), 0);
+  EXPECT_EQ(s.count(), 0U);
+  s.Record(-7);  // a single negative value is both extremes
+  EXPECT_EQ(s.Summary().min_ns, -7);
+  EXPECT_EQ(s.Summary().max_ns, -7);
+  EXPECT_EQ(s.max_ns(), -7);
+  EXPECT_EQ(s.Summary().p50_ns, 7);
+  s.Reset();
+  EXPECT_EQ(s.max_ns(), 0);
+  const TimingSummary empty = s.Summary();
+  EXPECT_EQ(empty.count, 0U);
+  EXPECT_EQ(empty.min_ns, 0);
+  EXPECT_EQ(empty.max_ns, 0);
+  s.Record(5);
+  EXPECT_EQ(s.Summary().min_ns, 5);  // not the sentinels of the empty statistics
+  EXPECT_EQ(s.Summary().max_ns, 5);
+  EXPECT_EQ(s.Summary().p999_ns, 5);
+}
+
+TEST(TimingStats, RunsOfEqualValuesCountLikeAnyOther) {
+  // Runs of repeated values (the cheap path) mixed with changes, signed, against a histogram
+  // fed every |value| and the exact figures.
+  std::mt19937_64 rng(11);
+  TimingStats s;
+  LogLinearHistogram reference;
+  std::int64_t lo = INT64_MAX, hi = INT64_MIN, sum = 0;
+  std::int64_t v = 0;
+  for (int i = 0; i < 200'000; ++i) {
+    if (rng() % 4 == 0) v = static_cast<std::int64_t>(rng() % 2'000'001) - 1'000'000;
+    s.Record(v);
+    reference.Record(v < 0 ? -v : v);
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    sum += v;
+  }
+  const TimingSummary got = s.Summary();
+  EXPECT_EQ(got.count, 200'000U);
+  EXPECT_EQ(got.min_ns, lo);
+  EXPECT_EQ(got.max_ns, hi);
+  EXPECT_DOUBLE_EQ(got.mean_ns, static_cast<double>(sum) / 200'000.0);
+  for (const double q : {0.0, 0.5, 0.99, 0.999, 1.0}) {
+    EXPECT_EQ(s.histogram().ValueAtQuantile(q), reference.ValueAtQuantile(q)) << q;
+  }
+  for (std::size_t i = 0; i < LogLinearHistogram::BucketCount(); ++i) {
+    ASSERT_EQ(s.histogram().CountAt(i), reference.CountAt(i)) << i;
+  }
+  s.Reset();  // a value equal to the last before the reset is a first value again
+  s.Record(v);
+  EXPECT_EQ(s.Summary().count, 1U);
+  EXPECT_EQ(s.Summary().min_ns, v);
+  EXPECT_EQ(s.Summary().max_ns, v);
 }
 
 TEST(TimingStats, ExactMinMeanMaxAndSignedJitter) {

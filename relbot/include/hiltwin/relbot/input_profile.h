@@ -5,6 +5,7 @@
 /// repeats with its period. Sampling and holding the signal (as a PWM does) is the job of
 /// whoever plays it (the ECS side at its own rate), not of the profile.
 
+#include <cstddef>
 #include <filesystem>
 #include <span>
 #include <stdexcept>
@@ -43,6 +44,11 @@ class InputProfile {
   /// Duty at t_s. The profile repeats with period_s(); before the first knot of a repetition
   /// the first knot's duty holds; at a step the later value applies. Non-finite t_s gives 0.
   [[nodiscard]] Duty At(double t_s) const noexcept;
+  /// The same duty, bit for bit, found from `cursor`: the caller's hint where the last lookup
+  /// ended (start it at 0; any value is safe). A player reading the profile forward in time
+  /// finds its segment in one or two comparisons instead of a search from the start each time;
+  /// a jump (back, into another repetition, far ahead) falls back to the search.
+  [[nodiscard]] Duty At(double t_s, std::size_t& cursor) const noexcept;
   /// Length of one repetition: the last knot's time.
   [[nodiscard]] double period_s() const noexcept { return knots_.back().time_s; }
   /// Built-in name or the file the profile came from (for messages and reports).
@@ -53,6 +59,10 @@ class InputProfile {
  private:
   InputProfile(std::string name, std::vector<ProfileKnot> knots)
       : name_(std::move(name)), knots_(std::move(knots)) {}
+  /// Index of the first knot strictly after local_s (upper bound), tried at `hint` and the
+  /// segment after it before searching.
+  [[nodiscard]] std::size_t KnotAfter(double local_s, std::size_t hint) const noexcept;
+  [[nodiscard]] bool IsKnotAfter(double local_s, std::size_t index) const noexcept;
   std::string name_;
   std::vector<ProfileKnot> knots_;
 };

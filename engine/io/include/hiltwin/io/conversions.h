@@ -4,6 +4,7 @@
 /// position, and the PWM reader's quantisation. All noexcept and allocation-free.
 
 #include <cstdint>
+#include <cmath>
 
 #include "hiltwin/io/frame.h"
 
@@ -25,15 +26,38 @@ constexpr std::int32_t kPwmPeriodClocks = 4096;
 /// [-2048, 2047]. NaN maps to 0 so a broken model output cannot drive the motor.
 [[nodiscard]] std::int32_t DutyToPwm(double duty) noexcept;
 /// PWM value to duty: value / 2048 (appendix G, `channel / PWM_RESOLUTION`).
-[[nodiscard]] double PwmToDuty(std::int32_t pwm_value) noexcept;
+/// The per-cycle conversions are inline: the drivers and the board call them per channel.
+[[nodiscard]] inline double PwmToDuty(std::int32_t pwm_value) noexcept {
+  return static_cast<double>(pwm_value) / kPwmResolution;
+}
 /// Signed PWM value <-> frame word (magnitude + direction bit).
-[[nodiscard]] PwmWord PwmWordFromValue(std::int32_t pwm_value, bool pin = false) noexcept;
-[[nodiscard]] std::int32_t PwmValueFromWord(const PwmWord& word) noexcept;
+[[nodiscard]] inline PwmWord PwmWordFromValue(std::int32_t pwm_value, bool pin = false) noexcept {
+  std::int32_t magnitude = pwm_value < 0 ? -pwm_value : pwm_value;
+  if (magnitude > kPwmMagnitudeMax) magnitude = kPwmMagnitudeMax;
+  return PwmWord{static_cast<std::uint16_t>(magnitude), pwm_value < 0, pin};
+}
+[[nodiscard]] inline std::int32_t PwmValueFromWord(const PwmWord& word) noexcept {
+  const auto magnitude = static_cast<std::int32_t>(word.magnitude);
+  return word.negative ? -magnitude : magnitude;
+}
 
 /// What the twin's PWM reader measures for an input of `duty` (thesis §2.2.2): the high time in
 /// clocks of a 4096-clock period, halved into an 11-bit value (so 2048 saturates at 2047), with
 /// the sign from the direction pin.
-[[nodiscard]] std::int32_t PwmReaderValue(double duty) noexcept;
+[[nodiscard]] inline std::int32_t PwmReaderValue(double duty) noexcept {
+  if (std::isnan(duty)) return 0;
+  double magnitude = std::fabs(duty);
+  if (magnitude > 1.0) magnitude = 1.0;
+  // High time in whole clocks of the 12-bit period counter, rounded to nearest even as
+  // std::nearbyint does in the default rounding mode: for 0 <= x <= 4096, x + 2^52 has no
+  // fraction bits left, so the addition rounds x exactly so (without the libm call).
+  constexpr double kRound = 4503599627370496.0;  // 2^52
+  const double high = (magnitude * kPwmPeriodClocks + kRound) - kRound;
+  const auto high_clocks = static_cast<std::int32_t>(high);
+  std::int32_t value = high_clocks / 2;
+  if (value > 2047) value = 2047;  // 11-bit register
+  return duty < 0.0 ? -value : value;
+}
 
 /// Wheel geometry for metres <-> counts: counts = metres · N · CPR / (2π · r). metres / r is
 /// wheel radians; the motor turns N times per wheel turn, so motor radians = wheel radians · N;
@@ -54,8 +78,18 @@ constexpr double kMaxAbsCounts = 4.611686018427387904e18;  // 2^62
 
 /// A plant output to absolute encoder counts: floor(value · counts_per_unit), the one rule
 /// every encoder channel uses (plant maps, plant/plant_map.h). Non-finite results give 0;
-/// results are clamped to ±kMaxAbsCounts.
-[[nodiscard]] std::int64_t ValueToCounts(double value, double counts_per_unit) noexcept;
+/// results are clamped to ±kMaxAbsCounts. Inline: the twin's task calls it per channel and
+/// cycle.
+[[nodiscard]] inline std::int64_t ValueToCounts(double value, double counts_per_unit) noexcept {
+  const double counts = value * counts_per_unit;
+  if (!std::isfinite(counts)) return 0;
+  if (counts >= kMaxAbsCounts) return static_cast<std::int64_t>(kMaxAbsCounts);
+  if (counts <= -kMaxAbsCounts) return -static_cast<std::int64_t>(kMaxAbsCounts);
+  // std::floor without the libm call: |counts| < 2^62, so the truncation is exact as an
+  // integer and as a double; one less when it rounded a negative fraction up.
+  const auto truncated = static_cast<std::int64_t>(counts);
+  return counts < static_cast<double>(truncated) ? truncated - 1 : truncated;
+}
 
 /// Wheel travel in metres to absolute encoder counts, floored: appendix G truncates towards
 /// zero, which makes the count around zero two counts wide; flooring keeps every count equal.
@@ -68,7 +102,16 @@ constexpr double kMaxAbsCounts = 4.611686018427387904e18;  // 2^62
 /// `calc_value`, without its loops, and for any resolution that is a positive even number;
 /// a resolution below 2 gives 0).
 [[nodiscard]] std::int32_t WrapToRelative(std::int64_t absolute_counts,
-                                          std::int32_t resolution = kEncoderResolution) noexcept;
+                                          std::int32_t resolution) noexcept;
+/// WrapToRelative for the encoders' 14 bits, inline (every channel of every cycle): a mask;
+/// unsigned arithmetic wraps by definition, so no input can overflow.
+[[nodiscard]] inline std::int32_t WrapToRelative(std::int64_t absolute_counts) noexcept {
+  constexpr std::int64_t kHalf = kEncoderResolution / 2;
+  constexpr auto kMask = static_cast<std::uint64_t>(kEncoderResolution) - 1U;
+  const std::uint64_t shifted =
+      (static_cast<std::uint64_t>(absolute_counts) + static_cast<std::uint64_t>(kHalf)) & kMask;
+  return static_cast<std::int32_t>(static_cast<std::int64_t>(shifted) - kHalf);
+}
 
 /// Rebuilds an absolute position from successive relative readings, assuming the position moved
 /// less than half a turn between two readings (the same assumption the encoder emulator makes).

@@ -76,7 +76,10 @@ class EmulatedFpga final : public SpiDevice {
   /// Twin image: where the emulator's periods go (not owned; null = nowhere).
   void SetEncoderSink(EncoderLineSink* sink) noexcept { encoder_sink_ = sink; }
   /// Levels of the digital input pins (the other side's digital outputs).
-  void SetDigitalInputs(const std::array<bool, kChannels>& pins) noexcept { pins_in_ = pins; }
+  void SetDigitalInputs(const std::array<bool, kChannels>& pins) noexcept {
+    pins_in_ = pins;
+    pwm_memo_valid_ = false;  // the twin's answer words carry them
+  }
   /// Fault-injection hooks, changed between transfers.
   [[nodiscard]] FaultInjection& faults() noexcept { return faults_; }
 
@@ -111,12 +114,24 @@ class EmulatedFpga final : public SpiDevice {
  private:
   void HandleRequest(const Frame& request, Frame& answer) noexcept;
   void HandleInit(const Frame& request, Frame& answer) noexcept;
-  void HandleAll(const Frame& request, Frame& answer) noexcept;
+  /// An ALL frame's sampling moment: takes the request's channel words, returns the answer's.
+  ChannelWords HandleAll(ChannelWords request_words) noexcept;
+  ChannelWords SampleTwin(ChannelWords encoder_words, std::int64_t t_ns) noexcept;
+  /// Twin image: the PWM reader on duty_scratch_: pwm_values_ and pwm_words_.
+  void MeasurePwm() noexcept;
+  ChannelWords SampleEcs(ChannelWords pwm_words, std::int64_t t_ns) noexcept;
   void FillReadback(Opcode opcode, Frame& answer) const noexcept;
   /// Shifts out the answer register, applying the answer faults to answers of non-NOOPs.
   void SendAnswer(FrameBytes& miso) noexcept;
   /// Decodes the request (after the request faults) and acts on it: the new answer register.
   void TakeRequest(const FrameBytes& mosi) noexcept;
+  void ActOn(const FrameBytes& request_bytes) noexcept;
+  /// ALL, the per-cycle request, decoded and answered word-wide.
+  void TakeAll(const FrameBytes& request_bytes) noexcept;
+  /// The answer to a request that failed its checks.
+  void Reject(const FrameBytes& request_bytes) noexcept;
+  /// `status` with INITIALISED and PULSE_LIMIT as the board stands.
+  [[nodiscard]] std::uint8_t WithStateBits(std::uint8_t status) const noexcept;
   void ResetState() noexcept;
   /// Twin image: hands the periods just started to the sink.
   void PublishPeriod() noexcept;
@@ -145,6 +160,11 @@ class EmulatedFpga final : public SpiDevice {
   std::array<bool, kChannels> pins_in_{};
   std::array<bool, kChannels> pins_out_{};
   std::array<double, kChannels> duty_scratch_{};
+  /// Twin image: the bits of the duties pwm_values_ and pwm_words_ were measured from, with
+  /// pins_in_ as they stand while pwm_memo_valid_ (exact memoisation, SampleTwin).
+  std::array<std::uint64_t, kChannels> duty_bits_{};
+  ChannelWords pwm_words_ = 0;
+  bool pwm_memo_valid_ = false;
   FrameBytes answer_register_{};      ///< answer to the latest request; zeros at power-up
   bool answer_register_data_ = false;  ///< it answers a request whose opcode byte is not NOOP
   FrameBytes previous_miso_{};         ///< what the latest transfer shifted out
@@ -157,6 +177,13 @@ class EmulatedSpiBus final : public SpiBus {
       : device_(device), name_(name) {}
   BusStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept override {
     device_.Exchange(mosi, miso);
+    return {};
+  }
+  /// Both transfers straight to the device (an emulated transfer cannot fail).
+  BusStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                         const FrameBytes& fetch, FrameBytes& answer) noexcept override {
+    device_.Exchange(request, request_miso);
+    device_.Exchange(fetch, answer);
     return {};
   }
   [[nodiscard]] const char* Name() const noexcept override { return name_; }

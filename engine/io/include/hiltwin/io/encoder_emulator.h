@@ -93,7 +93,20 @@ class EncoderEmulator {
   /// `target_counts` (relative) and spreads them over [t_ns, t_ns + step). Returns false when the
   /// change needs more pulses than MaxPulsesPerPeriod (emitted at the limit, rest carried over):
   /// a change of exactly half a turn (8192) included, whatever S.
-  bool StartPeriod(std::int32_t target_counts, std::int64_t t_ns) noexcept;
+  bool StartPeriod(std::int32_t target_counts, std::int64_t t_ns) noexcept {
+    // The usual case, inline: the period is over and the target is where it ended. What the
+    // plan below gives for it, exactly: a period of no pulses from there (Table 4.1's no change).
+    if (!stuck_ && t_ns - segment_.start_ns >= period_ns_ &&
+        WrapToRelative(target_counts) == end_counts_) {
+      segment_.start_counts = end_counts_;
+      segment_.start_ns = t_ns;
+      segment_.pulses = 0;
+      segment_.direction = 0;
+      last_case_ = DifferenceCase::kNone;
+      return true;
+    }
+    return PlanPeriod(target_counts, t_ns);
+  }
   /// While stuck, StartPeriod emits nothing (fault injection: a frozen encoder line).
   void SetStuck(bool stuck) noexcept { stuck_ = stuck; }
 
@@ -107,7 +120,18 @@ class EncoderEmulator {
   [[nodiscard]] std::int64_t step_ns() const noexcept { return step_ns_; }
 
  private:
+  /// StartPeriod's general case: Table 4.1 from the position reached at `t_ns`.
+  bool PlanPeriod(std::int32_t target_counts, std::int64_t t_ns) noexcept;
+  /// The segment's position once its period is over, and the period's length: StartPeriod's
+  /// usual case (the sampling moment after the whole period) without EdgesBy.
+  [[nodiscard]] std::int32_t ReachedAt(std::int64_t t_ns) const noexcept {
+    return t_ns - segment_.start_ns >= period_ns_ ? end_counts_ : segment_.PositionAt(t_ns);
+  }
+
   PulseSegment segment_{};
+  std::int32_t end_counts_ = 0;  ///< segment_.PositionAt(any time after the period)
+  std::int64_t period_ns_ =      ///< divider · 10 ns · subticks of segment_
+      std::int64_t{kMinClockDivider} * kNsPerFpgaClock;
   DifferenceCase last_case_ = DifferenceCase::kNone;
   std::uint64_t limit_events_ = 0;
   std::int64_t step_ns_ = 0;

@@ -162,10 +162,82 @@ enum class FrameError : std::uint8_t {
 [[nodiscard]] FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
                                 Frame& out) noexcept;
 
-/// Packs/unpacks channel words (exposed for the board model and tests).
-[[nodiscard]] std::uint16_t PackPwm(const PwmWord& word) noexcept;
-[[nodiscard]] std::uint16_t PackEnc(const EncWord& word) noexcept;
-[[nodiscard]] PwmWord UnpackPwm(std::uint16_t bits) noexcept;
-[[nodiscard]] EncWord UnpackEnc(std::uint16_t bits) noexcept;
+/// Encode() of the NOOP frame numbered `sequence` with status byte `status` (0 in requests;
+/// kStatusMask bits only), from the CRC tables directly: the driver's fetch and the board's
+/// answer to it, in every exchange. Cannot fail.
+void EncodeNoop(std::uint8_t sequence, std::uint8_t status, FrameBytes& out) noexcept;
+/// True exactly when Decode(in, Direction::kRequest, any image) accepts `in` as a NOOP: the
+/// bytes EncodeNoop(in[1], 0) writes.
+[[nodiscard]] bool IsNoopRequest(const FrameBytes& in) noexcept;
+
+/// The four channel words of a frame (the PackPwm/PackEnc bits) as one value in wire order:
+/// channel c's word in bits 63-16c..48-16c, so bytes 2..9 of the frame are its big-endian bytes.
+/// Word-wide packing for the per-cycle ALL frames.
+using ChannelWords = std::uint64_t;
+[[nodiscard]] constexpr std::uint16_t ChannelWord(ChannelWords words, std::size_t c) noexcept {
+  return static_cast<std::uint16_t>((words >> (48U - 16U * (c & 3U))) & 0xFFFFU);
+}
+/// `word` as channel c's word (OR the four together).
+[[nodiscard]] constexpr ChannelWords PlaceChannelWord(std::size_t c, std::uint16_t word) noexcept {
+  return ChannelWords{word} << (48U - 16U * (c & 3U));
+}
+
+/// An ALL frame (the per-cycle opcode) without a Frame in between: what its bytes 1..10 hold.
+struct AllFrame {
+  std::uint8_t sequence = 0;
+  std::uint8_t status = 0;  ///< kStatus* bits in answers, 0 in requests
+  ChannelWords words = 0;   ///< PWM or encoder words, as PayloadOf(kAll, ...) says
+  friend bool operator==(const AllFrame&, const AllFrame&) = default;
+};
+
+/// Encode() of the ALL frame `frame`: the same bytes and the same checks as for a Frame with
+/// opcode kAll and these words (a word Decode would refuse is refused: kOutOfRange for a PWM
+/// magnitude above 2048, kReservedBits for an encoder word with bit 15 set).
+[[nodiscard]] FrameError EncodeAll(const AllFrame& frame, Direction direction, Image host_image,
+                                   FrameBytes& out) noexcept;
+/// Decode() of an ALL frame: the same checks and errors; `out` untouched on any error. A valid
+/// frame of another opcode gives kOpcode: call Decode for frames whose byte 0 is not kAll.
+[[nodiscard]] FrameError DecodeAll(const FrameBytes& in, Direction direction, Image host_image,
+                                   AllFrame& out) noexcept;
+
+/// Channel word bits: PWM direction (1 = negative) or encoder reserved bit, digital pin, value.
+constexpr std::uint16_t kWordBit15 = 0x8000;
+constexpr std::uint16_t kWordPinBit = 0x4000;
+constexpr std::uint16_t kWordValueMask = 0x3FFF;
+
+/// A channel word's fields one by one, as UnpackPwm/UnpackEnc give them, without building the
+/// struct (the per-cycle loops): the digital pin; the signed PWM value (PwmValueFromWord of
+/// UnpackPwm); the encoder counts, the 14-bit field sign-extended (its bit 13 moved to bit 15,
+/// then shifted back arithmetically).
+[[nodiscard]] constexpr bool WordPin(std::uint16_t bits) noexcept {
+  return (bits & kWordPinBit) != 0;
+}
+[[nodiscard]] constexpr std::int32_t PwmValueOfWord(std::uint16_t bits) noexcept {
+  const std::int32_t magnitude = bits & kWordValueMask;
+  return (bits & kWordBit15) != 0 ? -magnitude : magnitude;
+}
+[[nodiscard]] constexpr std::int16_t EncCountsOfWord(std::uint16_t bits) noexcept {
+  const auto high = static_cast<std::int16_t>(static_cast<std::uint16_t>(bits << 2U));
+  return static_cast<std::int16_t>(high >> 2);
+}
+
+/// Packs/unpacks channel words (exposed for the board model and tests); inline, as the drivers
+/// and the board pack four of them per cycle.
+[[nodiscard]] inline std::uint16_t PackPwm(const PwmWord& word) noexcept {
+  return static_cast<std::uint16_t>((word.negative ? kWordBit15 : 0U) |
+                                    (word.pin ? kWordPinBit : 0U) |
+                                    (word.magnitude & kWordValueMask));
+}
+[[nodiscard]] inline std::uint16_t PackEnc(const EncWord& word) noexcept {
+  return static_cast<std::uint16_t>((word.pin ? kWordPinBit : 0U) |
+                                    (static_cast<std::uint16_t>(word.counts) & kWordValueMask));
+}
+[[nodiscard]] inline PwmWord UnpackPwm(std::uint16_t bits) noexcept {
+  return PwmWord{static_cast<std::uint16_t>(bits & kWordValueMask), (bits & kWordBit15) != 0,
+                 (bits & kWordPinBit) != 0};
+}
+[[nodiscard]] inline EncWord UnpackEnc(std::uint16_t bits) noexcept {
+  return EncWord{EncCountsOfWord(bits), WordPin(bits)};
+}
 
 }  // namespace hiltwin::io

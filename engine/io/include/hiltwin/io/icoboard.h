@@ -93,17 +93,35 @@ class IcoBoardLink {
   /// Judges rx_ (the fetch's MISO) as the answer to `request`, decoded into `answer`: kOk, or
   /// the code and reason of the first check it fails, with that counter incremented.
   ExchangeStatus CheckAnswer(const Frame& request, Frame& answer) noexcept;
+  /// Transact() of an ALL frame carrying `words`, word-wide (the per-cycle exchange).
+  ExchangeStatus TransactAll(ChannelWords words, AllFrame& answer) noexcept;
 
   TimedSpi spi_;
   Image image_;
   bool initialised_ = false;
   std::int64_t step_ns_ = 0;
   std::uint32_t clock_divider_ = 0;
+  std::int64_t counts_limit_ = 0;  ///< MaxCountsPerStep(step_ns_, clock_divider_)
   std::uint8_t sequence_ = 0;
   LinkCounters counters_{};
   std::array<bool, kChannels> pins_out_{};
   std::array<std::int64_t, kChannels> last_counts_{};         ///< twin: last positions the board acknowledged
   std::array<EncoderUnwrapper, kChannels> unwrappers_{};      ///< ECS: relative -> absolute
+
+ private:
+  /// Numbers and encodes the NOOP fetch into fetch_tx_ (a NOOP always encodes: true).
+  bool EncodeFetch() noexcept;
+  ExchangeStatus EncodeFault() noexcept;
+  /// The request in tx_ and its fetch, one bus transaction; `check` judges rx_ as the answer.
+  template <typename Check>
+  ExchangeStatus TransferAndCheck(Opcode opcode, Check&& check) noexcept;
+  /// CheckAnswer() of the answer to an ALL request numbered `sequence`.
+  ExchangeStatus CheckAllAnswer(std::uint8_t sequence, AllFrame& answer) noexcept;
+  /// The checks after decoding, in their order: decoded, not rejected, same sequence, same
+  /// opcode, INITIALISED for a data frame.
+  ExchangeStatus Judge(FrameError error, std::uint8_t answer_status, bool same_sequence,
+                       bool same_opcode, bool data) noexcept;
+
   Frame request_{};
   Frame answer_{};
   FrameBytes tx_{};

@@ -72,7 +72,12 @@ struct TransferTiming {
   kernel_glue::TimeNs max_ns = 0;
 };
 
-/// Non-virtual wrapper: times each transfer with `clock` (the monotonic clock when null).
+/// TimedSpi's clock for a driver whose transfer times nobody reads (the twin's loop: the
+/// executive times its whole I/O step): no clock is read, transfers are counted with duration 0.
+[[nodiscard]] const kernel_glue::Clock* UntimedTransfers() noexcept;
+
+/// Non-virtual wrapper: times each transfer with `clock` (the monotonic clock when null; none
+/// for UntimedTransfers()).
 class TimedSpi {
  public:
   explicit TimedSpi(SpiBus& bus, const kernel_glue::Clock* clock = nullptr) noexcept;
@@ -81,7 +86,17 @@ class TimedSpi {
   TransferStatus Transfer(const FrameBytes& mosi, FrameBytes& miso) noexcept;
   /// SpiBus::TransferPair, timed and counted as one transfer (an exchange).
   TransferStatus TransferPair(const FrameBytes& request, FrameBytes& request_miso,
-                              const FrameBytes& fetch, FrameBytes& answer) noexcept;
+                              const FrameBytes& fetch, FrameBytes& answer) noexcept {
+    if (timed_) return TimedTransferPair(request, request_miso, fetch, answer);
+    // Untimed, inline (the twin's exchange on every cycle): what Record adds for a duration of
+    // 0 is the count alone.
+    const BusStatus bus_status = bus_.TransferPair(request, request_miso, fetch, answer);
+    ++timing_.transfers;
+    TransferStatus status;
+    status.result = bus_status.result;
+    status.reason = bus_status.reason;
+    return status;
+  }
   [[nodiscard]] const TransferTiming& timing() const noexcept { return timing_; }
   [[nodiscard]] SpiBus& bus() noexcept { return bus_; }
   [[nodiscard]] const SpiBus& bus() const noexcept { return bus_; }
@@ -89,7 +104,10 @@ class TimedSpi {
  private:
   SpiBus& bus_;
   const kernel_glue::Clock* clock_;
+  bool timed_;  ///< false for UntimedTransfers(): two clock reads per exchange saved
   kernel_glue::MonotonicClock monotonic_;
+  TransferStatus TimedTransferPair(const FrameBytes& request, FrameBytes& request_miso,
+                                   const FrameBytes& fetch, FrameBytes& answer) noexcept;
   /// Adds one transfer (or pair) that began at `start_ns` to the timing statistics.
   TransferStatus Record(kernel_glue::TimeNs start_ns, const BusStatus& bus_status) noexcept;
 

@@ -91,7 +91,18 @@ class QosMonitor {
   /// included as misses). Returns true when the caller must stop now: policy abort and a rule
   /// has been violated (this cycle or earlier). Releases with index < grace_cycles are counted
   /// apart and judged by no rule.
-  [[nodiscard]] bool Record(std::uint64_t cycle, bool missed) noexcept;
+  [[nodiscard]] bool Record(std::uint64_t cycle, bool missed) noexcept {
+    // At rest (see quiet_) a met cycle moves only the counts of cycles: every rule's figure,
+    // the distance and the verdict are what they were. Cycles come in increasing order, so a
+    // monitor at rest is past the grace period.
+    if (quiet_ && !missed) [[likely]] {
+      ++judged_cycles_;
+      live_releases_.store(releases_recorded(), std::memory_order_relaxed);
+      live_cycles_.store(judged_cycles_, std::memory_order_relaxed);
+      return aborted_;
+    }
+    return RecordInFull(cycle, missed);
+  }
 
   /// PASS, FLAGGED or ABORTED for the cycles recorded so far (final once recording stops).
   [[nodiscard]] Verdict verdict() const noexcept;
@@ -141,6 +152,12 @@ class QosMonitor {
     std::uint64_t miss_budget = 0;  // ratio: fewest misses that fail it over the plan (0: none)
   };
 
+  /// Record() of a cycle that may change a figure: a miss, or any cycle while not at rest.
+  [[nodiscard]] bool RecordInFull(std::uint64_t cycle, bool missed) noexcept;
+  /// Whether the figures are at rest after this judged cycle (quiet_).
+  [[nodiscard]] bool AtRest() const noexcept;
+  /// Puts back what cycles at rest did not write: the miss bits and the window rules' rings.
+  void LeaveRest() noexcept;
   [[nodiscard]] bool Bit(std::uint64_t index) const noexcept;
   void SetBit(std::uint64_t index, bool value) noexcept;
   void MarkViolation(std::size_t rule, std::uint64_t cycle) noexcept;
@@ -149,6 +166,11 @@ class QosMonitor {
   void UpdateRatioRule(const Engine& engine, RuleStatus& status, std::size_t rule,
                        std::uint64_t cycle) noexcept;
   [[nodiscard]] std::uint32_t RatioDistance(const Engine& engine) const noexcept;
+  /// The ratio rule's distance under a plan: the misses its budget has left.
+  [[nodiscard]] std::uint32_t BudgetDistance(const Engine& engine) const noexcept {
+    const std::uint64_t left = engine.miss_budget > misses_ ? engine.miss_budget - misses_ : 0;
+    return left >= kNeverFails ? kNeverFails : static_cast<std::uint32_t>(left);
+  }
 
   QosConfig config_;
   std::vector<RuleStatus> status_;
@@ -165,6 +187,15 @@ class QosMonitor {
   std::uint64_t grace_misses_ = 0;
   std::uint64_t judged_plan_ = 0;  // planned_cycles - grace_cycles (0: no plan)
   bool aborted_ = false;
+  // At rest: the last rest_after_ judged cycles met (the longest window, at least 1) and every
+  // ratio rule holds under a plan. A met cycle then changes no rule's figure: windows hold no
+  // miss and their distance is k - m + 1, a consecutive rule's run is 0, a holding planned
+  // ratio keeps its budget. Such cycles skip the rules and write neither the miss bits nor the
+  // met rings; LeaveRest rebuilds both, as the last rest_after_ cycles all met.
+  bool quiet_ = false;
+  bool unplanned_ratio_ = false;  // a ratio rule without a plan: its distance moves every cycle
+  std::uint64_t met_run_ = 0;     // current run of consecutive judged met cycles
+  std::uint64_t rest_after_ = 1;
   std::optional<std::uint64_t> abort_cycle_;
   std::optional<std::size_t> abort_rule_;
 

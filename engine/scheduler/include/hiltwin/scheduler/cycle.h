@@ -13,8 +13,8 @@ using kernel_glue::TimeNs;
 struct TimingSample {
   std::uint64_t cycle = 0;        ///< release index k (release = t0 + k·period)
   TimeNs release_ns = 0;          ///< when the cycle should have started
-  TimeNs wake_ns = 0;             ///< when the sleep returned
-  TimeNs start_ns = 0;            ///< when the step began
+  TimeNs wake_ns = 0;             ///< when the sleep returned (catch-up: when it was skipped)
+  TimeNs start_ns = 0;            ///< when the step began: the same clock reading as wake_ns
   TimeNs end_ns = 0;              ///< when the step (and its I/O) ended
   TimeNs io_ns = 0;               ///< of end - start, the time the step spent in I/O
   std::uint32_t releases_skipped = 0;  ///< releases after this one dropped by kSkip (each a miss)
@@ -40,8 +40,16 @@ class CyclicTask {
   virtual ~CyclicTask() = default;
   virtual CycleAction Step(const CycleContext& context) noexcept = 0;
   /// How much of the last Step() was I/O (bus transfers), so that compute time and I/O time
-  /// are reported apart. Tasks without I/O keep the default.
-  [[nodiscard]] virtual TimeNs IoNsOfLastStep() const noexcept { return 0; }
+  /// are reported apart. Tasks without I/O leave it 0. Not virtual: the executive reads it
+  /// every cycle, and a field costs no call.
+  [[nodiscard]] TimeNs IoNsOfLastStep() const noexcept { return io_ns_of_last_step_; }
+
+ protected:
+  /// A task with I/O sets its I/O time here during Step().
+  void SetIoNsOfLastStep(TimeNs io_ns) noexcept { io_ns_of_last_step_ = io_ns; }
+
+ private:
+  TimeNs io_ns_of_last_step_ = 0;
 };
 
 /// Receives every cycle's timing right after the cycle (QoS, tracing, logging). One virtual

@@ -93,7 +93,7 @@ class Executive {
   [[nodiscard]] std::vector<TimingSample> RecentSamples() const;
 
  private:
-  void Account(TimingSample& sample, bool has_previous_start, TimeNs previous_start_ns,
+  void Account(const TimingSample& sample, bool has_previous_start, TimeNs previous_start_ns,
                bool loop_was_idle) noexcept;
 
   kernel_glue::Clock& clock_;

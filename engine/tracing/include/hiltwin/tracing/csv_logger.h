@@ -34,6 +34,9 @@
 #include "hiltwin/lockfree/spsc_ring.h"
 
 namespace hiltwin::tracing {
+namespace detail {
+struct CellMemo;
+}  // namespace detail
 
 /// The log's file cannot be written at all (its header failed: a full disk, an I/O error):
 /// the disk's problem, not the path's.
@@ -133,7 +136,8 @@ class CsvLogger {
   // Producer side. Counters are written by the producer only (plain load+store, no RMW) and
   // read by anyone.
   lockfree::SpscRing ring_;
-  std::unique_ptr<double[]> rows_;
+  std::unique_ptr<double[]> row_storage_;
+  double* rows_;  ///< row_storage_ from its first cache-line boundary
   std::uint32_t decimation_countdown_ = 0;
   std::atomic<std::uint64_t> offered_{0};
   std::atomic<std::uint64_t> producer_dropped_{0};
@@ -144,6 +148,7 @@ class CsvLogger {
   // the logger knows which rows reached the file (stdio would accept a row into its buffer
   // and fail later, in fflush, for rows already counted).
   int fd_ = -1;
+  std::unique_ptr<detail::CellMemo[]> cell_memos_;  ///< each column's last text
   std::unique_ptr<char[]> file_buffer_;
   std::size_t buffered_bytes_ = 0;       ///< formatted, not yet written
   std::uint64_t buffered_rows_ = 0;      ///< whole rows in those bytes
