@@ -26,9 +26,13 @@ Duty FromScratch(const InputProfile& profile, double controller_hz, double twin_
 // start (a board re-initialised) and at random times.
 TEST(ProfilePwmSource, PlaysTheControllersSamplesBitForBitInAnyOrder) {
   const InputProfile profile = OpenLoopProfile();
-  for (const auto& [controller_hz, twin_hz] :
+  for (const auto& rates_hz :
        {std::pair{1000.0, 4000.0}, std::pair{1000.0, 7000.0}, std::pair{250.0, 4000.0},
         std::pair{4000.0, 4000.0}}) {
+    // Named copies, not a structured binding: the lambdas below capture them (C++20 allows
+    // capturing a binding; clang-tidy's clang 14 does not).
+    const double controller_hz = rates_hz.first;
+    const double twin_hz = rates_hz.second;
     ProfilePwmSource source(profile, controller_hz, twin_hz);
     const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(twin_hz);
     std::array<double, io::kChannels> duty{};
@@ -75,10 +79,14 @@ TEST(ProfilePwmSource, PlaysTheControllersSamplesBitForBitInAnyOrder) {
 // change every frame or at uneven frames must still read the contract's duty.
 TEST(ProfilePwmSource, AHeldSampleEndsAtTheNanosecondTheNextOneStarts) {
   const InputProfile profile = OpenLoopProfile();
-  for (const auto& [controller_hz, twin_hz] :
+  for (const auto& rates_hz :
        {std::pair{1000.0, 4000.0}, std::pair{1000.0, 7000.0}, std::pair{3000.0, 7000.0},
         std::pair{333.0, 4000.0}, std::pair{5000.0, 4000.0}, std::pair{50000.0, 3.0},
         std::pair{1.0, 50000.0}, std::pair{4000.0, 4000.0}}) {
+    // Named copies, not a structured binding: the lambdas below capture them (C++20 allows
+    // capturing a binding; clang-tidy's clang 14 does not).
+    const double controller_hz = rates_hz.first;
+    const double twin_hz = rates_hz.second;
     ProfilePwmSource source(profile, controller_hz, twin_hz);
     const std::int64_t period_ns = kernel_glue::PeriodNsFromRateHz(twin_hz);
     std::array<double, io::kChannels> duty{};
