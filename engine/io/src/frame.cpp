@@ -246,22 +246,14 @@ void PutHeader(unsigned op, std::uint8_t sequence, std::uint8_t answer_status, b
 }
 
 // Decoding writes the carried words only: a per-channel frame leaves the other slots as they were.
-void GetPwmWords(const FrameBytes& in, unsigned op, Frame& out) noexcept {
+template <typename Slots, typename Unpack>
+void GetWords(const FrameBytes& in, unsigned op, Slots& slots, Unpack unpack) noexcept {
   const std::uint64_t body = GetBody(in);
   if (op == static_cast<unsigned>(Opcode::kAll)) {
-    ForEachChannel([&](auto c) { out.pwm[c] = UnpackPwm(WordOf(body, c)); });
+    ForEachChannel([&](auto c) { slots[c] = unpack(WordOf(body, c)); });
   } else {
     const std::size_t c = op & 3U;
-    out.pwm[c] = UnpackPwm(WordOf(body, c));
-  }
-}
-void GetEncWords(const FrameBytes& in, unsigned op, Frame& out) noexcept {
-  const std::uint64_t body = GetBody(in);
-  if (op == static_cast<unsigned>(Opcode::kAll)) {
-    ForEachChannel([&](auto c) { out.enc[c] = UnpackEnc(WordOf(body, c)); });
-  } else {
-    const std::size_t c = op & 3U;
-    out.enc[c] = UnpackEnc(WordOf(body, c));
+    slots[c] = unpack(WordOf(body, c));
   }
 }
 
@@ -375,8 +367,12 @@ FrameError Decode(const FrameBytes& in, Direction direction, Image host_image,
   out.sequence = in[1];
   out.status = status;
   switch (payload) {
-    case Payload::kPwm: GetPwmWords(in, op, out); break;
-    case Payload::kEnc: GetEncWords(in, op, out); break;
+    case Payload::kPwm:
+      GetWords(in, op, out.pwm, [](auto word) { return UnpackPwm(word); });
+      break;
+    case Payload::kEnc:
+      GetWords(in, op, out.enc, [](auto word) { return UnpackEnc(word); });
+      break;
     case Payload::kInitRequest:
       out.init_request = InitRequest{GetU32(in, 2), GetU32(in, 6)};
       break;

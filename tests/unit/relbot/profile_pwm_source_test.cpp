@@ -83,8 +83,7 @@ TEST(ProfilePwmSource, AHeldSampleEndsAtTheNanosecondTheNextOneStarts) {
        {std::pair{1000.0, 4000.0}, std::pair{1000.0, 7000.0}, std::pair{3000.0, 7000.0},
         std::pair{333.0, 4000.0}, std::pair{5000.0, 4000.0}, std::pair{50000.0, 3.0},
         std::pair{1.0, 50000.0}, std::pair{4000.0, 4000.0}}) {
-    // Named copies, not a structured binding: the lambdas below capture them (C++20 allows
-    // capturing a binding; clang-tidy's clang 14 does not).
+    // Named copies for the lambda to capture (see the test above).
     const double controller_hz = rates_hz.first;
     const double twin_hz = rates_hz.second;
     ProfilePwmSource source(profile, controller_hz, twin_hz);
