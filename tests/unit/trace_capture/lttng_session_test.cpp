@@ -220,10 +220,24 @@ TEST_F(LttngSessionTest, ASecondSessionKeepsTheDaemonWhileTheFirstEnds) {
   }
   ExpectDaemonHandledRightly(daemon_pid);
   {
-    LttngSession third(Config("third"));  // and once more after all ended
-    const int emitter = RunEmitter(100);
+    // And once more after all ended, with a daemon started afresh. The emitter waits for `go`
+    // and the session awaits its registration, as `hiltwin trace` does: CI once recorded none
+    // of a process started just after a fresh daemon (not seen in 70 runs here, 40 of them
+    // beside stress-ng), and what this block checks is the daemon's lifecycle, not that race.
+    const fs::path go = base_ / "go_third";
+    ProcessOptions options;
+    options.out = OutputTarget::Discard();
+    Process emitter = Process::Start({HILTWIN_TRACE_EMITTER, "100", go.string()}, options);
+    const int emitter_pid = emitter.pid();  // pid() is -1 once reaped
+    LttngSessionConfig config = Config("third");
+    config.only_pid = emitter_pid;
+    config.await_registration = true;
+    LttngSession third(config);
+    std::ofstream(go) << "go\n";
+    const auto status = emitter.WaitFor(std::chrono::seconds(30));
+    ASSERT_TRUE(status && status->Success()) << (status ? status->Describe() : "still running");
     third.Stop();
-    EXPECT_EQ(CyclesOf(base_ / "third", emitter), 100);
+    EXPECT_EQ(CyclesOf(base_ / "third", emitter_pid), 100);
     daemon_pid = third.daemon_pid();
   }
   ExpectDaemonHandledRightly(daemon_pid);
