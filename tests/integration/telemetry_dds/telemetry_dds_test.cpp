@@ -267,9 +267,21 @@ TEST_F(TelemetryDds, OnTheVirtualClockTheTwinPublishesClockAndStampsWithItsTime)
   constexpr std::uint32_t kDomain = 226;
   const std::string ns = Ns("twin");
   Process probe = Probe(kDomain, ns, "probe.jsonl");
+  // Alone on the virtual clock the twin runs its 30 s in about 0.1 s of wall time, which a
+  // loaded machine's DDS discovery outlasted: CI's probe then had only the final timing record
+  // (transient-local) and no sample of the volatile topics. So the twin waits in `ready` for a
+  // lockstep ECS on a wire, and the ECS starts once the probe has the twin's timing record,
+  // that is once the probe has discovered the twin. In the pair only the twin publishes clock.
+  const std::string wire = "wire:tdds" + std::to_string(::getpid());
   std::vector<std::string> argv = Twin(kDomain, ns, "30");
-  argv.insert(argv.end(), {"--clock", "virtual"});
+  argv.insert(argv.end(), {"--clock", "virtual", "--io", wire, "--wait-peer", "20"});
   Process twin = hiltwin::test::Spawn(argv, Path("twin.out"));
+  WaitForTiming("probe.jsonl");
+  Process ecs = hiltwin::test::Spawn({HILTWIN_BINARY, "ecs", "--io", wire, "--clock", "virtual",
+                                      "--rate", "200", "--mode", "openloop", "--duration", "30",
+                                      "--priority", "0", "--no-progress"},
+                                     Path("ecs.out"));
+  ExpectCleanExit(ecs, "ecs");
   ExpectCleanExit(twin, "twin");
   ASSERT_TRUE(probe.WaitFor(kProcessTimeout).has_value()) << "probe still running";
   const std::vector<Json> lines = ReadLines(Path("probe.jsonl"));
