@@ -9,7 +9,8 @@ include("${CMAKE_CURRENT_LIST_DIR}/test_steps.cmake")
 hiltwin_test_require_vars(BUILD_DIR SOURCE_DIR WORK_DIR VERSION GENERATOR)
 
 # The targets a plant or controller needs (the issue's contract, cmake/HiltwinInstall.cmake).
-set(required_targets kernel_glue scheduler qos lifecycle io tracing runtime plant fmi)
+set(required_targets kernel_glue scheduler qos lifecycle io tracing runtime plant fmi
+    controller_abi)
 
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
@@ -19,7 +20,7 @@ hiltwin_test_run("install into a staging prefix" out
   HINT "build the tree first (cmake --build ${BUILD_DIR}), then see "
        "cmake/HiltwinInstall.cmake")
 set(installed bin/hiltwin include/hiltwin/runtime/run_session.h include/hiltwin/io/backend.h
-    include/hiltwin/plant/plant.h share/hiltwin/relbot.toml
+    include/hiltwin/plant/plant.h include/hiltwin/controller_abi.h share/hiltwin/relbot.toml
     share/hiltwin/config/cyclonedds-loopback.xml
     share/hiltwin/ros2/hiltwin_msgs/msg/Timing.msg share/doc/hiltwin/README.md
     share/bash-completion/completions/hiltwin)

@@ -60,9 +60,18 @@ typedef struct hiltwin_controller_descriptor {
   const char* (*last_error)(void* self);
 } hiltwin_controller_descriptor;
 
+/* Gives hiltwin_controller default visibility even in a library built with
+ * -fvisibility=hidden (hiltwin_add_controller builds so, to export nothing else); the
+ * definition inherits it from the declaration below. */
+#if defined(__GNUC__) || defined(__clang__)
+#define HILTWIN_CONTROLLER_EXPORT __attribute__((visibility("default")))
+#else
+#define HILTWIN_CONTROLLER_EXPORT
+#endif
+
 /* What the library defines (once, with external linkage and default visibility). */
 typedef const hiltwin_controller_descriptor* (*hiltwin_controller_fn)(void);
-const hiltwin_controller_descriptor* hiltwin_controller(void);
+HILTWIN_CONTROLLER_EXPORT const hiltwin_controller_descriptor* hiltwin_controller(void);
 
 #ifdef __cplusplus
 }
