@@ -106,3 +106,59 @@ if(NOT steps EQUAL 1000 OR NOT counts EQUAL 499 OR y LESS 0.4999 OR y GREATER 0.
          "examples/lag_twin/lag_twin.cpp says")
 endif()
 message(STATUS "out-of-tree example: y = ${y} m after ${steps} steps, ${counts} counts")
+
+# The C controller example as a student builds it: a C project of its own, found hiltwin with
+# find_package, hiltwin_add_controller, the installed hiltwin/controller_abi.h. Then the loader
+# (tests/controllers' probe) steps the library it made with known inputs. The PD law itself is
+# checked by hand in tests/unit/controller_abi against the in-tree build of the same source;
+# here the out-of-tree library must step exactly as that one, and hold the values that need no
+# gains: no error gives zero duty, a metre of error gives full duty each way.
+if(PROBE AND IN_TREE_CONTROLLER_DIR)
+  set(controller "${WORK_DIR}/controller_c_pd")
+  set(configure_args -S "${SOURCE_DIR}/examples/controller_c_pd" -B "${controller}"
+      -G "${GENERATOR}" "-DCMAKE_PREFIX_PATH=${stage}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
+      "-DCMAKE_C_FLAGS=-Wall -Wextra -Wpedantic -Wconversion -Wshadow -Werror")
+  if(TOOLCHAIN_FILE)
+    list(APPEND configure_args "--toolchain" "${TOOLCHAIN_FILE}")
+  elseif(C_COMPILER)
+    list(APPEND configure_args "-DCMAKE_C_COMPILER=${C_COMPILER}")
+  endif()
+  hiltwin_test_run("configure the C controller example" out
+    COMMAND "${CMAKE_COMMAND}" ${configure_args}
+    HINT "find_package(hiltwin) in a C-only project: cmake/hiltwinConfig.cmake.in and "
+         "cmake/HiltwinController.cmake")
+  hiltwin_test_run("build the C controller example" out
+    COMMAND "${CMAKE_COMMAND}" --build "${controller}"
+    HINT "the installed hiltwin/controller_abi.h or hiltwin_add_controller do not build it")
+  hiltwin_test_require_files("the C controller example"
+                             "see hiltwin_add_controller in cmake/HiltwinController.cmake"
+                             "${controller}" my_pd.so)
+  set(steps "0,0,0,0" "0.001,-0.001,0,0" "1,-1,0,0")
+  hiltwin_test_run("step the out-of-tree controller" out
+    COMMAND ${EMULATOR} "${PROBE}" "${controller}/my_pd.so" 0.001 ${steps})
+  hiltwin_test_run("step the in-tree controller" in_tree
+    COMMAND ${EMULATOR} "${PROBE}" "${IN_TREE_CONTROLLER_DIR}/my_pd.so" 0.001 ${steps})
+  if(NOT out STREQUAL in_tree)
+    hiltwin_test_fail("step the out-of-tree controller"
+      WHY "it stepped\n${out}but the in-tree build of the same source stepped\n${in_tree}"
+      HINT "the installed header or hiltwin_add_controller build it differently")
+  endif()
+  set(expected "^step 1: duty_left=0 duty_right=0\n"
+      "step 2: duty_left=([0-9.e-]+) duty_right=(-[0-9.e-]+)\n"
+      "step 3: duty_left=1 duty_right=-1\n$")
+  string(CONCAT expected ${expected})
+  set(duty_left "")
+  set(duty_right "")
+  if(out MATCHES "${expected}")  # its own if: ${CMAKE_MATCH_n} expands before an if runs
+    set(duty_left "${CMAKE_MATCH_1}")
+    set(duty_right "${CMAKE_MATCH_2}")
+  endif()
+  if(duty_left STREQUAL "" OR NOT duty_left GREATER 0 OR NOT duty_left LESS 1
+     OR NOT duty_right STREQUAL "-${duty_left}")
+    hiltwin_test_fail("step the out-of-tree controller"
+      WHY "it stepped\n${out}expected zero duty, then a duty in (0, 1) and its negative, then "
+          "exactly 1 and -1"
+      HINT "see examples/controller_c_pd/my_pd.c")
+  endif()
+  message(STATUS "out-of-tree controller: ${out}")
+endif()
