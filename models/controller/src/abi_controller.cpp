@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include "content_hash.h"
 #include "hiltwin/controller_abi.h"
@@ -143,23 +145,29 @@ std::vector<Port> ReadPorts(const std::string& where, const char* side,
     throw ControllerError(where + ": " + side + "_count is " + std::to_string(count) +
                           " but " + list + " is NULL: point it at the port array");
   }
+  // "<where>: inputs[3]", built only for a message.
+  const auto at = [&](std::uint32_t i) {
+    std::string text = where;
+    text.append(": ").append(list).append("[").append(std::to_string(i)).append("]");
+    return text;
+  };
   std::vector<Port> out;
   std::set<std::string, std::less<>> seen;
   for (std::uint32_t i = 0; i < count; ++i) {
-    const std::string at = where + ": " + list + "[" + std::to_string(i) + "]";
     const char* name = ports[i].name;
     if (name == nullptr || !IsPortName(name)) {
-      throw ControllerError(at + " has " + (name == nullptr ? "a NULL name" :
-                            "the name \"" + std::string(name) + "\"") +
+      const std::string what =
+          name == nullptr ? std::string("a NULL name") : "the name \"" + std::string(name) + "\"";
+      throw ControllerError(at(i) + " has " + what +
                             ": a port name is letters, digits and '_', such as wheel_left_m");
     }
     if (ports[i].unit == nullptr) {
-      throw ControllerError(at + " (" + name + ") has a NULL unit: give its unit (\"m\", " +
+      throw ControllerError(at(i) + " (" + name + ") has a NULL unit: give its unit (\"m\", " +
                             "\"rad\", \"1\" for a duty...) or \"\" when it has none");
     }
     if (!seen.insert(name).second) {
-      throw ControllerError(at + ": the " + side + " " + name + " is listed twice: give every " +
-                            side + " its own name");
+      throw ControllerError(at(i) + ": the " + side + " " + name + " is listed twice: give " +
+                            "every " + side + " its own name");
     }
     out.push_back(Port{name, ports[i].unit});
   }

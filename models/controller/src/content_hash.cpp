@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cerrno>
+#include <cstddef>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -36,7 +37,8 @@ std::string Sha256HexOfFile(const std::filesystem::path& file) {
   if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1) {
     Fail(file, "OpenSSL could not start a SHA-256 digest");
   }
-  std::array<char, 64 * 1024> block{};
+  constexpr std::size_t kBlockBytes = std::size_t{64} * 1024;
+  std::array<char, kBlockBytes> block{};
   while (in) {
     in.read(block.data(), block.size());
     const std::streamsize got = in.gcount();
@@ -56,7 +58,7 @@ std::string Sha256HexOfFile(const std::filesystem::path& file) {
   static constexpr std::array<char, 16> kHex = {'0', '1', '2', '3', '4', '5', '6', '7',
                                                 '8', '9', 'a', 'b', 'c', 'd', 'e', 'f'};
   std::string hex;
-  hex.reserve(2 * length);
+  hex.reserve(std::size_t{2} * length);
   for (unsigned int i = 0; i < length; ++i) {
     hex += kHex[digest[i] >> 4U];
     hex += kHex[digest[i] & 0xFU];
