@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "content_hash.h"
+#include "elf_header.h"
 #include "hiltwin/controller_abi.h"
 #include "hiltwin/plant/twentysim_plant.h"  // FormatNumber, RateForStep: the same --rate advice
 
@@ -73,10 +74,13 @@ Library Open(const std::string& where, const std::filesystem::path& file) {
   void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* why = dlerror();  // NOLINT(concurrency-mt-unsafe): per thread in glibc
+    std::string advice = ExplainUnloadableElf(file);
+    if (advice.empty()) {
+      advice = "it must be a shared library built for this machine's architecture whose own "
+               "dependencies are installed (file, ldd)";
+    }
     throw ControllerError(where + ": cannot be loaded (" +
-                          (why != nullptr ? why : "dlopen failed") +
-                          "): it must be a shared library built for this machine's "
-                          "architecture whose own dependencies are installed (file, ldd)");
+                          (why != nullptr ? why : "dlopen failed") + "): " + advice);
   }
   return Library(handle);
 }

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -48,8 +49,8 @@ INSTANTIATE_TEST_SUITE_P(
         Refusal{"no_such_library", {": no such file: build the controller first"}},
         // dlopen's own reason is part of the message.
         Refusal{"not_a_library",
-                {"cannot be loaded (", "not_a_library.so: ", "): it must be a shared library "
-                 "built for this machine's architecture"}},
+                {"cannot be loaded (", "not_a_library.so: ", "): it is not an ELF file, so "
+                 "not a shared library: give the .so the build made"}},
         Refusal{"bad_abi_version",
                 {"built against controller ABI version 99, but this hiltwin speaks version 1: "
                  "rebuild the library against the installed hiltwin/controller_abi.h"}},
@@ -71,6 +72,18 @@ TEST(AbiRefusal, AnErrorMessageGivesTheAbsoluteFileWhenThePathIsRelative) {
   const std::string message = LoadError("no/such/dir/my_pd.so");
   EXPECT_THAT(message, StartsWith("controller lib:no/such/dir/my_pd.so ("));
   EXPECT_THAT(message, HasSubstr("/no/such/dir/my_pd.so): no such file"));
+}
+
+TEST(AbiRefusal, ALibraryForAnotherMachineIsRefusedNamingBothMachines) {
+  const std::string path = Lib("foreign_machine");
+  if (!std::filesystem::exists(path)) {
+    GTEST_SKIP() << "no arm64 compiler on this x86-64 machine (tests/controllers)";
+  }
+  const std::string message = LoadError(path);
+  EXPECT_THAT(message, StartsWith("controller lib:" + path + ": cannot be loaded ("));
+  EXPECT_THAT(message, HasSubstr("): it was built for arm64 (aarch64), but this machine is "
+                                 "x86-64 (amd64): build it here, or with a compiler for this "
+                                 "machine"));
 }
 
 TEST(AbiRefusal, CreateReturningNullIsRefusedAtStart) {
