@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -252,7 +253,13 @@ TEST(AbiController, ANullDereferenceInStepKillsTheProcessWithSigsegv) {
   const auto good = hiltwin::test::Run({probe, Lib("test_controller"), "0.001", "1,2,0.5,0.5"});
   EXPECT_EQ(good.exit_code, 0) << good.err;
   EXPECT_EQ(good.out, "step 1: duty_left=0.5 duty_right=1.5\n");
-  const auto crash = hiltwin::test::Run({probe, Lib("null_dereference"), "0.001", "0,0,0,0"});
+  // Under AddressSanitizer (the sanitizer stage) its own SIGSEGV handler would report and exit
+  // 1: handle_segv=0 leaves the signal to kill, as in the program that ships.
+  const char* asan = std::getenv("ASAN_OPTIONS");  // NOLINT(concurrency-mt-unsafe): one thread
+  const std::string asan_options =
+      "ASAN_OPTIONS=" + (asan != nullptr ? std::string(asan) + ":" : "") + "handle_segv=0";
+  const auto crash = hiltwin::test::Run(
+      {"env", asan_options, probe, Lib("null_dereference"), "0.001", "0,0,0,0"});
   EXPECT_FALSE(crash.status.exited) << crash.status.Describe() << "\n" << crash.err;
   EXPECT_EQ(crash.status.signal, SIGSEGV) << crash.status.Describe();
   EXPECT_EQ(crash.out, "");  // it died in its first step
