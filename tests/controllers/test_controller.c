@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "hiltwin/controller_abi.h"
 
@@ -15,6 +16,7 @@ __attribute__((visibility("default"))) int hiltwin_test_calls[5];
 
 typedef struct {
   int steps;
+  char error[64];  /* last_error's text, owned by the state (HILTWIN_TEST_STEP_ERROR) */
   double* history; /* never allocated: calloc leaves it NULL (HILTWIN_TEST_NULL_DEREFERENCE) */
 } test_state;
 
@@ -66,7 +68,10 @@ __attribute__((unused)) static int step(void* self, const double* in, double* ou
   out[1] = nan("");
 #endif
 #if defined(HILTWIN_TEST_STEP_ERROR)
-  if (state->steps >= 3) return 1;
+  if (state->steps >= 3) {
+    strcpy(state->error, "wheel runaway: the test library stops at its third step");
+    return 1;
+  }
 #endif
   return 0;
 }
@@ -78,6 +83,8 @@ static void finish(void* self) {
 
 static void destroy(void* self) {
   ++hiltwin_test_calls[4];
+  /* Wiped before it is freed, so text hiltwin kept a pointer to reads empty, never stale. */
+  memset(self, 0, sizeof(test_state));
   free(self);
 }
 
@@ -86,7 +93,7 @@ __attribute__((unused)) static const char* last_error(void* self) {
 #if defined(HILTWIN_TEST_START_FAILS)
   return "start refused: the test library was built to refuse";
 #else
-  return "wheel runaway: the test library stops at its third step";
+  return ((test_state*)self)->error;
 #endif
 }
 

@@ -4,8 +4,11 @@
 
 #include <dlfcn.h>
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <set>
@@ -226,6 +229,7 @@ class AbiController final : public Controller {
   ControllerInfo info_;
   void* self_ = nullptr;
   bool started_ = false;
+  std::array<char, 256> step_error_{};  ///< the last step error's text (longer text is cut)
 };
 
 void AbiController::CheckStep(double step_s) const {
@@ -273,7 +277,14 @@ ControllerStatus AbiController::Step(std::span<const double> in,
   }
   if (d_.step(self_, in.data(), out.data()) == 0) return ControllerStatus::Ok();
   const char* why = LastError();
-  return ControllerStatus::Error(why != nullptr && *why != '\0' ? why : kStepFailedNoText);
+  if (why == nullptr || *why == '\0') return ControllerStatus::Error(kStepFailedNoText);
+  // The library's text lives until its next call, or its destroy(): a copy in a buffer of our
+  // own (a bounded copy, no allocation) stays valid until this controller goes, so the report
+  // can name it after Finish.
+  const std::size_t length = strnlen(why, step_error_.size() - 1);
+  std::memcpy(step_error_.data(), why, length);
+  step_error_[length] = '\0';
+  return ControllerStatus::Error(step_error_.data());
 }
 
 const char* AbiController::LastError() const noexcept {

@@ -209,6 +209,9 @@ TEST(AbiController, AStepErrorStopsWithTheLibrarysText) {
   const ControllerStatus status = controller->Step(std::vector{0.0, 0.0, 0.0, 0.0}, out);
   EXPECT_EQ(status.code, ControllerStatus::Code::kError);
   EXPECT_STREQ(status.reason, "wheel runaway: the test library stops at its third step");
+  // The library's text was in its state, which destroy() wipes: the reason is a copy.
+  controller->Finish();
+  EXPECT_STREQ(status.reason, "wheel runaway: the test library stops at its third step");
 }
 
 TEST(AbiController, AStepErrorWithoutLastErrorSaysSo) {

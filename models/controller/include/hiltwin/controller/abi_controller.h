@@ -6,10 +6,12 @@
 /// entry points, port names and units) before anything of it is called, and every refusal is a
 /// ControllerError naming the file, what is wrong and what to do.
 ///
-/// Start(step_s) calls create() then start(step_s); Step() is one call of step() (nonzero:
-/// ControllerStatus::Error with the library's last_error() text); Finish() calls finish() once
-/// and destroy(); the library is closed when the controller is destroyed. hiltwin does not
-/// check the outputs here: the ECS's controller task does (a NaN passes through unchanged).
+/// Start(step_s) calls create() then start(step_s). Step() is one call of step(); nonzero is
+/// ControllerStatus::Error with a copy of the library's last_error() text (its first 255
+/// bytes), which stays valid after Finish, until the controller is destroyed. Finish() calls
+/// finish() once and destroy(); the library is closed when the controller is destroyed.
+/// hiltwin does not check the outputs here: the ECS's controller task does (a NaN passes
+/// through unchanged).
 /// A crash in the library's code (a null dereference) ends the process, by design: the twin
 /// goes safe as for any ECS that dies.
 
