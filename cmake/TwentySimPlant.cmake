@@ -190,13 +190,14 @@ function(_hiltwin_20sim_folder_hash out dir)
   set(${out} "${folder_hash}" PARENT_SCOPE)
 endfunction()
 
-# hiltwin_link_20sim(<consumer> <20-sim target>...): links the OBJECT libraries of 20-sim plants
-# or controllers and the support libraries they share (tests that build the adapter themselves).
-function(hiltwin_link_20sim consumer)
-  foreach(target IN LISTS ARGN)
-    get_target_property(support ${target} HILTWIN_20SIM_SUPPORT)
-    target_link_libraries(${consumer} PRIVATE ${target} ${support})
-  endforeach()
+# hiltwin_link_20sim(<consumer> <20-sim target>): links the OBJECT library of a 20-sim plant or
+# controller and the support libraries it shares, and gives the consumer the class's name in
+# this build (a test that builds the adapter over the class itself; one 20-sim target each).
+function(hiltwin_link_20sim consumer target)
+  get_target_property(support ${target} HILTWIN_20SIM_SUPPORT)
+  get_target_property(rename ${target} HILTWIN_20SIM_RENAME)
+  target_link_libraries(${consumer} PRIVATE ${target} ${support})
+  target_compile_definitions(${consumer} PRIVATE "${rename}")
 endfunction()
 
 # The generated sources of `dir`, without EXCLUDE and without a file defining main (20-sim may
@@ -338,12 +339,15 @@ function(_hiltwin_add_20sim role name)
   endforeach()
   set(target hiltwin_${role}_${name})
   add_library(${target} OBJECT ${class_sources} "${register}")
-  # PUBLIC: tests (and tools) may build the adapter over the class themselves, under the name
-  # the class has in this build (_hiltwin_20sim_share_support says why it is renamed).
+  # PUBLIC: tests (and tools) may build the adapter over the class themselves. The class's name
+  # in this build (_hiltwin_20sim_share_support says why it is renamed) is private: the hiltwin
+  # executable links several 20-sim targets; hiltwin_link_20sim gives it to a test.
+  set(rename "${ARG_CLASS}=hiltwin_20sim_${name}_${ARG_CLASS}")
   target_include_directories(${target} PUBLIC "${ARG_DIR}")
-  target_compile_definitions(${target} PUBLIC "${ARG_CLASS}=hiltwin_20sim_${name}_${ARG_CLASS}")
+  target_compile_definitions(${target} PRIVATE "${rename}")
   target_link_libraries(${target} PUBLIC hiltwin::${role})
   set_property(TARGET ${target} PROPERTY HILTWIN_20SIM_SUPPORT "${support}")
+  set_property(TARGET ${target} PROPERTY HILTWIN_20SIM_RENAME "${rename}")
   # hiltwin's warning set for the registration file only: take what hiltwin_target_warnings
   # gives the target and move it onto that one source, so the set stays defined in one place.
   hiltwin_target_warnings(${target})
