@@ -1,7 +1,8 @@
 #pragma once
 // What the tests of controllers that implement the ECS's position PID share (the 20-sim
 // example models/controllers/pid20sim, the FMU tests/fmus/pid): the control law restated by
-// hand, and the thesis's 2.5 m closed loop against the RELbot model in process.
+// hand, the allocation count of Step, and the thesis's 2.5 m closed loop against the RELbot
+// model in process.
 //
 // The closed loop: the RELbot model (RK4 at the twin's rate) and the controller at the ECS's
 // rate on one virtual timeline, without the boards: at each ECS sample the controller reads the
@@ -14,11 +15,13 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "fakes/alloc_counter.h"
 #include "hiltwin/controller/controller.h"
 #include "hiltwin/relbot/relbot_model.h"
 #include "hiltwin/relbot/relbot_params.h"
@@ -87,6 +90,24 @@ inline PidPorts PidPortsOf(const controller::ControllerInfo& info) {
   return {PortIndex(info.inputs, "setpoint_left_m"), PortIndex(info.inputs, "setpoint_right_m"),
           PortIndex(info.inputs, "wheel_left_m"),    PortIndex(info.inputs, "wheel_right_m"),
           PortIndex(info.outputs, "duty_left"),      PortIndex(info.outputs, "duty_right")};
+}
+
+// What `steps` calls of Step(in, out) on a started controller allocated (operator new always;
+// malloc when the counter can see it), and how many of them did not return ok.
+struct StepAllocations {
+  std::uint64_t allocations = 0;
+  int not_ok = 0;
+};
+inline StepAllocations CountStepAllocations(controller::Controller& controller,
+                                            std::span<const double> in, int steps = 10'000) {
+  std::vector<double> out(controller.Info().outputs.size(), 0.0);
+  StepAllocations result;
+  {
+    const ScopedAllocationCount count;
+    for (int k = 0; k < steps; ++k) result.not_ok += controller.Step(in, out).ok() ? 0 : 1;
+    result.allocations = count.count();
+  }
+  return result;
 }
 
 struct ClosedLoopFigures {

@@ -37,8 +37,8 @@ std::unique_ptr<Controller> Load(const std::string& name, const ControllerOption
   if (std::find(names.begin(), names.end(), name) != names.end()) {
     if (const ControllerEntry* entry = FindController(name)) return entry->make(options);
   }
-  throw ControllerError("--controller 20sim:" + name + ": no 20-sim controller '" + name +
-                        "' (" + KnownList() + ")");
+  throw ControllerError("--controller 20sim:" + name + ": no 20-sim controller '" + name + "' (" +
+                        KnownList() + ")");
 }
 
 }  // namespace

@@ -66,9 +66,7 @@ class FmuController final : public controller::Controller {
   FmuController(FmuController&&) = delete;
   FmuController& operator=(FmuController&&) = delete;
 
-  [[nodiscard]] const controller::ControllerInfo& Info() const noexcept override {
-    return info_;
-  }
+  [[nodiscard]] const controller::ControllerInfo& Info() const noexcept override { return info_; }
 
   void Start(double step_s) override {
     try {
@@ -109,10 +107,10 @@ std::unique_ptr<controller::Controller> OpenFmuController(
     const std::filesystem::path& fmu_path, const controller::ControllerOptions& options,
     FmuOptions fmu_options) {
   if (!options.gains_path.empty()) {
-    throw ControllerError("--gains " + options.gains_path + " cannot apply to fmu:" +
-                          fmu_path.string() + ": an FMU brings its own parameters, set in " +
-                          "the tool that exported it: drop --gains, or export the FMU with " +
-                          "the gains you want");
+    throw ControllerError(
+        "--gains " + options.gains_path + " cannot apply to fmu:" + fmu_path.string() +
+        ": an FMU brings its own parameters, set in " +
+        "the tool that exported it: drop --gains, or export the FMU with " + "the gains you want");
   }
   return std::make_unique<FmuController>(fmu_path, std::move(fmu_options));
 }

@@ -14,7 +14,6 @@
 #include <memory>
 #include <string>
 
-#include "fakes/alloc_counter.h"
 #include "fakes/controller_loop.h"
 #include "hiltwin/controller/content_hash.h"
 #include "hiltwin/controller/controller_registry.h"
@@ -90,7 +89,8 @@ TEST(FmuController, SetpointStepGivesPIAndDTermsOfTheHandComputation) {
     EXPECT_NEAR(out[0], expected[k], 1e-12) << "step " << k + 1;
     EXPECT_NEAR(out[0], left.Step(1e-3, travel_m[k]), 1e-12) << "step " << k + 1;
   }
-  EXPECT_NEAR(out[1], 100.0 * -2e-3 + 3 * 1000.0 * kControllerStepS * -2e-3, 1e-12);  // P + 3 steps of I
+  EXPECT_NEAR(out[1], 100.0 * -2e-3 + 3 * 1000.0 * kControllerStepS * -2e-3,
+              1e-12);  // P + 3 steps of I
   controller->Finish();
   controller->Finish();
 }
@@ -124,7 +124,7 @@ TEST(FmuController, TheFmuKindOpensItFromTheSpec) {
 
 TEST(FmuController, ModelExchangeOnlyIsRefused) {
   EXPECT_THAT(ControllerOpenError("bad_pid_me_only"),
-              HasSubstr("bad_pid_me_only.fmu: modelDescription.xml:4: a ModelExchange-only FMU"));
+              HasSubstr("bad_pid_me_only.fmu: modelDescription.xml:5: a ModelExchange-only FMU"));
 }
 
 TEST(FmuController, AnFmuWithoutOutputsIsRefused) {
@@ -134,12 +134,12 @@ TEST(FmuController, AnFmuWithoutOutputsIsRefused) {
                 "least one (a duty): export its commands as outputs");
 }
 
-// Line 44: the variable's <Integer> element in the configured pid.xml.in (the line the plant's
-// messages give for a variable's type).
+// Line 49: where the variable's <ScalarVariable ...> start tag ends in the configured
+// pid.xml.in (the line libxml2 gives a node, as in the plant's messages).
 TEST(FmuController, ANonRealOutputIsRefusedWithItsLine) {
   EXPECT_EQ(ControllerOpenError("bad_pid_integer_output"),
             TestFmu("bad_pid_integer_output").string() +
-                ": modelDescription.xml:44: the output 'mode' is of type Integer: a "
+                ": modelDescription.xml:49: the output 'mode' is of type Integer: a "
                 "controller's outputs are duties, Real only: export it as a Real, or give it "
                 "causality \"local\" if it is not a command");
 }
@@ -175,17 +175,11 @@ TEST(FmuController, StepAllocatesNothing) {
   const std::unique_ptr<Controller> controller = OpenPidController();
   controller->Start(kControllerStepS);
   const std::array<double, 4> in{0.01, 0.02, 0.0, 0.0};
-  std::array<double, 2> out{};
-  int not_ok = 0;
-  std::uint64_t allocations = 0;
-  {
-    const hiltwin::test::ScopedAllocationCount count;
-    for (int k = 0; k < 10'000; ++k) not_ok += controller->Step(in, out).ok() ? 0 : 1;
-    allocations = count.count();
-  }
-  EXPECT_EQ(not_ok, 0);
-  EXPECT_EQ(allocations, 0U) << (hiltwin::test::MallocIsCounted() ? "malloc and new counted"
-                                                                  : "operator new counted");
+  const hiltwin::test::StepAllocations counted =
+      hiltwin::test::CountStepAllocations(*controller, in);
+  EXPECT_EQ(counted.not_ok, 0);
+  EXPECT_EQ(counted.allocations, 0U)
+      << (hiltwin::test::MallocIsCounted() ? "malloc and new counted" : "operator new counted");
 }
 
 // Thesis §7.2: the 2.5 m move with the error below 3 mm.

@@ -14,7 +14,6 @@
 #include <string>
 
 #include "LoopController.h"
-#include "fakes/alloc_counter.h"
 #include "fakes/controller_loop.h"
 #include "hiltwin/controller/controller_registry.h"
 
@@ -122,8 +121,9 @@ TEST(TwentySimController, UnknownNameListsTheBuiltInOnes) {
     static_cast<void>(MakeController("20sim:pid21sim", {}));
     FAIL() << "an unknown 20-sim controller was made";
   } catch (const ControllerError& e) {
-    EXPECT_STREQ(e.what(), "--controller 20sim:pid21sim: no 20-sim controller 'pid21sim' "
-                           "(built in: pid20sim)");
+    EXPECT_STREQ(e.what(),
+                 "--controller 20sim:pid21sim: no 20-sim controller 'pid21sim' "
+                 "(built in: pid20sim)");
   }
 }
 
@@ -133,10 +133,11 @@ TEST(TwentySimController, StartAtAnotherStepNamesTheRateToUse) {
     controller->Start(0.002);  // --rate 500
     FAIL() << "a 500 Hz step was accepted by a controller generated for 1 kHz";
   } catch (const ControllerError& e) {
-    EXPECT_STREQ(e.what(), "--rate 500 Hz gives a step of 0.002 s but the 20-sim controller "
-                           "'pid20sim' was generated for a step of 0.001 s (m_step_size in "
-                           "LoopController.cpp): run at --rate 1000, or regenerate the code with "
-                           "step size 0.002 s");
+    EXPECT_STREQ(e.what(),
+                 "--rate 500 Hz gives a step of 0.002 s but the 20-sim controller "
+                 "'pid20sim' was generated for a step of 0.001 s (m_step_size in "
+                 "LoopController.cpp): run at --rate 1000, or regenerate the code with "
+                 "step size 0.002 s");
   }
   EXPECT_NO_THROW(controller->Start(kStepS + 0.4e-9));  // within the 1 ns resolution
 }
@@ -191,17 +192,10 @@ TEST(TwentySimController, StepAllocatesNothing) {
   const std::unique_ptr<Controller> controller = MakePid20sim();
   controller->Start(kStepS);
   const std::array<double, 4> in{0.01, 0.02, 0.0, 0.0};
-  std::array<double, 2> out{};
-  int not_ok = 0;
-  std::uint64_t allocations = 0;
-  {
-    const test::ScopedAllocationCount count;  // operator new always; malloc when counted
-    for (int k = 0; k < 10'000; ++k) not_ok += controller->Step(in, out).ok() ? 0 : 1;
-    allocations = count.count();
-  }
-  EXPECT_EQ(not_ok, 0);
-  EXPECT_EQ(allocations, 0U) << (test::MallocIsCounted() ? "malloc and new counted"
-                                                         : "operator new counted");
+  const test::StepAllocations counted = test::CountStepAllocations(*controller, in);
+  EXPECT_EQ(counted.not_ok, 0);
+  EXPECT_EQ(counted.allocations, 0U)
+      << (test::MallocIsCounted() ? "malloc and new counted" : "operator new counted");
 }
 
 // Thesis §7.2: the 2.5 m move with the error below 3 mm. The built-in PID, with the same law
@@ -212,7 +206,7 @@ TEST(TwentySimController, TracksTheTwoAndAHalfMetreMoveWithinTheThesisBound) {
   EXPECT_EQ(run.steps_not_ok, 0U);
   EXPECT_LT(run.max_abs_error_left_m, 1.5e-3);
   EXPECT_LT(run.max_abs_error_right_m, 1.5e-3);
-  EXPECT_GT(run.max_abs_error_left_m, 0.5e-3);  // a real figure, not a dead loop
+  EXPECT_GT(run.max_abs_error_left_m, 0.5e-3);        // a real figure, not a dead loop
   EXPECT_LT(std::abs(run.final_error_left_m), 1e-4);  // at rest on the setpoint, within a count
   EXPECT_LT(std::abs(run.final_error_right_m), 1e-4);
   EXPECT_LT(run.max_abs_duty, 0.85);

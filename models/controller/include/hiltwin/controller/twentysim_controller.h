@@ -54,17 +54,10 @@ class TwentySimController final : public Controller {
   /// is negative.
   TwentySimController(plant::TwentySimSpec spec, std::string content_sha256)
       : core_(std::move(spec), "controller") {
-    const plant::TwentySimSpec& s = core_.spec();
-    info_.spec = "20sim:" + s.name;
-    info_.kind = "20-sim C++ class";
-    info_.name = s.name;
-    info_.file = s.source_dir;
+    core_.Describe(info_);
+    info_.spec = "20sim:" + core_.spec().name;
+    info_.file = core_.spec().source_dir;
     info_.content_sha256 = std::move(content_sha256);
-    info_.inputs = s.inputs;
-    info_.outputs = s.outputs;
-    info_.model_step_s = core_.model_step_s();
-    info_.step_is_fixed = true;  // compiled into the constructor
-    info_.details = core_.Details();
   }
 
   ~TwentySimController() override = default;  // the core terminates the submodel
@@ -84,19 +77,22 @@ class TwentySimController final : public Controller {
   [[nodiscard]] ControllerStatus Step(std::span<const double> in,
                                       std::span<double> out) noexcept override {
     if (!core_.initialized()) {
-      return ControllerStatus::Error("the 20-sim controller was stepped before Start or after "
-                                     "Finish");
+      return ControllerStatus::Error(
+          "the 20-sim controller was stepped before Start or after "
+          "Finish");
     }
     if (in.size() != info_.inputs.size() || out.size() != info_.outputs.size()) {
-      return ControllerStatus::Error("the 20-sim controller was stepped with the wrong port "
-                                     "count");
+      return ControllerStatus::Error(
+          "the 20-sim controller was stepped with the wrong port "
+          "count");
     }
     const bool running = core_.Calculate(in);
     const std::span<const double> y = core_.outputs();
     std::copy(y.begin(), y.end(), out.begin());
     if (!running) {
-      return ControllerStatus::Error("the 20-sim controller reached its finish time "
-                                     "(m_finish_time)");
+      return ControllerStatus::Error(
+          "the 20-sim controller reached its finish time "
+          "(m_finish_time)");
     }
     return ControllerStatus::Ok();
   }

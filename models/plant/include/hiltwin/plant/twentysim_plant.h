@@ -56,13 +56,7 @@ class TwentySimPlant final : public Plant {
   /// Builds the submodel to learn its step; throws PlantError when that step is not a
   /// positive number (hand-edited code) or the finish time is negative.
   explicit TwentySimPlant(TwentySimPlantSpec spec) : core_(std::move(spec), "plant") {
-    info_.name = core_.spec().name;
-    info_.kind = "20-sim C++ class";
-    info_.inputs = core_.spec().inputs;
-    info_.outputs = core_.spec().outputs;
-    info_.model_step_s = core_.model_step_s();
-    info_.step_is_fixed = true;  // compiled into the constructor
-    info_.details = core_.Details();
+    core_.Describe(info_);
   }
 
   ~TwentySimPlant() override = default;  // the core terminates the submodel

@@ -147,15 +147,15 @@ class TwentySimCore {
     model_.emplace();
     model_step_s_ = static_cast<double>(model_->m_step_size);
     if (!(std::isfinite(model_step_s_) && model_step_s_ > 0.0)) {
-      throw Error(Who() + " has m_step_size = " +
-                  twentysim_detail::FormatNumber(model_step_s_, 9) + " in " + spec_.class_name +
-                  ".cpp: it must be a positive step in seconds");
+      throw Error(Who() + " has m_step_size = " + twentysim_detail::FormatNumber(model_step_s_, 9) +
+                  " in " + spec_.class_name + ".cpp: it must be a positive step in seconds");
     }
     if (!(std::isfinite(spec_.finish_time_s) && spec_.finish_time_s >= 0.0)) {
       throw Error(Who() + " has finish time " +
                   twentysim_detail::FormatNumber(spec_.finish_time_s, 9) +
                   " s: use 0 (run for ever) or a positive time (FINISH_TIME in its "
-                  "hiltwin_add_20sim_" + role_ + " line)");
+                  "hiltwin_add_20sim_" +
+                  role_ + " line)");
     }
     model_->SetFinishTime(spec_.finish_time_s);
   }
@@ -178,9 +178,7 @@ class TwentySimCore {
   }
 
   /// "the 20-sim plant 'msd20sim'": how messages name the submodel.
-  [[nodiscard]] std::string Who() const {
-    return "the 20-sim " + role_ + " '" + spec_.name + "'";
-  }
+  [[nodiscard]] std::string Who() const { return "the 20-sim " + role_ + " '" + spec_.name + "'"; }
 
   /// Throws StepError naming --rate when `step_s` is not the step the code was generated for.
   void CheckStep(double step_s) const {
@@ -189,8 +187,8 @@ class TwentySimCore {
     }
     using twentysim_detail::FormatNumber;
     const std::string step_text = FormatNumber(step_s, 9);
-    throw StepError("--rate " + FormatNumber(1.0 / step_s, 6) + " Hz gives a step of " +
-                    step_text + " s but " + Who() + " was generated for a step of " +
+    throw StepError("--rate " + FormatNumber(1.0 / step_s, 6) + " Hz gives a step of " + step_text +
+                    " s but " + Who() + " was generated for a step of " +
                     FormatNumber(model_step_s_, 9) + " s (m_step_size in " + spec_.class_name +
                     ".cpp): run at --rate " + twentysim_detail::RateForStep(model_step_s_) +
                     ", or regenerate the code with step size " + step_text + " s");
@@ -236,8 +234,8 @@ class TwentySimCore {
   }
 
   [[nodiscard]] bool OutputsFinite() const noexcept {
-    return std::all_of(y_buf_.begin(), y_buf_.begin() + static_cast<std::ptrdiff_t>(
-                                                            spec_.outputs.size()),
+    return std::all_of(y_buf_.begin(),
+                       y_buf_.begin() + static_cast<std::ptrdiff_t>(spec_.outputs.size()),
                        [](double y) { return std::isfinite(y); });
   }
 
@@ -260,17 +258,29 @@ class TwentySimCore {
     finished_ = false;
   }
 
+  /// What a plant's and a controller's Info() say alike (PlantInfo, ControllerInfo): name,
+  /// kind, ports, the fixed step and the report's details.
+  template <class Info>
+  void Describe(Info& info) const {
+    info.name = spec_.name;
+    info.kind = "20-sim C++ class";
+    info.inputs = spec_.inputs;
+    info.outputs = spec_.outputs;
+    info.model_step_s = model_step_s_;
+    info.step_is_fixed = true;  // compiled into the constructor
+    info.details = Details();
+  }
+
   /// The report's facts: class, step, integrator, finish time, source folder.
   [[nodiscard]] std::vector<std::pair<std::string, std::string>> Details() const {
     using twentysim_detail::FormatNumber;
     std::vector<std::pair<std::string, std::string>> details = {
         {"class", spec_.class_name},
         {"step", FormatNumber(model_step_s_, 9) + " s (m_step_size)"},
-        {"integrator", spec_.integrator.empty() ? std::string("not known (myintegmethod)")
-                                                : spec_.integrator},
-        {"finish time", spec_.finish_time_s == 0.0
-                            ? std::string("0 s (endless)")
-                            : FormatNumber(spec_.finish_time_s, 9) + " s"},
+        {"integrator",
+         spec_.integrator.empty() ? std::string("not known (myintegmethod)") : spec_.integrator},
+        {"finish time", spec_.finish_time_s == 0.0 ? std::string("0 s (endless)")
+                                                   : FormatNumber(spec_.finish_time_s, 9) + " s"},
     };
     if (!spec_.source_dir.empty()) details.emplace_back("source", spec_.source_dir);
     return details;
