@@ -11,6 +11,8 @@
 // boards' own delays and quantisation are tests/unit/app/in_process_hil.h's; this rig holds the
 // control law and the adapter, so it needs only the model.
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -118,6 +120,17 @@ struct ClosedLoopFigures {
   double max_abs_duty = 0.0;
   std::size_t steps_not_ok = 0;
 };
+
+// The figures as test properties (in --gtest_output=xml), so a run shows them, not only pass.
+inline void RecordClosedLoopFigures(const ClosedLoopFigures& run) {
+  ::testing::Test::RecordProperty("max_abs_error_left_mm",
+                                  std::to_string(run.max_abs_error_left_m * 1e3));
+  ::testing::Test::RecordProperty("max_abs_error_right_mm",
+                                  std::to_string(run.max_abs_error_right_m * 1e3));
+  ::testing::Test::RecordProperty("final_error_left_mm",
+                                  std::to_string(run.final_error_left_m * 1e3));
+  ::testing::Test::RecordProperty("max_abs_duty", std::to_string(run.max_abs_duty));
+}
 
 // Runs `controller` (started here at the ECS's step) against the RELbot model over the whole
 // `closedloop` profile.

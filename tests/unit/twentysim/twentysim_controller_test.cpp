@@ -203,6 +203,7 @@ TEST(TwentySimController, StepAllocatesNothing) {
 TEST(TwentySimController, TracksTheTwoAndAHalfMetreMoveWithinTheThesisBound) {
   const std::unique_ptr<Controller> controller = MakePid20sim();
   const test::ClosedLoopFigures run = test::RunRelbotClosedLoop(*controller);
+  test::RecordClosedLoopFigures(run);
   EXPECT_EQ(run.steps_not_ok, 0U);
   EXPECT_LT(run.max_abs_error_left_m, 1.5e-3);
   EXPECT_LT(run.max_abs_error_right_m, 1.5e-3);
