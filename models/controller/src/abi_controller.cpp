@@ -18,8 +18,8 @@
 #include <utility>
 #include <vector>
 
-#include "content_hash.h"
 #include "elf_header.h"
+#include "hiltwin/controller/content_hash.h"
 #include "hiltwin/controller_abi.h"
 #include "hiltwin/plant/twentysim_plant.h"  // FormatNumber, RateForStep: the same --rate advice
 

@@ -1,6 +1,6 @@
 // SHA-256 with OpenSSL's EVP interface (libcrypto, found by the top-level CMakeLists.txt), read
 // in blocks so a large library is never held in memory whole.
-#include "content_hash.h"
+#include "hiltwin/controller/content_hash.h"
 
 #include <openssl/evp.h>
 

@@ -1,6 +1,7 @@
 #pragma once
 // The SHA-256 of a controller's file, for ControllerInfo::content_sha256: the run report names
-// it so a result can be traced to the exact code that produced it (issue 37, item 4).
+// it so a result can be traced to the exact code that produced it (issue 37, item 4). Public:
+// the FMU controller (models/fmi) hashes its .fmu with it too.
 
 #include <filesystem>
 #include <string>
