@@ -2,6 +2,7 @@
 #include "hiltwin/controller/controller_task.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
@@ -33,6 +34,13 @@ double OnEncoderGrid(double value, double counts_per_unit) noexcept {
   return static_cast<double>(std::llround(counts)) / counts_per_unit;
 }
 
+/// `value` in its shortest form that reads back to the same double ("0.8").
+std::string Shortest(double value) {
+  std::array<char, 32> text{};
+  const auto end = std::to_chars(text.data(), text.data() + text.size(), value).ptr;
+  return {text.data(), end};
+}
+
 std::string Describe(const ControllerInfo& info) {
   return "controller '" + info.name + "' (--controller " + info.spec + ")";
 }
@@ -58,7 +66,7 @@ ControllerTask::ControllerTask(io::IcoBoard& board, Controller& controller,
         {who + " stopped: output '" + port + "' is not finite (NaN or infinite); the motors "
                                              "were stopped",
          who + " stopped: output '" + port + "' asks for a duty beyond its duty_limit " +
-             std::to_string(route.duty_limit) + "; the motors were stopped"});
+             Shortest(route.duty_limit) + "; the motors were stopped"});
   }
   error_status_text_ = who + " stopped: its step returned an error; the motors were stopped";
   period_text_ = who + ": the session's period differs from the ECS task's (the controller "
