@@ -102,14 +102,19 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--ecs-rate", o->ecs_rate_hz, "controller rate in Hz")->capture_default_str();
   app->add_option("--duration", o->duration_s,
                   "controller run length in seconds (default: the profile's length)");
-  app->add_option("--mode", o->mode, "closedloop (PID on --setpoint) or openloop (--input duty)")
+  app->add_option("--mode", o->mode,
+                  "closedloop (--controller on --setpoint) or openloop (--input duty)")
       ->check(CLI::IsMember({"closedloop", "openloop"}))
       ->capture_default_str();
   app->add_option("--setpoint", o->setpoint, "closed loop: closedloop or CSV time,left_m,right_m")
       ->capture_default_str();
   app->add_option("--input", o->input, "open loop: openloop or CSV time,left,right")
       ->capture_default_str();
-  app->add_option("--gains", o->gains_path, "PID gains (TOML, relbot/ecs_gains.toml)");
+  app->add_option("--controller", o->controller,
+                  "the ECS's controller: pid (default), lib:PATH.so, 20sim:NAME, fmu:PATH.fmu");
+  app->add_option("--controller-map", o->controller_map_path,
+                  "the ECS's controller map (TOML; default: relbot/ecs_controller_map.toml)");
+  app->add_option("--gains", o->gains_path, "--controller pid's gains (TOML, relbot/ecs_gains.toml)");
   app->add_option("--config", o->config_path, "RELbot parameters (TOML), for both sides");
   app->add_option("--twin-qos", o->twin_qos, "twin (m,k) rule M:K (repeatable)");
   app->add_option("--ecs-qos", o->ecs_qos, "controller (m,k) rule M:K (repeatable)");

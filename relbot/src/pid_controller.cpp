@@ -35,7 +35,7 @@ controller::ControllerInfo PidInfo() {
                  {"wheel_left_m", "m"},
                  {"wheel_right_m", "m"}};
   info.outputs = {{"duty_left", "1"}, {"duty_right", "1"}};
-  info.details = {{"controller", "position PID per wheel (thesis 7.2), gains from --gains"}};
+  info.details = {{"algorithm", "position PID per wheel (thesis 7.2), gains from --gains"}};
   return info;
 }
 

@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "hiltwin/controller/controller.h"
+#include "hiltwin/controller/controller_task.h"
 #include "hiltwin/io/emulated_fpga.h"
 #include "hiltwin/io/encoder_lines.h"
 #include "hiltwin/io/icoboard.h"
@@ -21,6 +23,9 @@ struct EcsFigures {
   TrackingStats tracking;
   io::LinkCounters link;
   std::optional<io::EncoderLineCounters> encoder_lines;  ///< emulated boards only
+  /// Closed loop: the controller that ran, and why it was stopped (kind kNone: it was not).
+  std::optional<controller::ControllerInfo> controller;
+  controller::ControllerFault fault;
 };
 
 /// Collects the figures after the run (the loop has stopped).
@@ -29,11 +34,15 @@ struct EcsFigures {
 
 /// The run report's JSON with the ECS's sections: `tracking` (closed loop: `max_abs_error_m`
 /// {left, right}, `rms_error_m`, `final_error_m` {left, right}, `saturated_cycles`,
-/// `max_abs_duty`; null in open loop), `link_counters` and `encoder_lines` (null on spidev).
+/// `max_abs_duty`; null in open loop), `controller` (closed loop: `spec`, `kind`, `name`,
+/// `file`, `content_sha256`, `inputs` and `outputs` [{name, unit}], `model_step_s`, `details`,
+/// `fault`: null, or {`kind`, `output`, `value`, `duty_limit`, `reason`, `cycle`}; null in open
+/// loop), `link_counters` and `encoder_lines` (null on spidev).
 [[nodiscard]] nlohmann::ordered_json EcsReportJson(const runtime::RunReport& report,
                                                    const EcsFigures& figures);
 
-/// Summary lines printed before the run summary ("tracking  ..." in closed loop).
+/// Summary lines printed before the run summary ("tracking  ..." in closed loop, "controller
+/// stopped ..." when it was).
 [[nodiscard]] std::string FormatEcsFigures(const EcsFigures& figures);
 
 }  // namespace hiltwin::app
