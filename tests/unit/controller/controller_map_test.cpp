@@ -7,7 +7,7 @@
 #include <numbers>
 #include <string>
 
-#include "fake_controller.h"
+#include "fakes/fake_controller.h"
 
 namespace hiltwin::controller {
 namespace {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "fake_controller.h"
+#include "fakes/fake_controller.h"
 #include "hiltwin/controller/content_hash.h"
 
 namespace hiltwin::controller {

@@ -9,7 +9,7 @@
 #include <numbers>
 #include <string>
 
-#include "fake_controller.h"
+#include "fakes/fake_controller.h"
 #include "fakes/alloc_counter.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/emulated_fpga.h"
