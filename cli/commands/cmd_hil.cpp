@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "commands.h"
+#include "hiltwin/controller/controller_map.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/setpoint_profile.h"
@@ -72,10 +73,19 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
 
 /// The flags, read once, in the order they are checked (exit 2 naming the flag): the files (no
 /// output names an input or another output), the rates and the duration (0: the profile's
-/// length, read here), the telemetry flags and the wire's name.
+/// length, read here), the controller map's syntax, the telemetry flags and the wire's name.
 HilRunOptions HilRunOptionsOf(HilRunOptions o) {
   CheckFilesDistinct(HilFiles(o));
   Validate(o);
+  // A map that does not parse is the parent's exit 2 with its place, before any side starts;
+  // whether it fits the controller the ECS checks (its exit 2).
+  if (!o.controller_map_path.empty()) {
+    try {
+      static_cast<void>(controller::LoadControllerMap(o.controller_map_path));
+    } catch (const controller::ControllerMapError& e) {
+      ThrowUsage(e.what());
+    }
+  }
   ValidateTelemetry(o.telemetry);
   if (o.wire.empty()) o.wire = "hil-" + std::to_string(::getpid());
   try {
