@@ -25,6 +25,7 @@ struct EcsFlags {
   std::string setpoint = "closedloop";
   std::string input = "openloop";
   std::string controller = "pid";
+  bool controller_given = false;
   std::string controller_map_path;
   std::string gains_path;
   std::string config_path;
@@ -50,6 +51,12 @@ EcsRunOptions EcsRunOptionsOf(const EcsFlags& f) {
   o.mode = f.mode == "openloop" ? EcsMode::kOpenLoop : EcsMode::kClosedLoop;  // CLI11-checked
   o.setpoint = f.setpoint;
   o.input = f.input;
+  // Open loop plays a duty profile: no controller runs, so naming one is a mistake.
+  if (f.mode == "openloop" && (f.controller_given || !f.controller_map_path.empty())) {
+    ThrowUsage(std::string(f.controller_given ? "--controller" : "--controller-map") +
+               " is for --mode closedloop; open loop plays --input's duties without a "
+               "controller: drop it, or use --mode closedloop");
+  }
   o.controller = f.controller;
   o.controller_map_path = f.controller_map_path;
   o.gains_path = f.gains_path;
@@ -92,7 +99,8 @@ Command AddEcsCommand(CLI::App& parent) {
   app->add_option("--controller", o->controller,
                   "closed loop: the controller, pid (built in), lib:PATH.so (C ABI), 20sim:NAME or "
                   "fmu:PATH.fmu (docs/controllers.md)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->controller_given = true; });
   app->add_option("--controller-map", o->controller_map_path,
                   "controller map (TOML): which encoder, setpoint column and PWM channel meet "
                   "which controller port (default: the RELbot's, relbot/ecs_controller_map.toml)");
