@@ -160,21 +160,14 @@ ControllerMap ParseMapText(std::string_view toml_text, std::string_view source) 
 }  // namespace
 
 ControllerMap ParseControllerMap(std::string_view toml_text, std::string_view source_name) {
-  try {
-    return ParseMapText(toml_text, source_name);
-  } catch (const mt::MapTomlError& e) {
-    throw ControllerMapError(e.what());
-  }
+  return mt::Rethrown<ControllerMapError>([&] { return ParseMapText(toml_text, source_name); });
 }
 
 ControllerMap LoadControllerMap(const std::filesystem::path& path) {
-  std::string text;
-  try {
-    text = mt::ReadMapFile(path, "controller map",
+  const std::string text = mt::Rethrown<ControllerMapError>([&] {
+    return mt::ReadMapFile(path, "controller map",
                            "give an existing TOML file to --controller-map (docs/controllers.md)");
-  } catch (const mt::MapTomlError& e) {
-    throw ControllerMapError(e.what());
-  }
+  });
   return ParseControllerMap(text, path.string());
 }
 

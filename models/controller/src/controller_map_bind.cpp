@@ -4,23 +4,13 @@
 #include <string>
 
 #include "hiltwin/controller/controller_map.h"
+#include "hiltwin/plant/map_toml.h"
 
 namespace hiltwin::controller {
 namespace {
 
-std::optional<std::size_t> PortIndex(const std::vector<Port>& ports, const std::string& name) {
-  for (std::size_t i = 0; i < ports.size(); ++i) {
-    if (ports[i].name == name) return i;
-  }
-  return std::nullopt;
-}
-
-std::string PortNames(const std::vector<Port>& ports) {
-  if (ports.empty()) return "none";
-  std::string out;
-  for (const Port& port : ports) out += (out.empty() ? "" : ", ") + port.name;
-  return out;
-}
+using plant::map_toml::PortIndex;
+using plant::map_toml::PortNames;
 
 /// Says where in the map and which controller, then what.
 class ControllerBinder {

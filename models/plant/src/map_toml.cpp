@@ -234,4 +234,18 @@ std::vector<ConstantInput> ParseConstants(std::string_view source, const toml::t
   return out;
 }
 
+std::optional<std::size_t> PortIndex(const std::vector<Port>& ports, const std::string& name) {
+  for (std::size_t i = 0; i < ports.size(); ++i) {
+    if (ports[i].name == name) return i;
+  }
+  return std::nullopt;
+}
+
+std::string PortNames(const std::vector<Port>& ports) {
+  if (ports.empty()) return "none";
+  std::string out;
+  for (const Port& port : ports) out += (out.empty() ? "" : ", ") + port.name;
+  return out;
+}
+
 }  // namespace hiltwin::plant::map_toml

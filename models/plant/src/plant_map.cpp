@@ -92,21 +92,14 @@ PlantMap ParseMap(std::string_view toml_text, std::string_view source_name) {
 }  // namespace
 
 PlantMap ParsePlantMap(std::string_view toml_text, std::string_view source_name) {
-  try {
-    return ParseMap(toml_text, source_name);
-  } catch (const map_toml::MapTomlError& e) {
-    throw PlantMapError(e.what());
-  }
+  return map_toml::Rethrown<PlantMapError>([&] { return ParseMap(toml_text, source_name); });
 }
 
 PlantMap LoadPlantMap(const std::filesystem::path& path) {
-  std::string text;
-  try {
-    text = map_toml::ReadMapFile(path, "plant map",
+  const std::string text = map_toml::Rethrown<PlantMapError>([&] {
+    return map_toml::ReadMapFile(path, "plant map",
                                  "give an existing TOML file to --plant-map (docs/plants.md)");
-  } catch (const map_toml::MapTomlError& e) {
-    throw PlantMapError(e.what());
-  }
+  });
   return ParsePlantMap(text, path.string());
 }
 

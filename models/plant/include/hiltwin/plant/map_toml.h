@@ -90,6 +90,22 @@ class Entry {
 [[nodiscard]] std::vector<ConstantInput> ParseConstants(std::string_view source,
                                                         const toml::table& root);
 
+/// `parse()`, with a MapTomlError turned into the map's own `Error` with the same message.
+template <class Error, class Fn>
+auto Rethrown(Fn&& parse) -> decltype(parse()) {
+  try {
+    return parse();
+  } catch (const MapTomlError& e) {
+    throw Error(e.what());
+  }
+}
+
+/// The index of the port called `name`, if any (both binders resolve names with it).
+[[nodiscard]] std::optional<std::size_t> PortIndex(const std::vector<Port>& ports,
+                                                   const std::string& name);
+/// "a, b, c", or "none": the ports a message lists as what exists instead.
+[[nodiscard]] std::string PortNames(const std::vector<Port>& ports);
+
 /// One board channel carries one signal per direction. `tables` are the routes' own, for the
 /// place of the second `channel`.
 template <class Route>
