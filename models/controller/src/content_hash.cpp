@@ -22,7 +22,7 @@ namespace {
 std::string Hex(const unsigned char* bytes, unsigned int size) {
   static constexpr char kDigits[] = "0123456789abcdef";
   std::string out;
-  out.reserve(2U * size);
+  out.reserve(static_cast<std::size_t>(size) * 2U);
   for (unsigned int i = 0; i < size; ++i) {
     out += kDigits[bytes[i] >> 4U];
     out += kDigits[bytes[i] & 0x0fU];
