@@ -32,6 +32,11 @@ class FakeController final : public Controller {
   static std::vector<Port> RelbotOutputs() { return {{"duty_left", "1"}, {"duty_right", "1"}}; }
 
   [[nodiscard]] const ControllerInfo& Info() const noexcept override { return info_; }
+  /// A controller that runs only at `step_s` (20-sim code, an ABI controller that says so).
+  void FixStep(double step_s) {
+    info_.model_step_s = step_s;
+    info_.step_is_fixed = true;
+  }
   void Start(double step_s) override {
     started_step_s = step_s;
     ++starts;

@@ -45,6 +45,20 @@ std::string Describe(const ControllerInfo& info) {
   return "controller '" + info.name + "' (--controller " + info.spec + ")";
 }
 
+/// A controller whose step is compiled in runs only at that step (to a part in 10^9: the
+/// period is whole nanoseconds).
+void CheckFixedStep(const ControllerInfo& info, std::int64_t period_ns) {
+  const double step_s = static_cast<double>(period_ns) * 1e-9;
+  if (!info.step_is_fixed || std::abs(step_s - info.model_step_s) <= 1e-9 * info.model_step_s) {
+    return;
+  }
+  throw ControllerError(Describe(info) + " runs only at its own step of " +
+                        Shortest(info.model_step_s) + " s, but the ECS's period is " +
+                        Shortest(step_s) + " s: run the ECS at --rate " +
+                        Shortest(1.0 / info.model_step_s) + ", or regenerate the controller "
+                        "for this step");
+}
+
 }  // namespace
 
 ControllerTask::ControllerTask(io::IcoBoard& board, Controller& controller,
@@ -74,6 +88,7 @@ ControllerTask::ControllerTask(io::IcoBoard& board, Controller& controller,
   for (std::size_t s = 0; s < map_.setpoints.size(); ++s) {
     if (const auto e = map_.setpoints[s].tracked_encoder) pairs_.push_back({s, *e});
   }
+  CheckFixedStep(info, period_ns_);
   controller_.Start(static_cast<double>(period_ns_) * 1e-9);
 }
 

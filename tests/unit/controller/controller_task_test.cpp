@@ -247,6 +247,26 @@ TEST(ControllerTask, TheCyclePathAllocatesNothing) {
   EXPECT_EQ(fake.steps, 200);
 }
 
+TEST(ControllerTask, AControllerWithAFixedStepRunsOnlyAtIt) {
+  LoneBoard rig;
+  const Ramp ramp;
+  FakeController fake(FakeController::RelbotInputs(), FakeController::RelbotOutputs());
+  fake.FixStep(0.002);
+  try {
+    const ControllerTask task(rig.driver, fake, Bind(fake), ramp, kPeriodNs);
+    FAIL() << "no error";
+  } catch (const ControllerError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "controller 'fake' (--controller fake) runs only at its own step of 0.002 s, but "
+              "the ECS's period is 0.001 s: run the ECS at --rate 500, or regenerate the "
+              "controller for this step");
+  }
+  EXPECT_EQ(fake.starts, 0);
+  fake.FixStep(0.001);
+  const ControllerTask task(rig.driver, fake, Bind(fake), ramp, kPeriodNs);
+  EXPECT_EQ(fake.starts, 1);
+}
+
 TEST(ControllerTask, TheLogHasTheControllersInputsThenOutputs) {
   LoneBoard rig;
   const Ramp ramp;

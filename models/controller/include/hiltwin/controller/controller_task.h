@@ -66,7 +66,8 @@ struct ControllerFault {
 class ControllerTask final : public runtime::RunTask {
  public:
   /// Starts `controller` at period_ns (Controller::Start: ControllerError when it cannot run
-  /// at it). None of the references is owned; all must outlive the task. `map` must be bound
+  /// at it; without starting it when its step is fixed (ControllerInfo::step_is_fixed) at
+  /// another). None of the references is owned; all must outlive the task. `map` must be bound
   /// to `controller`. Throws std::invalid_argument for period_ns <= 0.
   ControllerTask(io::IcoBoard& board, Controller& controller, BoundControllerMap map,
                  const SetpointColumns& setpoints, std::int64_t period_ns);
