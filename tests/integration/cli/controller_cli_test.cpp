@@ -58,6 +58,13 @@ TEST_F(ControllerCli, GainsBesideAnotherControllerIsRefusedNamingBothFlags) {
                                "lib:./my_pd.so is another controller: drop --gains"));
 }
 
+TEST_F(ControllerCli, AControllerInOpenLoopIsRefused) {
+  const auto r = Ecs({"--mode", "openloop", "--controller", "pid"});
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--controller is for --mode closedloop; open loop plays --input's "
+                               "duties without a controller: drop it, or use --mode closedloop"));
+}
+
 TEST_F(ControllerCli, TheStartLineAndTheReportNameThePidAsBuiltIn) {
   const auto r = Ecs({"--report", Path("r.json")});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
