@@ -10,8 +10,8 @@ include(CMakePackageConfigHelpers)
 # The engine and the models (docs/architecture.md, "Tiers"). The RELbot, the tools outside the
 # loop (observe/) and the program (cli/) stay inside the binary: they would pull Cyclone DDS,
 # FFTW and babeltrace into every user's link for nothing a plant or controller needs.
-set(HILTWIN_EXPORTED_MODULES lockfree kernel_glue scheduler qos lifecycle io tracing runtime plant fmi
-    controller)
+set(HILTWIN_EXPORTED_MODULES lockfree kernel_glue scheduler qos lifecycle io tracing runtime plant
+    fmi controller)
 set(HILTWIN_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/hiltwin")
 set(HILTWIN_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/hiltwin")
 

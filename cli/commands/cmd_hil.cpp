@@ -124,7 +124,8 @@ Command AddHilCommand(CLI::App& parent) {
                   "the ECS's controller: pid (default), lib:PATH.so, 20sim:NAME, fmu:PATH.fmu");
   app->add_option("--controller-map", o->controller_map_path,
                   "the ECS's controller map (TOML; default: relbot/ecs_controller_map.toml)");
-  app->add_option("--gains", o->gains_path, "--controller pid's gains (TOML, relbot/ecs_gains.toml)");
+  app->add_option("--gains", o->gains_path,
+                  "--controller pid's gains (TOML, relbot/ecs_gains.toml)");
   app->add_option("--config", o->config_path, "RELbot parameters (TOML), for both sides");
   app->add_option("--twin-qos", o->twin_qos, "twin (m,k) rule M:K (repeatable)");
   app->add_option("--ecs-qos", o->ecs_qos, "controller (m,k) rule M:K (repeatable)");

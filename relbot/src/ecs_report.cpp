@@ -40,7 +40,9 @@ const char* ToString(controller::ControllerFault::Kind kind) {
 
 Json PortsJson(const std::vector<controller::Port>& ports) {
   Json out = Json::array();
-  for (const controller::Port& port : ports) out.push_back({{"name", port.name}, {"unit", port.unit}});
+  for (const controller::Port& port : ports) {
+    out.push_back({{"name", port.name}, {"unit", port.unit}});
+  }
   return out;
 }
 

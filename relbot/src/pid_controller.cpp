@@ -94,8 +94,9 @@ void RegisterPidController() {
          "the built-in position PID per wheel, thesis 7.2 (--gains)",
          [](const controller::ControllerOptions& o) -> std::unique_ptr<controller::Controller> {
            try {
-             return std::make_unique<PidController>(o.gains_path.empty() ? DefaultEcsGains()
-                                                                         : LoadEcsGains(o.gains_path));
+             const PidGains gains =
+                 o.gains_path.empty() ? DefaultEcsGains() : LoadEcsGains(o.gains_path);
+             return std::make_unique<PidController>(gains);
            } catch (const ConfigError& e) {
              throw controller::ControllerError(e.what());
            }

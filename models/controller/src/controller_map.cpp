@@ -96,7 +96,9 @@ void CheckFedOnce(std::string_view source, const ControllerMap& map) {
   for (const SetpointInput& r : map.setpoints) {
     feed(r.input, r.line, r.col, "setpoint column " + r.column);
   }
-  for (const ConstantControllerInput& c : map.constant_inputs) feed(c.name, c.line, c.col, "[inputs]");
+  for (const ConstantControllerInput& c : map.constant_inputs) {
+    feed(c.name, c.line, c.col, "[inputs]");
+  }
 }
 
 /// `tracks` names an input an encoder feeds, in metres as the setpoint columns are.

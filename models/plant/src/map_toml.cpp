@@ -163,7 +163,8 @@ std::pair<int, int> Entry::Place(std::string_view key) const {
 std::string Entry::EncoderUnit() const {
   std::string unit = String("unit", true);
   if (unit != "m" && unit != "rad") {
-    Fail("unit", name_ + ": unit \"" + unit + "\" is not one an encoder measures: \"m\" or \"rad\"");
+    Fail("unit",
+         name_ + ": unit \"" + unit + "\" is not one an encoder measures: \"m\" or \"rad\"");
   }
   return unit;
 }

@@ -247,7 +247,8 @@ TEST(ControllerMap, UnitMismatchesAreRefused) {
   EXPECT_EQ(BindError(kGood, radians),
             "c.toml:4:9: encoder input 'wheel_left_m' is in rad but the map gives it m: make "
             "the units agree (the map's unit, or the controller's) (controller fake)");
-  const FakeController volts(FakeController::RelbotInputs(), {{"duty_left", "V"}, {"duty_right", "1"}});
+  const FakeController volts(FakeController::RelbotInputs(),
+                             {{"duty_left", "V"}, {"duty_right", "1"}});
   EXPECT_EQ(BindError(kGood, volts),
             "c.toml:29:10: PWM output 'duty_left' is in V but the map gives it 1: make the "
             "units agree (the map's unit, or the controller's) (controller fake)");

@@ -158,7 +158,7 @@ class EcsTask final : public runtime::RunTask {
   io::EcsInputs inputs_{};  ///< open loop
   std::array<std::int32_t, io::kChannels> pwm_next_{};  ///< computed by the last step
   std::array<std::int32_t, io::kChannels> pwm_sent_{};  ///< on the wire since the last exchange
-  std::array<std::int64_t, 2> origin_counts_{};         ///< open loop: left, right at the first step
+  std::array<std::int64_t, 2> origin_counts_{};  ///< open loop: left, right at the first step
   bool have_inputs_ = false;       ///< an exchange has succeeded: the counts are a reading
   bool started_ = false;           ///< the origin is taken
   std::uint64_t held_cycles_ = 0;  ///< exchanges with safe outputs (paused): not profile time

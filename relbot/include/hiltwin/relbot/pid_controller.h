@@ -1,9 +1,9 @@
 #pragma once
-/// The built-in position PID (thesis §7.2) as a controller (controller/controller.h), `--controller
-/// pid`, the default: inputs setpoint_left_m, setpoint_right_m, wheel_left_m, wheel_right_m (m),
-/// outputs duty_left, duty_right (1), one PositionPid per wheel with the --gains. And the RELbot's
-/// controller map, the board wiring every controller kind runs with when no --controller-map is
-/// given (relbot/ecs_controller_map.toml is the same map as a file).
+/// The built-in position PID (thesis §7.2) as a controller (controller/controller.h),
+/// `--controller pid`, the default: inputs setpoint_left_m, setpoint_right_m, wheel_left_m,
+/// wheel_right_m (m), outputs duty_left, duty_right (1), one PositionPid per wheel with the
+/// --gains. And the RELbot's controller map, the board wiring every controller kind runs with
+/// when no --controller-map is given (relbot/ecs_controller_map.toml is the same map as a file).
 
 #include <memory>
 
@@ -39,10 +39,10 @@ class PidController final : public controller::Controller {
   PositionPid right_;
 };
 
-/// The RELbot's controller map for a wheel geometry (WheelGeometryOf(params) of --config): encoder channels per
-/// relbot_channels.h into wheel_left_m / wheel_right_m, setpoint columns left_m / right_m into
-/// setpoint_left_m / setpoint_right_m (tracking their wheels, on the encoder grid), duty_left /
-/// duty_right onto the PWM channels with gain 1 and duty_limit 1.
+/// The RELbot's controller map for a wheel geometry (WheelGeometryOf(params) of --config):
+/// encoder channels per relbot_channels.h into wheel_left_m / wheel_right_m, setpoint columns
+/// left_m / right_m into setpoint_left_m / setpoint_right_m (tracking their wheels, on the
+/// encoder grid), duty_left / duty_right onto the PWM channels with gain 1 and duty_limit 1.
 [[nodiscard]] controller::ControllerMap RelbotControllerMap(const io::WheelGeometry& geometry);
 
 /// Registers `pid` (controller_registry.h); idempotent. The command line calls it before it

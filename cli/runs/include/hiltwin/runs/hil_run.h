@@ -41,7 +41,8 @@ struct HilRunOptions {
 };
 
 /// Every file hil reads and writes, for CheckFilesDistinct: the profiles (unless built in),
-/// --controller-map, --gains, --config, --report and, with --log-dir, each side's report, log and output there.
+/// --controller-map, --gains, --config, --report and, with --log-dir, each side's report, log
+/// and output there.
 [[nodiscard]] std::vector<NamedFile> HilFiles(const HilRunOptions& o);
 
 /// Starts both sides, waits for them (a stop signal is passed on), prints the combined summary
