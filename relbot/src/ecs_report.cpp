@@ -16,6 +16,7 @@ EcsFigures EcsFiguresOf(const EcsTask& task, const io::IcoBoardLink& driver,
   if (const controller::ControllerTask* loop = task.controller_task()) {
     figures.controller = loop->controller().Info();
     figures.fault = loop->fault();
+    figures.pairs = loop->tracking();
   }
   return figures;
 }
@@ -54,6 +55,21 @@ Json FaultJson(const controller::ControllerFault& f) {
           {"duty_limit", f.duty_limit}, {"reason", f.reason}, {"cycle", f.cycle}};
 }
 
+Json PairsJson(const EcsFigures& f) {
+  if (!f.controller) return nullptr;
+  Json out = Json::array();
+  for (const controller::TrackingPair& p : f.pairs) {
+    out.push_back({{"column", p.column},
+                   {"input", p.input},
+                   {"tracks", p.tracked},
+                   {"samples", p.samples},
+                   {"max_abs_error", p.max_abs_error},
+                   {"rms_error", p.rms_error},
+                   {"final_error", p.final_error}});
+  }
+  return out;
+}
+
 Json ControllerJson(const EcsFigures& f) {
   if (!f.controller) return nullptr;
   const controller::ControllerInfo& c = *f.controller;
@@ -90,6 +106,7 @@ nlohmann::ordered_json EcsReportJson(const runtime::RunReport& report, const Ecs
                  {"saturated_cycles", t.saturated_cycles},
                  {"max_abs_duty", t.max_abs_duty}};
   json["controller"] = ControllerJson(f);
+  json["tracking_pairs"] = PairsJson(f);
   const io::LinkCounters& l = f.link;
   json["link_counters"] = {{"frames_sent", l.frames_sent},
                            {"frames_received", l.frames_received},

@@ -53,6 +53,7 @@ EcsTask::EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints,
       period_ns_(CheckedPeriodNs(period_ns)) {
   columns_.emplace(setpoints);
   loop_.emplace(board, controller, std::move(map), *columns_, period_ns);
+  pid_ = dynamic_cast<const PidController*>(&controller);
 }
 
 EcsTask::EcsTask(io::IcoBoard& board, const InputProfile& duty_profile,
@@ -140,6 +141,10 @@ runtime::StepStatus EcsTask::Step(const scheduler::CycleContext& context) noexce
   if (loop_) {
     const runtime::StepStatus status = loop_->Step(context);
     RecordClosedLoop();
+    if (pid_ != nullptr && status.code == runtime::StepStatus::Code::kOk &&
+        (pid_->left().last().saturated || pid_->right().last().saturated)) {
+      ++pid_saturated_cycles_;
+    }
     return status;
   }
   // The profile's clock runs only while the task runs: after a pause the duties go on from
@@ -211,7 +216,7 @@ TrackingStats EcsTask::tracking() const noexcept {
   if (stats.samples > 0) {
     stats.rms_error_m = std::sqrt(sum_sq_m2 / (2.0 * static_cast<double>(stats.samples)));
   }
-  stats.saturated_cycles = loop_->saturated_cycles();
+  stats.saturated_cycles = pid_ != nullptr ? pid_saturated_cycles_ : loop_->saturated_cycles();
   stats.max_abs_duty = loop_->max_abs_duty();
   return stats;
 }

@@ -136,6 +136,14 @@ TEST(ControllerSafety, AWellBehavedControllerRunsToTheEndAndIsNamedInTheReport) 
   EXPECT_EQ(o.json["controller"]["kind"], "test");
   EXPECT_TRUE(o.json["controller"]["fault"].is_null());
   EXPECT_GT(o.json["tracking"]["max_abs_error_m"]["left"].get<double>(), 0.0);
+  // The map's pairs, the left one the ECS's left wheel figures.
+  const auto& pairs = o.json["tracking_pairs"];
+  ASSERT_EQ(pairs.size(), 2U);
+  EXPECT_EQ(pairs[0]["column"], "left_m");
+  EXPECT_EQ(pairs[0]["tracks"], "wheel_left_m");
+  EXPECT_EQ(pairs[0]["max_abs_error"], o.json["tracking"]["max_abs_error_m"]["left"]);
+  EXPECT_EQ(pairs[1]["final_error"], o.json["tracking"]["final_error_m"]["right"]);
+  EXPECT_EQ(pairs[1]["samples"], 2000);
 }
 
 /// Busy-waits `ns` on CLOCK_MONOTONIC: a controller whose step takes that long.

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "hiltwin/controller/controller.h"
 #include "hiltwin/controller/controller_task.h"
@@ -26,6 +27,8 @@ struct EcsFigures {
   /// Closed loop: the controller that ran, and why it was stopped (kind kNone: it was not).
   std::optional<controller::ControllerInfo> controller;
   controller::ControllerFault fault;
+  /// Closed loop: the tracking error of each `tracks` pair of the controller map.
+  std::vector<controller::TrackingPair> pairs;
 };
 
 /// Collects the figures after the run (the loop has stopped).
@@ -37,7 +40,9 @@ struct EcsFigures {
 /// `max_abs_duty`; null in open loop), `controller` (closed loop: `spec`, `kind`, `name`,
 /// `file`, `content_sha256`, `inputs` and `outputs` [{name, unit}], `model_step_s`, `details`,
 /// `fault`: null, or {`kind`, `output`, `value`, `duty_limit`, `reason`, `cycle`}; null in open
-/// loop), `link_counters` and `encoder_lines` (null on spidev).
+/// loop), `tracking_pairs` (closed loop: per `tracks` pair of the map, {`column`, `input`,
+/// `tracks`, `samples`, `max_abs_error`, `rms_error`, `final_error`}, in the pair's unit; null
+/// in open loop), `link_counters` and `encoder_lines` (null on spidev).
 [[nodiscard]] nlohmann::ordered_json EcsReportJson(const runtime::RunReport& report,
                                                    const EcsFigures& figures);
 

@@ -36,6 +36,7 @@
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/pid_controller.h"
 #include "hiltwin/relbot/position_pid.h"
 #include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/relbot/setpoint_profile.h"
@@ -56,7 +57,9 @@ struct TrackingStats {
   double rms_error_m = 0.0;         ///< over both wheels together
   double final_error_left_m = 0.0;  ///< at the last step
   double final_error_right_m = 0.0;
-  std::uint64_t saturated_cycles = 0;  ///< steps in which either wheel's output hit its limit
+  /// Steps in which either wheel's output hit its limit: the built-in PID's own (--gains),
+  /// another controller's duty at its route's duty_limit.
+  std::uint64_t saturated_cycles = 0;
   double max_abs_duty = 0.0;           ///< largest |duty| commanded, either wheel
 };
 
@@ -153,6 +156,10 @@ class EcsTask final : public runtime::RunTask {
   io::WheelGeometry geometry_;
   std::int64_t period_ns_;
   std::unique_ptr<controller::Controller> owned_controller_;  ///< the built-in PID's
+  /// The controller when it is the built-in PID: its own saturation flag counts saturated
+  /// cycles, as before controllers were pluggable (its --gains limit may be below the map's).
+  const PidController* pid_ = nullptr;
+  std::uint64_t pid_saturated_cycles_ = 0;
   std::optional<ProfileColumns> columns_;                     ///< closed loop
   std::optional<controller::ControllerTask> loop_;            ///< closed loop
   io::EcsInputs inputs_{};  ///< open loop
