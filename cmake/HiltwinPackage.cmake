@@ -62,7 +62,7 @@ set(CPACK_COMPONENT_DEV_DEPENDS runtime)
 set(CPACK_DEBIAN_ENABLE_COMPONENT_DEPENDS ON)
 # What cmake/hiltwinConfig.cmake.in finds, as Debian names it (Threads is libc's).
 set(dev_depends libspdlog-dev "nlohmann-json3-dev (>= 3.11)" libtomlplusplus-dev libxml2-dev
-    libzip-dev pkg-config)
+    libzip-dev libssl-dev pkg-config)
 if(HILTWIN_WITH_LTTNG)
   list(APPEND dev_depends liblttng-ust-dev)
 endif()

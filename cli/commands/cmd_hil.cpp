@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "commands.h"
+#include "hiltwin/controller/controller_map.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/setpoint_profile.h"
@@ -72,10 +73,19 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
 
 /// The flags, read once, in the order they are checked (exit 2 naming the flag): the files (no
 /// output names an input or another output), the rates and the duration (0: the profile's
-/// length, read here), the telemetry flags and the wire's name.
+/// length, read here), the controller map's syntax, the telemetry flags and the wire's name.
 HilRunOptions HilRunOptionsOf(HilRunOptions o) {
   CheckFilesDistinct(HilFiles(o));
   Validate(o);
+  // A map that does not parse is the parent's exit 2 with its place, before any side starts;
+  // whether it fits the controller the ECS checks (its exit 2).
+  if (!o.controller_map_path.empty()) {
+    try {
+      static_cast<void>(controller::LoadControllerMap(o.controller_map_path));
+    } catch (const controller::ControllerMapError& e) {
+      ThrowUsage(e.what());
+    }
+  }
   ValidateTelemetry(o.telemetry);
   if (o.wire.empty()) o.wire = "hil-" + std::to_string(::getpid());
   try {
@@ -102,14 +112,20 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--ecs-rate", o->ecs_rate_hz, "controller rate in Hz")->capture_default_str();
   app->add_option("--duration", o->duration_s,
                   "controller run length in seconds (default: the profile's length)");
-  app->add_option("--mode", o->mode, "closedloop (PID on --setpoint) or openloop (--input duty)")
+  app->add_option("--mode", o->mode,
+                  "closedloop (--controller on --setpoint) or openloop (--input duty)")
       ->check(CLI::IsMember({"closedloop", "openloop"}))
       ->capture_default_str();
   app->add_option("--setpoint", o->setpoint, "closed loop: closedloop or CSV time,left_m,right_m")
       ->capture_default_str();
   app->add_option("--input", o->input, "open loop: openloop or CSV time,left,right")
       ->capture_default_str();
-  app->add_option("--gains", o->gains_path, "PID gains (TOML, relbot/ecs_gains.toml)");
+  app->add_option("--controller", o->controller,
+                  "the ECS's controller: pid (default), lib:PATH.so, 20sim:NAME, fmu:PATH.fmu");
+  app->add_option("--controller-map", o->controller_map_path,
+                  "the ECS's controller map (TOML; default: relbot/ecs_controller_map.toml)");
+  app->add_option("--gains", o->gains_path,
+                  "--controller pid's gains (TOML, relbot/ecs_gains.toml)");
   app->add_option("--config", o->config_path, "RELbot parameters (TOML), for both sides");
   app->add_option("--twin-qos", o->twin_qos, "twin (m,k) rule M:K (repeatable)");
   app->add_option("--ecs-qos", o->ecs_qos, "controller (m,k) rule M:K (repeatable)");

@@ -47,6 +47,24 @@ std::optional<HilTracking> TrackingOf(const std::optional<Json>& ecs) {
   return tracking;
 }
 
+/// The ECS report's `controller` section (closed loop), or null.
+Json ControllerOf(const HilSide& ecs) {
+  if (!ecs.report || !ecs.report->contains("controller")) return nullptr;
+  return (*ecs.report)["controller"];
+}
+
+/// "controller pid (built-in): pid" and, for code from a file, its path and SHA-256: which code
+/// produced the result.
+std::string ControllerLine(const Json& c) {
+  if (!c.is_object()) return "";
+  const auto text = [&c](const char* key) {
+    return c.contains(key) && c[key].is_string() ? c[key].get<std::string>() : std::string();
+  };
+  std::string line = "controller " + text("spec") + " (" + text("kind") + "): " + text("name");
+  if (!text("file").empty()) line += "; " + text("file") + ", sha256 " + text("content_sha256");
+  return line + "\n";
+}
+
 Json SideExit(const HilSide& side) {
   return {{"exit_code", ExitCodeOf(side.status)}, {"ended", side.status.Describe()}};
 }
@@ -121,6 +139,7 @@ Json ToJson(const HilResult& r) {
   json["exit_code"] = r.exit_code;
   json["wire"] = r.wire;
   json["mode"] = r.mode;
+  json["controller"] = ControllerOf(r.ecs);
   if (r.tracking) {
     json["tracking_error_max_m"] = {{"left", r.tracking->max_left_m},
                                     {"right", r.tracking->max_right_m}};
@@ -144,7 +163,7 @@ Json ToJson(const HilResult& r) {
 }
 
 std::string FormatHilSummary(const HilResult& r) {
-  std::string out = SideLine(r.twin) + SideLine(r.ecs);
+  std::string out = SideLine(r.twin) + SideLine(r.ecs) + ControllerLine(ControllerOf(r.ecs));
   char text[400];
   if (r.tracking) {
     std::snprintf(text, sizeof text,
