@@ -11,7 +11,9 @@
 /// overruns reach the ECS's QoS verdict. Its outputs are checked before they reach a motor: an
 /// error status, a non-finite output or a duty beyond its route's duty_limit stops the
 /// controller with zero duty (safe outputs) and a model fault naming the controller, the port
-/// and what was wrong, so the run ends ABORTED (fault() has the details for the report).
+/// and what was wrong: the run ends as a plant's model fault does (exit 1, "the run did NOT
+/// finish: model fault at cycle N", docs/architecture.md "Exit codes"), and fault() has the
+/// details for the report.
 ///
 /// Time is the task's own: (cycle − paused cycles) × period_ns, so a pause stops the setpoint
 /// profile rather than skipping part of it. Everything on the loop's path is noexcept and
