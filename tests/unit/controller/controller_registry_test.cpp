@@ -73,8 +73,8 @@ TEST(ContentHash, TheSha256OfAFileIsItsBytesDigestInLowerCaseHex) {
     FAIL() << "no error";
   } catch (const ControllerError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "cannot compute the SHA-256 of /nonexistent/x.so: No such file or directory; give "
-              "a readable file");
+              "/nonexistent/x.so: cannot hash the controller's file (No such file or directory): "
+              "check that it is readable");
   }
 }
 
