@@ -2,10 +2,13 @@
 # `cmake --install` of this build folder into an empty prefix, then examples/lag_twin
 # configured, built and run against that prefix with find_package(hiltwin), as a user's own
 # project would be. The example is a plant stepped by the run assembly on the emulated board.
+# Last, docs/controllers.md's "Your first controller" is followed as a student would, against
+# the same prefix (doc_blocks.cmake).
 # In: BUILD_DIR, SOURCE_DIR, WORK_DIR, VERSION, GENERATOR, CXX_COMPILER; TOOLCHAIN_FILE and
 # EMULATOR when cross-compiling.
 cmake_minimum_required(VERSION 3.25)
 include("${CMAKE_CURRENT_LIST_DIR}/test_steps.cmake")
+include("${CMAKE_CURRENT_LIST_DIR}/doc_blocks.cmake")
 hiltwin_test_require_vars(BUILD_DIR SOURCE_DIR WORK_DIR VERSION GENERATOR)
 
 # The targets a plant or controller needs (the issue's contract, cmake/HiltwinInstall.cmake).
@@ -161,4 +164,33 @@ if(PROBE AND IN_TREE_CONTROLLER_DIR)
       HINT "see examples/controller_c_pd/my_pd.c")
   endif()
   message(STATUS "out-of-tree controller: ${out}")
+endif()
+
+# docs/controllers.md, "Your first controller", as a student follows it: its run blocks in a
+# fresh folder holding a copy of the example, with the staged hiltwin found as the page tells a
+# student to (PATH and CMAKE_PREFIX_PATH in the environment), so its lines run verbatim; its
+# file blocks equal the example, its lockstep output is the real one. The real-time run is run
+# too (12 s; exit 0 or 3, its figures are the machine's): it is the page's second command a
+# student types, and the only check that the page's real-time line still runs. Left out when
+# cross-compiling: the staged hiltwin is another machine's.
+if(NOT EMULATOR AND NOT TOOLCHAIN_FILE)
+  set(RUN_DIR "${WORK_DIR}/tutorial")
+  file(COPY "${SOURCE_DIR}/examples/controller_c_pd/" DESTINATION "${RUN_DIR}")
+  file(REMOVE_RECURSE "${RUN_DIR}/build")  # a student's copy has no build folder yet
+  set(ENV{PATH} "${stage}/bin:$ENV{PATH}")
+  set(ENV{CMAKE_PREFIX_PATH} "${stage}")
+  set(ENV{CMAKE_GENERATOR} "${GENERATOR}")
+  if(C_COMPILER)
+    set(ENV{CC} "${C_COMPILER}")
+  endif()
+  string(TIMESTAMP tutorial_start_s "%s")
+  hiltwin_doc_blocks("${SOURCE_DIR}/docs/controllers.md")
+  string(TIMESTAMP tutorial_end_s "%s")
+  math(EXPR tutorial_s "${tutorial_end_s} - ${tutorial_start_s}")
+  if(doc_blocks_checked LESS 6)
+    hiltwin_test_fail("docs/controllers.md" WHY "${doc_blocks_checked} tagged blocks, not 6"
+                      HINT "the tutorial lost its tags (doc_blocks.cmake): put them back")
+  endif()
+  message(STATUS "docs/controllers.md: ${doc_blocks_checked} tagged blocks checked, "
+                 "${tutorial_s} s")
 endif()
