@@ -200,6 +200,35 @@ INSTANTIATE_TEST_SUITE_P(EveryKind, ControllerKindsLoop,
                          ::testing::Values("pid", "lib_my_pd", "twentysim_pid20sim", "fmu_pid"),
                          [](const auto& kind) { return std::string(kind.param); });
 
+// --- The file a report names ----------------------------------------------------------
+
+// A controller given by a relative path (the tutorial's `lib:./my_pd.so`): the spec as typed,
+// the file absolute, so a report read elsewhere still says which file ran; lib and fmu alike.
+class ControllerFile : public ::testing::TestWithParam<const char*> {
+ protected:
+  hiltwin::test::WireScratch scratch_{"ctlfile"};
+};
+
+TEST_P(ControllerFile, ARelativePathIsReportedAbsolute) {
+  const bool lib = std::string(GetParam()) == "lib";
+  const std::string dir = lib ? HILTWIN_TEST_CONTROLLER_DIR : HILTWIN_TEST_FMU_DIR;
+  const std::string spec = lib ? "lib:./my_pd.so" : "fmu:./pid.fmu";
+  const std::string report = scratch_.Path("ecs.json");
+  const auto r = hiltwin::test::Run(
+      {"/bin/sh", "-c",
+       "cd '" + dir + "' && exec '" + HILTWIN_BINARY + "' ecs --no-progress --clock virtual " +
+           "--duration 0.01 --controller " + spec + " --report '" + report + "'"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const std::string file = (fs::path(dir) / (lib ? "my_pd.so" : "pid.fmu")).lexically_normal();
+  const Json ecs = ReadJson(report);
+  EXPECT_EQ(ecs["controller"]["spec"], spec);
+  EXPECT_EQ(ecs["controller"]["file"], file);
+  EXPECT_EQ(ecs["controller"]["content_sha256"], Sha256sum(file));
+  EXPECT_THAT(r.out, HasSubstr("controller file " + file + ", sha256 "));
+}
+
+INSTANTIATE_TEST_SUITE_P(LibAndFmu, ControllerFile, ::testing::Values("lib", "fmu"));
+
 // --- Every malformed controller, with its exit code and message -------------------------
 
 /// A library of tests/controllers and what `hiltwin ecs --controller lib:LIB` on the mock
