@@ -334,6 +334,40 @@ INSTANTIATE_TEST_SUITE_P(
                     "duty_limit": 1.0, "reason": "", "cycle": 0})")),
     [](const auto& row) { return std::string(row.param.library); });
 
+// --- A controller stopped in the loop ---------------------------------------------------
+
+// In the closed loop against the twin: a step error stops the controller with safe outputs,
+// the twin ends cleanly as its peer stopped, and hil's combined report names the controller and
+// its fault, the library's own text included.
+class ControllerStopped : public ControllerLockstep {};
+
+TEST_F(ControllerStopped, AStepErrorEndsThePairWithTheLibrarysTextInTheCombinedReport) {
+  const std::string library = ControllerLib("step_error");
+  const HilRun run = Hil("stopped", {"--controller", "lib:" + library});
+  EXPECT_EQ(run.result.exit_code, 1) << run.result.out << run.result.err;
+  const Json& hil = run.report;
+  ASSERT_TRUE(hil.is_object()) << run.result.out << run.result.err;
+  EXPECT_EQ(hil["exit_code"], 1);
+  EXPECT_EQ(hil["controller"]["spec"], "lib:" + library);
+  EXPECT_EQ(hil["controller"]["fault"]["kind"], "error status");
+  EXPECT_EQ(hil["controller"]["fault"]["reason"],
+            "wheel runaway: the test library stops at its third step");
+  EXPECT_EQ(hil["controller"]["fault"]["cycle"], 2);
+  EXPECT_EQ(hil["ecs"]["stop_reason"], "model_fault");
+  EXPECT_EQ(hil["ecs"]["outputs_safe"], true);
+  EXPECT_EQ(hil["ecs"]["cycles_run"], 3);
+  EXPECT_EQ(hil["twin"]["stop_reason"], "peer_stopped");
+  EXPECT_EQ(hil["twin"]["peer_stopped"], "wire: the ECS stopped on a fault (see its report)");
+  EXPECT_EQ(hil["twin"]["outputs_safe"], true);
+  EXPECT_EQ(hil["twin_exit"]["exit_code"], 0);
+  EXPECT_THAT(run.result.out, HasSubstr("hil       exit 1 (the worse of twin 0 and ECS 1)"));
+  EXPECT_THAT(run.result.err,
+              HasSubstr("ecs| controller lib:" + library +
+                        " stopped at cycle 2: error status "
+                        "(wheel runaway: the test library stops at its third step); safe "
+                        "outputs\n"));
+}
+
 // --- A crash of the user's code ------------------------------------------------------------
 
 // A library whose step() writes through NULL: the ECS process dies of SIGSEGV (the loader
