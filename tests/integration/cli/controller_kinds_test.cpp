@@ -80,11 +80,14 @@ class ControllerLockstep : public ::testing::Test {
     EXPECT_FALSE(fs::exists(scratch_.SegmentPath()))
         << "shared memory left behind: " << scratch_.SegmentPath();
   }
-  /// `hiltwin hil --clock virtual` on this test's wire with `extra`, its report in NAME.json.
-  HilRun Hil(const std::string& name, const std::vector<std::string>& extra) const {
-    std::vector<std::string> argv = {HILTWIN_BINARY,  "hil",      "--clock",
-                                     "virtual",       "--wire",   scratch_.WireName(),
-                                     "--no-progress", "--report", scratch_.Path(name + ".json")};
+  /// `hiltwin hil --clock virtual` on this test's wire with `extra`, its report in NAME.json;
+  /// `before`, if given, is the command that runs it (`env VAR=VALUE`).
+  HilRun Hil(const std::string& name, const std::vector<std::string>& extra,
+             const std::vector<std::string>& before = {}) const {
+    std::vector<std::string> argv = before;
+    argv.insert(argv.end(),
+                {HILTWIN_BINARY, "hil", "--clock", "virtual", "--wire", scratch_.WireName(),
+                 "--no-progress", "--report", scratch_.Path(name + ".json")});
     argv.insert(argv.end(), extra.begin(), extra.end());
     HilRun run{hiltwin::test::Run(argv, 120'000), Json()};
     const std::string report = scratch_.Path(name + ".json");
@@ -244,16 +247,16 @@ struct Malformed {
 void PrintTo(const Malformed& m, std::ostream* out) { *out << m.library; }
 
 /// Refused by the loader before the board opens: exit 2, the spec and what to do.
-Malformed Refused(const char* library, std::string message) {
-  return {library, 2, std::move(message), true, ""};
+Malformed Refused(const char* library, const std::string& message) {
+  return {library, 2, message, true, ""};
 }
 /// Refused by the controller map (the RELbot's default one) before the board opens.
-Malformed RefusedByTheMap(const char* library, std::string message) {
-  return {library, 2, std::move(message), false, ""};
+Malformed RefusedByTheMap(const char* library, const std::string& message) {
+  return {library, 2, message, false, ""};
 }
 /// Stopped during the run with safe outputs: exit 1, a model fault, and the report's fault.
-Malformed Stopped(const char* library, std::string message, std::string fault) {
-  return {library, 1, std::move(message), true, std::move(fault)};
+Malformed Stopped(const char* library, const std::string& message, const std::string& fault) {
+  return {library, 1, message, true, fault};
 }
 
 class ControllerMalformed : public ::testing::TestWithParam<Malformed> {
@@ -376,12 +379,16 @@ TEST_F(ControllerStopped, AStepErrorEndsThePairWithTheLibrarysTextInTheCombinedR
 class ControllerCrash : public ControllerLockstep {};
 
 TEST_F(ControllerCrash, ANullDereferenceKillsTheEcsAndTheTwinGoesSafe) {
-  // Under AddressSanitizer the ECS reports the fault and exits 1; the point is the default
-  // disposition, as a student's build without a sanitizer gets it.
-  ::setenv("ASAN_OPTIONS", "handle_segv=0", 1);
-  const HilRun run = Hil("crash", {"--controller", "lib:" + ControllerLib("null_dereference"),
-                                   "--log-dir", scratch_.Path("logs")});
-  ::unsetenv("ASAN_OPTIONS");
+  // Under AddressSanitizer (the sanitizer stage) the ECS's own SIGSEGV handler would report
+  // and exit 1: handle_segv=0 leaves the signal to kill, as in the program that ships (the
+  // loader's crash test does the same).
+  const char* asan = std::getenv("ASAN_OPTIONS");  // NOLINT(concurrency-mt-unsafe): one thread
+  const std::string asan_options =
+      "ASAN_OPTIONS=" + (asan != nullptr ? std::string(asan) + ":" : "") + "handle_segv=0";
+  const HilRun run = Hil("crash",
+                         {"--controller", "lib:" + ControllerLib("null_dereference"), "--log-dir",
+                          scratch_.Path("logs")},
+                         {"env", asan_options});
   // The pair's code is the worse of the two: the twin's I/O fault (5) and the crashed ECS,
   // which counts as 1 (a side that did not exit: hil_report.cpp's ExitCodeOf).
   EXPECT_EQ(run.result.exit_code, 1) << run.result.out << run.result.err;
