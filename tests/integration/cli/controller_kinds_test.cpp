@@ -182,7 +182,7 @@ TEST_P(ControllerKindsLoop, ClosesTheThesisLoopAgainstTheTwinWithBothVerdictsPas
       }
     }
   } else {
-    // my_pd: a PD without the integral, so it trails the ramp by more.
+    // my_pd: a PD (no integral, the derivative on the wheel), with figures of its own.
     EXPECT_NEAR(max_left_m, 2.486e-3, 0.5e-6);
     EXPECT_NEAR(rms_m, 1.214e-3, 0.5e-6);
   }
@@ -404,22 +404,30 @@ TEST_F(ControllerStopped, ARefusedLibraryEndsThePairWithExitTwoBeforeEitherRunsA
 
 // --- A crash of the user's code ------------------------------------------------------------
 
+/// `env` with the sanitizers' options plus handle_segv=0: under ASan (the sanitizer stage) or
+/// TSan (the concurrency stage) a process's own SIGSEGV handler would report and exit; this
+/// leaves the signal to kill, as in the program that ships (the loader's crash test does the
+/// same). The options the stage set are kept.
+std::vector<std::string> LeaveSegvToKill() {
+  std::vector<std::string> argv = {"env"};
+  for (const char* name : {"ASAN_OPTIONS", "TSAN_OPTIONS"}) {
+    const char* set = std::getenv(name);  // NOLINT(concurrency-mt-unsafe): one thread
+    argv.push_back(std::string(name) + "=" + (set != nullptr ? std::string(set) + ":" : "") +
+                   "handle_segv=0");
+  }
+  return argv;
+}
+
 // A library whose step() writes through NULL: the ECS process dies of SIGSEGV (the loader
 // cannot catch it, and must not try), and the twin ends as it does for any killed ECS: an I/O
 // fault with safe outputs, naming the ECS as gone; hil's summary names the ECS's signal.
 class ControllerCrash : public ControllerLockstep {};
 
 TEST_F(ControllerCrash, ANullDereferenceKillsTheEcsAndTheTwinGoesSafe) {
-  // Under AddressSanitizer (the sanitizer stage) the ECS's own SIGSEGV handler would report
-  // and exit 1: handle_segv=0 leaves the signal to kill, as in the program that ships (the
-  // loader's crash test does the same).
-  const char* asan = std::getenv("ASAN_OPTIONS");  // NOLINT(concurrency-mt-unsafe): one thread
-  const std::string asan_options =
-      "ASAN_OPTIONS=" + (asan != nullptr ? std::string(asan) + ":" : "") + "handle_segv=0";
   const HilRun run = Hil("crash",
                          {"--controller", "lib:" + ControllerLib("null_dereference"), "--log-dir",
                           scratch_.Path("logs")},
-                         {"env", asan_options});
+                         LeaveSegvToKill());
   // The pair's code is the worse of the two: the twin's I/O fault (5) and the crashed ECS,
   // which counts as 1 (a side that did not exit: hil_report.cpp's ExitCodeOf).
   EXPECT_EQ(run.result.exit_code, 1) << run.result.out << run.result.err;
