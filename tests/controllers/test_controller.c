@@ -26,6 +26,10 @@ static const hiltwin_port inputs[] = {{"setpoint_left_m", "m"}, {"setpoint_right
 #elif defined(HILTWIN_TEST_NULL_UNIT)
 static const hiltwin_port inputs[] = {{"setpoint_left_m", "m"}, {"setpoint_right_m", "m"},
                                       {"wheel_left_m", "m"},    {"wheel_right_m", NULL}};
+#elif defined(HILTWIN_TEST_WRONG_UNIT)
+/* Valid ports of their own, but the RELbot's default map feeds wheel_right_m in metres. */
+static const hiltwin_port inputs[] = {{"setpoint_left_m", "m"}, {"setpoint_right_m", "m"},
+                                      {"wheel_left_m", "m"},    {"wheel_right_m", "rad"}};
 #else
 static const hiltwin_port inputs[] = {{"setpoint_left_m", "m"}, {"setpoint_right_m", "m"},
                                       {"wheel_left_m", "m"},    {"wheel_right_m", "m"}};
@@ -66,6 +70,9 @@ __attribute__((unused)) static int step(void* self, const double* in, double* ou
   out[1] = in[1] - in[3];
 #if defined(HILTWIN_TEST_NAN_OUTPUT)
   out[1] = nan("");
+#endif
+#if defined(HILTWIN_TEST_DUTY_BEYOND_LIMIT)
+  out[0] = 1.5; /* beyond every duty_limit, which is at most 1 */
 #endif
 #if defined(HILTWIN_TEST_STEP_ERROR)
   if (state->steps >= 3) {

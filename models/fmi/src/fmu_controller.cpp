@@ -50,7 +50,7 @@ class FmuController final : public controller::Controller {
     info_.spec = "fmu:" + fmu_path.string();
     info_.kind = plant_info.kind;  // "FMI 2.0 co-simulation"
     info_.name = md.model_name;
-    info_.file = fmu_path.string();
+    info_.file = std::filesystem::absolute(fmu_path).lexically_normal().string();
     info_.content_sha256 = controller::Sha256HexOfFile(fmu_path);
     info_.inputs = plant_info.inputs;
     info_.outputs = plant_info.outputs;
