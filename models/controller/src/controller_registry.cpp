@@ -38,7 +38,7 @@ std::string WhatExists() {
     out += (out.empty() ? "" : "; ") + name + " (" + entry.description + ")";
   }
   for (const auto& [prefix, kind] : Kinds()) {
-    out += (out.empty() ? "" : "; ") + prefix + ":PATH (" + kind.description + ")";
+    out += (out.empty() ? "" : "; ") + prefix + ":" + kind.argument + " (" + kind.description + ")";
   }
   return out.empty() ? "none registered" : out;
 }
@@ -81,8 +81,8 @@ std::unique_ptr<Controller> MakeController(const std::string& spec,
     if (it != Kinds().end()) {
       const std::string path = spec.substr(colon + 1);
       if (path.empty()) {
-        throw ControllerError("--controller " + spec + ": no file after '" + it->first +
-                              ":': give " + it->first + ":PATH");
+        throw ControllerError("--controller " + spec + ": nothing after '" + it->first +
+                              ":': give " + it->first + ":" + it->second.argument);
       }
       return it->second.load(path, options);
     }

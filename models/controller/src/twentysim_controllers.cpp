@@ -55,7 +55,7 @@ void RegisterTwentySimControllerKind() {
     RegisterControllerKind({"20sim",
                             "a 20-sim C++ class for 20-sim submodel built into hiltwin "
                             "(hiltwin_add_20sim_controller)",
-                            &Load});
+                            &Load, "NAME"});
   });
 }
 

@@ -21,8 +21,8 @@ using ::testing::Not;
 class ControllerCli : public hiltwin::test::TempDirTest {
  protected:
   static hiltwin::test::RunResult Ecs(std::vector<std::string> extra) {
-    std::vector<std::string> argv = {HILTWIN_BINARY, "ecs", "--no-progress", "--clock",
-                                     "virtual", "--duration", "0.05"};
+    std::vector<std::string> argv = {HILTWIN_BINARY, "ecs",        "--no-progress", "--clock",
+                                     "virtual",      "--duration", "0.05"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     return hiltwin::test::Run(argv);
   }
@@ -34,6 +34,12 @@ TEST_F(ControllerCli, AnUnknownSpecIsExit2ListingTheControllersThatExist) {
   EXPECT_THAT(r.err, HasSubstr("--controller pdi: no such controller; give one of: pid (the "
                                "built-in position PID per wheel, thesis 7.2 (--gains))"));
   EXPECT_THAT(r.err, HasSubstr("(docs/controllers.md)"));
+  // Each kind says what follows its prefix: a file, or a 20-sim controller's name.
+  EXPECT_THAT(r.err, HasSubstr("; lib:PATH ("));
+  EXPECT_THAT(r.err, HasSubstr("; 20sim:NAME ("));
+  const auto bare = Ecs({"--controller", "20sim:"});
+  EXPECT_EQ(bare.exit_code, 2) << bare.out << bare.err;
+  EXPECT_THAT(bare.err, HasSubstr("--controller 20sim:: nothing after '20sim:': give 20sim:NAME"));
 }
 
 TEST_F(ControllerCli, ABadMapIsExit2WithItsPlace) {
@@ -84,8 +90,8 @@ TEST_F(ControllerCli, TheStartLineAndTheReportNameThePidAsBuiltIn) {
 
 TEST_F(ControllerCli, HilRefusesAMapThatDoesNotParseBeforeEitherSideStarts) {
   const std::string map = Write("bad.toml", "[[pwm]]\nchannel = 7\n");
-  const auto r = hiltwin::test::Run({HILTWIN_BINARY, "hil", "--clock", "virtual",
-                                     "--no-progress", "--controller-map", map});
+  const auto r = hiltwin::test::Run(
+      {HILTWIN_BINARY, "hil", "--clock", "virtual", "--no-progress", "--controller-map", map});
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   EXPECT_THAT(r.err, HasSubstr(map + ":2:11: [[pwm]] #1: channel must be an integer 1..4"));
   EXPECT_THAT(r.out, Not(HasSubstr("twin ")));

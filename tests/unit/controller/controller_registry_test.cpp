@@ -58,7 +58,7 @@ TEST(ControllerRegistry, AnUnknownSpecIsRefusedListingWhatExists) {
     FAIL() << "no error";
   } catch (const ControllerError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "--controller regkind:: no file after 'regkind:': give regkind:PATH");
+              "--controller regkind:: nothing after 'regkind:': give regkind:PATH");
   }
 }
 

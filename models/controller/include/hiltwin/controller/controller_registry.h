@@ -40,6 +40,7 @@ struct ControllerKind {
   std::string prefix;       ///< "lib", "fmu" (SPEC is "<prefix>:<path>")
   std::string description;  ///< one line for --help
   ControllerLoader load;
+  std::string argument = "PATH";  ///< what follows "<prefix>:" in SPEC, for messages ("NAME")
 };
 
 /// Adds a named controller / a file kind; returns true so it can initialise a namespace-scope
