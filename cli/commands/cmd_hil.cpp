@@ -13,10 +13,11 @@
 #include <utility>
 
 #include "commands.h"
-#include "hiltwin/controller/controller_map.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/pid_controller.h"
 #include "hiltwin/relbot/setpoint_profile.h"
+#include "hiltwin/runs/controllers.h"
 #include "hiltwin/runs/hil_run.h"
 #include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/scheduler/executive.h"
@@ -77,14 +78,12 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
 HilRunOptions HilRunOptionsOf(HilRunOptions o) {
   CheckFilesDistinct(HilFiles(o));
   Validate(o);
-  // A map that does not parse is the parent's exit 2 with its place, before any side starts;
-  // whether it fits the controller the ECS checks (its exit 2).
-  if (!o.controller_map_path.empty()) {
-    try {
-      static_cast<void>(controller::LoadControllerMap(o.controller_map_path));
-    } catch (const controller::ControllerMapError& e) {
-      ThrowUsage(e.what());
-    }
+  // The controller and its map, made, bound and dropped here: a library that cannot be
+  // loaded, a map that does not parse or does not fit the controller is the parent's exit 2
+  // before either side starts, not an ECS that dies beside a twin waiting for it.
+  if (o.mode == "closedloop") {
+    static_cast<void>(MakeBoundController({o.controller.empty() ? kPidControllerName : o.controller,
+                                           o.controller_map_path, o.gains_path, o.config_path}));
   }
   ValidateTelemetry(o.telemetry);
   if (o.wire.empty()) o.wire = "hil-" + std::to_string(::getpid());

@@ -13,7 +13,6 @@
 #include <string>
 #include <utility>
 
-#include "hiltwin/controller/controller_registry.h"
 #include "hiltwin/kernel_glue/stop_signal.h"
 #include "hiltwin/relbot/ecs_gains.h"
 #include "hiltwin/relbot/ecs_report.h"
@@ -50,16 +49,8 @@ struct Ecs {
   std::string profile_name;
 };
 
-/// --gains belongs to the built-in PID: another controller would silently ignore it.
-void CheckGainsFlag(const EcsRunOptions& o) {
-  if (o.gains_path.empty() || o.controller == kPidControllerName) return;
-  ThrowUsage("--gains " + o.gains_path + " gives the built-in PID's gains, but --controller " +
-             o.controller + " is another controller: drop --gains (its gains are its own), or "
-             "use --controller pid");
-}
-
 void LoadEcsConfiguration(const EcsRunOptions& o, Ecs& ecs) {
-  CheckGainsFlag(o);
+  CheckGainsFlag({o.controller, o.controller_map_path, o.gains_path, o.config_path});
   try {
     if (!o.config_path.empty()) ecs.params = LoadRelbotParams(o.config_path);
     if (!o.gains_path.empty()) ecs.gains = LoadEcsGains(o.gains_path);
@@ -80,19 +71,11 @@ void LoadEcsConfiguration(const EcsRunOptions& o, Ecs& ecs) {
 /// The closed loop's controller and its map, bound (exit 2 with the spec's or the map's
 /// message), before any board is opened.
 void MakeEcsController(const EcsRunOptions& o, Ecs& ecs) {
-  RegisterControllers();
-  try {
-    ecs.controller = controller::MakeController(o.controller, {o.gains_path, o.config_path});
-    const controller::ControllerMap map =
-        o.controller_map_path.empty() ? RelbotControllerMap(WheelGeometryOf(ecs.params))
-                                      : controller::LoadControllerMap(o.controller_map_path);
-    ecs.map_source = map.source;
-    ecs.map = controller::BindControllerMap(map, *ecs.controller);
-  } catch (const controller::ControllerError& e) {
-    ThrowUsage(e.what());
-  } catch (const controller::ControllerMapError& e) {
-    ThrowUsage(e.what());
-  }
+  BoundController made =
+      MakeBoundController({o.controller, o.controller_map_path, o.gains_path, o.config_path});
+  ecs.controller = std::move(made.controller);
+  ecs.map = std::move(made.map);
+  ecs.map_source = std::move(made.map_source);
 }
 
 /// Loads gains, profiles and the controller (exit 2 with file:line), opens the link and checks
@@ -207,8 +190,8 @@ int RunEcs(const EcsRunOptions& options) {
     config.details.emplace_back("controller_map", ecs->map_source);
     controller_line = ControllerLine(*ecs);
   }
-  config.on_ready = [o, planned, profile = ecs->profile_name, controller_line](
-                        const kernel_glue::RtSetupRecord* rt) {
+  config.on_ready = [o, planned, profile = ecs->profile_name,
+                     controller_line](const kernel_glue::RtSetupRecord* rt) {
     PrintStartLines(o, planned, profile, controller_line, rt);
   };
   // Whether this rate follows the counts (the twin's rate is not known here: `hil` checks it).
@@ -216,8 +199,7 @@ int RunEcs(const EcsRunOptions& options) {
       EncoderReadingWarnings({o.session.rate_hz, std::nullopt, TopCountsPerSecond(ecs->params)});
   PrintWarnings("ecs", config.warnings);
   const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
-  const EcsFigures figures =
-      EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
+  const EcsFigures figures = EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
   return PrintOutcome(role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
                       report_file);
 }
