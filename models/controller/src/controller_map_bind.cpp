@@ -23,7 +23,12 @@ class ControllerBinder {
     std::string where = map_.source;
     if (line > 0) where += ":" + std::to_string(line);
     if (line > 0 && col > 0) where += ":" + std::to_string(col);
-    throw ControllerMapError(where + ": " + what + " (controller " + info_.name + ")");
+    // The spec says which file (two libraries may share a descriptor name); the name, which
+    // code.
+    const std::string which =
+        info_.spec.empty() || info_.spec == info_.name ? info_.name
+                                                       : info_.spec + " '" + info_.name + "'";
+    throw ControllerMapError(where + ": " + what + " (controller " + which + ")");
   }
 
   /// An input by name, in `unit` when `unit` is not empty and the port says its unit.

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
+#include <string_view>
 
 #include "hiltwin/io/conversions.h"
 
@@ -82,7 +84,7 @@ ControllerTask::ControllerTask(io::IcoBoard& board, Controller& controller,
          who + " stopped: output '" + port + "' asks for a duty beyond its duty_limit " +
              Shortest(route.duty_limit) + "; the motors were stopped"});
   }
-  error_status_text_ = who + " stopped: its step returned an error; the motors were stopped";
+  error_status_text_ = who + " stopped: its step returned an error";
   period_text_ = who + ": the session's period differs from the ECS task's (the controller "
                        "was started for the task's)";
   for (std::size_t s = 0; s < map_.setpoints.size(); ++s) {
@@ -137,6 +139,27 @@ void ControllerTask::FeedInputs() noexcept {
   }
 }
 
+const char* ControllerTask::ComposeErrorStatusText() noexcept {
+  // The line a user reads last says why in the controller's own words: "<who> stopped: its
+  // step returned an error (<reason>); the motors were stopped", cut to the buffer.
+  std::size_t used = 0;
+  const auto append = [&](std::string_view text) noexcept {
+    const std::size_t room = error_status_buffer_.size() - 1 - used;
+    const std::size_t n = std::min(text.size(), room);
+    std::memcpy(error_status_buffer_.data() + used, text.data(), n);
+    used += n;
+  };
+  append(error_status_text_);
+  if (*fault_reason_ != '\0') {
+    append(" (");
+    append(fault_reason_);
+    append(")");
+  }
+  append("; the motors were stopped");
+  error_status_buffer_[used] = '\0';
+  return error_status_buffer_.data();
+}
+
 runtime::StepStatus ControllerTask::Stop(ControllerFault::Kind kind, std::size_t route,
                                          double value, const char* reason) noexcept {
   pwm_next_.fill(0);  // safe outputs from the next exchange on
@@ -145,7 +168,7 @@ runtime::StepStatus ControllerTask::Stop(ControllerFault::Kind kind, std::size_t
     fault_route_ = route;
     fault_value_ = value;
     fault_reason_ = reason != nullptr ? reason : "";
-    fault_text_ = kind == ControllerFault::Kind::kErrorStatus ? error_status_text_.c_str()
+    fault_text_ = kind == ControllerFault::Kind::kErrorStatus ? ComposeErrorStatusText()
                   : kind == ControllerFault::Kind::kNotFinite ? texts_[route].not_finite.c_str()
                                                                : texts_[route].beyond_limit.c_str();
   }

@@ -253,9 +253,10 @@ void PrintTo(const Malformed& m, std::ostream* out) { *out << m.library; }
 Malformed Refused(const char* library, const std::string& message) {
   return {library, 2, message, true, ""};
 }
-/// Refused by the controller map (the RELbot's default one) before the board opens.
+/// Refused by the controller map (the RELbot's default one) before the board opens; the
+/// message ends naming the spec, so the library's path.
 Malformed RefusedByTheMap(const char* library, const std::string& message) {
-  return {library, 2, message, false, ""};
+  return {library, 2, message, true, ""};
 }
 /// Stopped during the run with safe outputs: exit 1, a model fault, and the report's fault.
 Malformed Stopped(const char* library, const std::string& message, const std::string& fault) {
@@ -321,19 +322,22 @@ INSTANTIATE_TEST_SUITE_P(
         RefusedByTheMap("bad_wrong_unit",
                         "the built-in RELbot controller map: encoder input 'wheel_right_m' is in "
                         "rad but the map gives it m: make the units agree (the map's unit, or "
-                        "the controller's) (controller test_controller)"),
+                        "the controller's) (controller lib:"),
         Refused("bad_create_null", "its create() returned NULL"),
         Refused("bad_start_fails",
                 "returned 3: start refused: the test library was built to refuse; the run "
                 "did not start"),
         // Its third step (cycle 2) returns 1 with a last_error text.
+        // The last line says why in the library's own words.
         Stopped("step_error",
-                "model fault at cycle 2: controller 'test_controller' (--controller lib:",
+                "stopped: its step returned an error (wheel runaway: the test library stops at "
+                "its third step); the motors were stopped",
                 R"({"kind": "error status", "output": "", "value": 0.0, "duty_limit": 0.0,
                     "reason": "wheel runaway: the test library stops at its third step",
                     "cycle": 2})"),
         Stopped("step_error_no_text",
-                "stopped: its step returned an error; the motors were stopped",
+                "stopped: its step returned an error (the controller's step() returned nonzero "
+                "and it has no last_error text); the motors were stopped",
                 R"({"kind": "error status", "output": "", "value": 0.0, "duty_limit": 0.0,
                     "reason": "the controller's step() returned nonzero and it has no )"
                 R"(last_error text", "cycle": 2})"),

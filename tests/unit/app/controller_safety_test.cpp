@@ -94,19 +94,19 @@ void ExpectStoppedAt(const Outcome& o, std::uint64_t cycle, const std::string& r
   EXPECT_EQ(o.steps, static_cast<int>(cycle) + 1);  // never stepped again
 }
 
-TEST(ControllerSafety, AnErrorStatusAbortsTheRunNamingTheController) {
+TEST(ControllerSafety, AnErrorStatusStopsTheRunNamingTheController) {
   FakeController fake(FakeController::RelbotInputs(), FakeController::RelbotOutputs(),
                       TurnsBad(Misbehave::kErrorStatus, 300));
   const Outcome o = RunWith(fake, runtime::ClockKind::kVirtual, 2000);
   ExpectStoppedAt(o, 300, "controller 'fake' (--controller fake) stopped: its step returned an "
-                          "error; the motors were stopped");
+                          "error (my integrator overflowed); the motors were stopped");
   const auto& fault = o.json["controller"]["fault"];
   EXPECT_EQ(fault["kind"], "error status");
   EXPECT_EQ(fault["reason"], "my integrator overflowed");
   EXPECT_EQ(fault["cycle"], 300);
 }
 
-TEST(ControllerSafety, ANaNOutputAbortsTheRunNamingThePort) {
+TEST(ControllerSafety, ANaNOutputStopsTheRunNamingThePort) {
   FakeController fake(FakeController::RelbotInputs(), FakeController::RelbotOutputs(),
                       TurnsBad(Misbehave::kNaN, 10));
   const Outcome o = RunWith(fake, runtime::ClockKind::kVirtual, 2000);
@@ -116,7 +116,7 @@ TEST(ControllerSafety, ANaNOutputAbortsTheRunNamingThePort) {
   EXPECT_EQ(o.json["controller"]["fault"]["output"], "duty_right");
 }
 
-TEST(ControllerSafety, ADutyBeyondTheLimitAbortsTheRunNamingThePortAndLimit) {
+TEST(ControllerSafety, ADutyBeyondTheLimitStopsTheRunNamingThePortAndLimit) {
   FakeController fake(FakeController::RelbotInputs(), FakeController::RelbotOutputs(),
                       TurnsBad(Misbehave::kBeyondLimit, 1000));
   const Outcome o = RunWith(fake, runtime::ClockKind::kVirtual, 2000);

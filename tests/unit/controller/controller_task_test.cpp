@@ -188,8 +188,8 @@ TEST(ControllerTask, AnErrorStatusStopsTheControllerNamingIt) {
   ControllerFault fault;
   std::uint64_t cycle = 0;
   EXPECT_EQ(FirstFault(fake, fault, cycle),
-            "controller 'fake' (--controller fake) stopped: its step returned an error; the "
-            "motors were stopped");
+            "controller 'fake' (--controller fake) stopped: its step returned an error (the "
+            "gains file was empty); the motors were stopped");
   EXPECT_EQ(cycle, 4U);
   EXPECT_EQ(fault.kind, ControllerFault::Kind::kErrorStatus);
   EXPECT_EQ(fault.cycle, 4U);

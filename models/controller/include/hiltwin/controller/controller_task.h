@@ -136,6 +136,8 @@ class ControllerTask final : public runtime::RunTask {
   [[nodiscard]] runtime::StepStatus Stop(ControllerFault::Kind kind, std::size_t route,
                                          double value, const char* reason) noexcept;
   void Track() noexcept;
+  /// The fault text of an error status, with the controller's reason (fault_reason_).
+  [[nodiscard]] const char* ComposeErrorStatusText() noexcept;
 
   io::IcoBoard& board_;
   Controller& controller_;
@@ -147,7 +149,10 @@ class ControllerTask final : public runtime::RunTask {
   std::vector<double> duty_;  ///< per PWM route, this step
   std::vector<PairSums> pairs_;
   std::vector<RouteTexts> texts_;
-  std::string error_status_text_;
+  std::string error_status_text_;  ///< "<who> stopped: its step returned an error"
+  /// error_status_text_, the controller's own reason and the end, composed at the fault
+  /// without allocating; longer texts are cut (the report's fault.reason has it whole).
+  std::array<char, 512> error_status_buffer_{};
   std::string period_text_;
   io::EcsInputs board_in_{};
   std::array<double, 2> columns_{};
