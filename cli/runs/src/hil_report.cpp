@@ -98,6 +98,13 @@ int WorseExitCode(int a, int b) noexcept { return Severity(a) >= Severity(b) ? a
 
 namespace {
 
+/// "5", or "1, killed by signal 11 (SIGSEGV)": a side that did not exit counts as 1, and the
+/// summary says why rather than an exit code the side never gave.
+std::string CodeText(const kernel_glue::ExitStatus& status) {
+  const std::string code = std::to_string(ExitCodeOf(status));
+  return status.exited ? code : code + ", " + status.Describe();
+}
+
 /// A side that judged no cycle because its peer ended first (verdict NONE, stop peer_stopped)
 /// only echoes that peer's end: its exit 5 says nothing the peer's own code does not.
 bool EchoesItsPeer(const HilSide& side) {
@@ -183,8 +190,9 @@ std::string FormatHilSummary(const HilResult& r) {
   const int twin_code = ExitCodeOf(r.twin.status);
   const int ecs_code = ExitCodeOf(r.ecs.status);
   const bool worse = r.exit_code == WorseExitCode(twin_code, ecs_code);
-  std::snprintf(text, sizeof text, "hil       exit %d (%s twin %d and ECS %d)\n", r.exit_code,
-                worse ? "the worse of" : "the side that failed first of", twin_code, ecs_code);
+  std::snprintf(text, sizeof text, "hil       exit %d (%s twin %s and ECS %s)\n", r.exit_code,
+                worse ? "the worse of" : "the side that failed first of",
+                CodeText(r.twin.status).c_str(), CodeText(r.ecs.status).c_str());
   return out + text;
 }
 

@@ -459,6 +459,9 @@ TEST_F(ControllerCrash, ANullDereferenceKillsTheEcsAndTheTwinGoesSafe) {
   EXPECT_THAT(run.result.out, HasSubstr("ecs   no report (" + segv + ")\n"));
   EXPECT_THAT(run.result.out, HasSubstr("twin  PASS     stop io_fault "));
   EXPECT_THAT(run.result.err, HasSubstr("hiltwin hil: the ecs ended with " + segv));
+  // The exit line says how the ECS ended, not an exit code it never gave.
+  EXPECT_THAT(run.result.out,
+              HasSubstr("hil       exit 1 (the worse of twin 5 and ECS 1, " + segv + ")\n"));
 }
 
 }  // namespace
