@@ -62,6 +62,17 @@ std::string ControllerLine(const Json& c) {
   };
   std::string line = "controller " + text("spec") + " (" + text("kind") + "): " + text("name");
   if (!text("file").empty()) line += "; " + text("file") + ", sha256 " + text("content_sha256");
+  // A controller the ECS stopped: the pair's summary says so where it names the controller,
+  // as the ECS's own summary does (ecs_report.cpp).
+  if (c.contains("fault") && c["fault"].is_object()) {
+    const Json& f = c["fault"];
+    const auto field = [&f](const char* key) {
+      return f.contains(key) && f[key].is_string() ? f[key].get<std::string>() : std::string();
+    };
+    line += "; stopped at cycle " + std::to_string(f.value("cycle", 0ULL)) + ": " + field("kind");
+    if (!field("output").empty()) line += " on output " + field("output");
+    if (!field("reason").empty()) line += " (" + field("reason") + ")";
+  }
   return line + "\n";
 }
 

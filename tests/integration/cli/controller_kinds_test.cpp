@@ -385,10 +385,12 @@ TEST_F(ControllerStopped, AStepErrorEndsThePairWithTheLibrarysTextInTheCombinedR
                         " stopped at cycle 2: error status "
                         "(wheel runaway: the test library stops at its third step); safe "
                         "outputs\n"));
+  // The pair's own summary says it where it names the controller.
+  EXPECT_THAT(run.result.out,
+              HasSubstr("; stopped at cycle 2: error status (wheel runaway: the test library "
+                        "stops at its third step)\n"));
 }
 
-// Refused at load in hil: the ECS ends with exit 2 and the loader's message before a cycle, and
-// hil stops the twin, which never ran a cycle either; no shared memory is left.
 // hil makes and binds the controller itself before it starts either side: a library the
 // loader refuses, or one whose ports do not fit the map, is hil's own exit 2 naming it, with no
 // twin started, no report and no wire left.
