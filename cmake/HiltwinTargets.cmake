@@ -188,7 +188,9 @@ endfunction()
 # OWN_FLAGS: the executable changes code-generation flags or macros the shared precompiled
 # header depends on (say -UNDEBUG), so it does not use it (hiltwin_test_pch_target).
 # RESOURCE_LOCK: names CTest never runs two holders of at once (`lttng`: the one session
-# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer). Each
+# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer;
+# `compiler`: the tests that run a compiler or cpack, and the trace test whose culprit check
+# must not see one beside its own competing thread). Each
 # name is a label too, so a stage that has no such thing leaves those tests out by name
 # (`-LE lttng`: the arm64 suite under qemu, whose emulated processes cannot reach the host's
 # session daemon).
