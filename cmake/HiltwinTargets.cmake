@@ -180,17 +180,15 @@ endfunction()
 
 # hiltwin_add_gtest(<name> SOURCES <files...> LIBS <targets...> LABELS <labels...>
 #                   [RT_TESTS <regex>] [CONCURRENCY_TESTS <regex>]
-#                   [SLOW_TESTS <regex>=<seconds>...] [TIMEOUT s] [RESOURCE_LOCK <names...>]
-#                   [OWN_FLAGS])
+#                   [SLOW_TESTS <regex>=<seconds>...] [SERIAL_TESTS <regex>] [TIMEOUT s]
+#                   [RESOURCE_LOCK <names...>] [OWN_FLAGS])
 # A GoogleTest executable whose tests CTest discovers one by one, with labels
 # (unit, integration, rt, concurrency, long, soak) so suites can be chosen with `ctest -L`;
 # docs/testing.md says which stage runs which label.
 # OWN_FLAGS: the executable changes code-generation flags or macros the shared precompiled
 # header depends on (say -UNDEBUG), so it does not use it (hiltwin_test_pch_target).
 # RESOURCE_LOCK: names CTest never runs two holders of at once (`lttng`: the one session
-# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer;
-# `compiler`: the tests that run a compiler or cpack, and the trace test whose culprit check
-# must not see one beside its own competing thread). Each
+# daemon, started and stopped by whichever test needs it; `tracefs`: the kernel's tracer). Each
 # name is a label too, so a stage that has no such thing leaves those tests out by name
 # (`-LE lttng`: the arm64 suite under qemu, whose emulated processes cannot reach the host's
 # session daemon).
@@ -199,6 +197,10 @@ endfunction()
 # CONCURRENCY_TESTS: the tests that race threads or processes (lock-free queues, the logger,
 # the wire, telemetry, session threads, two-process pairs) also get the label `concurrency`:
 # the ThreadSanitizer stage runs exactly these (".*": every test of the executable).
+# SERIAL_TESTS: the tests (Suite.Name) that CTest runs with no other test beside them
+# (RUN_SERIAL): a test whose assertion is about everything the machine runs, as the trace test
+# that names its own competitor the top culprit of the misses (other tests' compilers, cpack,
+# real-time threads and browsers came out as culprits under `ctest -j`).
 # SLOW_TESTS: the tests that take ten seconds or more in some stage, each with its seconds in
 # the stage where it is slowest (measured; CTest's COST), so that `ctest -j` starts the longest
 # first: a fresh clone has no CTestCostData.txt, and CTest otherwise starts them wherever their
@@ -213,7 +215,7 @@ endfunction()
 # Cross-compiled (arm64), discovery runs the test binary at test time, under the emulator,
 # not at build time: the build then needs no emulator at all.
 function(hiltwin_add_gtest name)
-  cmake_parse_arguments(ARG "OWN_FLAGS" "TIMEOUT;RT_TESTS;CONCURRENCY_TESTS"
+  cmake_parse_arguments(ARG "OWN_FLAGS" "TIMEOUT;RT_TESTS;CONCURRENCY_TESTS;SERIAL_TESTS"
                         "SOURCES;LIBS;LABELS;RESOURCE_LOCK;SLOW_TESTS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
@@ -276,6 +278,12 @@ function(hiltwin_add_gtest name)
     string(APPEND content " RESOURCE_LOCK \"${ARG_RESOURCE_LOCK}\"")
   endif()
   string(APPEND content ")\n")
+  if(ARG_SERIAL_TESTS)
+    string(APPEND content
+      "  if(test MATCHES [=[${ARG_SERIAL_TESTS}]=])\n"
+      "    set_tests_properties(\"\${test}\" PROPERTIES RUN_SERIAL TRUE)\n"
+      "  endif()\n")
+  endif()
   foreach(slow IN LISTS ARG_SLOW_TESTS)
     if(NOT slow MATCHES "^(.+)=([0-9]+)$")
       message(FATAL_ERROR "hiltwin_add_gtest(${name}): SLOW_TESTS entry '${slow}' is not "

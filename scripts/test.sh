@@ -152,11 +152,44 @@ build_stage() {
   bash "$root/scripts/build.sh" "$build_dir" "$@"
   stage_built=$((SECONDS - stage_start))
 }
+# failure_digest DIR: each failed test of DIR's last ctest run, with its first failures (their
+# place and message, lines cut at 300 characters), printed after ctest's summary: a reader who
+# sees only the log's end (CI's summary keeps its last lines) then sees what failed, not only
+# which test.
+failure_digest() {
+  local log=$1/Testing/Temporary/LastTest.log
+  [[ -f $log ]] || return 0
+  echo "== what failed (from $log):"
+  awk '
+    # A failure: its "file:line: Failure" and the three lines after it (gtest`s bare "Failed"
+    # left out), six lines at most; without one (a crash, a timeout), the last three lines.
+    function digest(   i, after, shown) {
+      printf "%s\n", name
+      after = 0
+      shown = 0
+      for (i = 1; i <= n && shown < 6; ++i) {
+        if (out[i] ~ /: Failure$/) after = 4
+        if (after > 0 && out[i] != "Failed") { printf "   %s\n", substr(out[i], 1, 300); ++shown }
+        --after
+      }
+      for (i = (n > 3 ? n - 2 : 1); !shown && i <= n; ++i) printf "   %s\n", substr(out[i], 1, 300)
+    }
+    /^[0-9]+\/[0-9]+ Test: / { name = $0; sub(/^[0-9]+\/[0-9]+ Test: /, "", name); n = 0; next }
+    /^Output:$/ { reading = 1; getline; next }
+    /^<end of output>$/ { reading = 0; next }
+    reading { out[++n] = $0; next }
+    /^Test Failed/ && name != "" && ++failed <= 3 { digest() }
+  ' "$log"
+}
 test_stage() {
   local name=$1 build_dir=$2; shift 2
   echo "== testing $name: ctest $*"
-  local start=$SECONDS
-  ctest --test-dir "$build_dir" --output-on-failure "$@"
+  local start=$SECONDS status=0
+  ctest --test-dir "$build_dir" --output-on-failure "$@" || status=$?
+  if ((status != 0)); then
+    failure_digest "$build_dir"
+    exit "$status"
+  fi
   timings+=("$name" "$stage_built" "$((SECONDS - start))")
   echo "== $name: built in $stage_built s, tested in $((SECONDS - start)) s"
   stage_built=0

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -148,21 +149,29 @@ TEST_F(TraceCli, AnalyzeReadsATraceRecordedByHandWithTheLttngCommand) {
   ExpectAgreement(ReadJson(Path("run.json")), ReadJson(out + "/jitter_report.json"));
 }
 
-TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses) {
-  if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
-  // The competitor: SCHED_FIFO 95 on CPU 1, 3 ms of spinning every 100 ms, above the loop's 80.
-  constexpr int kSpinMs = 3;
-  constexpr int kSleepMs = 97;
-  constexpr int kTraceSeconds = 2;
-  constexpr int kRateHz = 4000;
+// The competitor of the cause test: SCHED_FIFO 95 on CPU 1, 3 ms of spinning every 100 ms,
+// above the loop's 80, beside a 2 s recording at 4 kHz.
+constexpr int kSpinMs = 3;
+constexpr int kSleepMs = 97;
+constexpr int kTraceSeconds = 2;
+constexpr int kRateHz = 4000;
+// The cycles the bursts cover: 2 s at 4 kHz, 3 ms in every 100 ms (240).
+constexpr std::size_t kHogCycles =
+    std::size_t{kTraceSeconds} * kRateHz * kSpinMs / (kSpinMs + kSleepMs);
+
+/// Records `hiltwin trace --kernel` into `out` beside the cause test's competitor (a
+/// SCHED_FIFO thread above the loop, on its CPU) and reads its jitter report into `jitter`.
+/// Skips when the machine refuses SCHED_FIFO or the kernel's tracer.
+void RecordBesideTheHog(const std::string& out, json& jitter) {
   // The hog must outlive the trace's set-up, however slow: beside other tests under ASan the
   // command took 25.7 s, and a hog that ran 20 s had gone before the loop began (CI refused
   // stop 46 on this test). It runs until this test stops it; its limit only bounds it should
   // the test die.
   constexpr int kHogLimitS = 290;
+  const std::string hog_out = out + ".hog";
   auto hog = hiltwin::test::Spawn({HILTWIN_HOG, "hiltwin-hog", "1", "95", std::to_string(kSpinMs),
                                    std::to_string(kSleepMs), std::to_string(kHogLimitS)},
-                                  Path("hog.out"));
+                                  hog_out);
   // "ready" once it spins at its priority; it exits 3 when the OS refuses. A loaded machine
   // may take seconds to start it (beside CI builds it took longer than the 1.1 s this waited
   // once, and the test skipped): only a refusal skips.
@@ -172,38 +181,37 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
     if (const auto ended = hog.WaitFor(std::chrono::milliseconds(20))) {
       GTEST_SKIP() << "SCHED_FIFO refused (" << ended->Describe() << "): no competitor";
     }
-    std::ifstream ready(Path("hog.out"));
+    std::ifstream ready(hog_out);
     ready >> word;
   }
   ASSERT_EQ(word, "ready") << "the hog did not start within 30 s";
-  const std::string out = Path("trace");
-  const auto r = Hiltwin({"trace", "--kernel", "--output", out, "--duration",
-                          std::to_string(kTraceSeconds), "--rate", std::to_string(kRateHz),
-                          "--cpu", "1", "--priority", "80", "--no-progress"});
+  const auto r =
+      hiltwin::test::Run({HILTWIN_BINARY, "trace", "--kernel", "--output", out, "--duration",
+                          std::to_string(kTraceSeconds), "--rate", std::to_string(kRateHz), "--cpu",
+                          "1", "--priority", "80", "--no-progress"},
+                         120'000);
   if (r.exit_code == 5 && r.err.find("--kernel") != std::string::npos) {
     GTEST_SKIP() << "the kernel cannot be recorded here: " << r.err;
   }
   ASSERT_LE(r.exit_code, 4) << r.out << r.err;
   // Still spinning when the trace ended, so it competed for the whole recorded run.
   ASSERT_FALSE(hog.WaitFor(std::chrono::milliseconds(0)).has_value())
-      << "the hog ended before the trace did: "
-      << hiltwin::test::ReadOutput(Path("hog.out.err"));
+      << "the hog ended before the trace did: " << hiltwin::test::ReadOutput(hog_out + ".err");
   hog.Kill(SIGKILL);
-  const json jitter = ReadJson(out + "/jitter_report.json");
-  EXPECT_TRUE(jitter["kernel_recorded"].get<bool>());
-  ASSERT_FALSE(jitter["causes"].empty()) << jitter.dump(2);
-  // "preempted" is the top class, and the hog its first culprit, outweighing every other named
-  // culprit of every class. The cycles the loop catches up after each burst (on a slower
-  // machine more than the burst's own: CI, stop 40, 321 against 232) count with the burst
-  // ("backlog behind k=N (preempted by hiltwin-hog ...)"), not as "invisible". Unless the
-  // guest itself lost its CPU for longer than a burst (hypervisor steal: one 27 ms stall at
-  // 4 kHz leaves 108 catch-up cycles behind it, seen beside five other helpers' builds): then
-  // the class order is the host's. So it is when many short unseen stalls add up to more
-  // cycles than half the hog's bursts (2026-11-30, a VM whose wake-up latency had risen tenfold:
-  // 156 invisible cycles of their own against the hog's 250, beside Chromium tests).
-  // The cycles the bursts cover: 2 s at 4 kHz, 3 ms in every 100 ms (240).
-  const std::size_t expected_cycles = std::size_t{kTraceSeconds} * kRateHz * kSpinMs /
-                                      (kSpinMs + kSleepMs);
+  std::ifstream report(out + "/jitter_report.json");
+  jitter = json::parse(report);
+  ASSERT_TRUE(jitter["kernel_recorded"].get<bool>());
+}
+
+/// The class order is the hog's ("preempted" on top) unless the guest itself lost its CPU for
+/// longer than a burst (hypervisor steal: one 27 ms stall at 4 kHz leaves 108 catch-up cycles
+/// behind it, seen beside five other helpers' builds), or many short unseen stalls add up to
+/// more cycles than half the hog's bursts (2026-11-30, a VM whose wake-up latency had risen
+/// tenfold: 156 invisible cycles of their own against the hog's 250, beside Chromium tests).
+/// The cycles the loop catches up after each burst (on a slower machine more than the burst's
+/// own: CI, stop 40, 321 against 232) count with the burst ("backlog behind k=N (preempted by
+/// hiltwin-hog ...)"), not as "invisible".
+bool TheHostDecidesTheClassOrder(const json& jitter) {
   std::int64_t longest_invisible_ns = 0;
   std::int64_t invisible_own_cycles = 0;
   for (const json& cause : jitter["causes"]) {
@@ -216,12 +224,21 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
     longest_invisible_ns =
         std::max(longest_invisible_ns, cycle["cause"]["duration_ns"].get<std::int64_t>());
   }
-  if (longest_invisible_ns <= std::int64_t{kSpinMs} * 1'000'000 &&
-      invisible_own_cycles <= static_cast<std::int64_t>(expected_cycles / 2)) {
-    EXPECT_EQ(jitter["causes"][0]["class"], "preempted") << jitter["causes"].dump(2);
-  } else {
-    RecordProperty("top_class_unchecked_invisible_stall_ns", std::to_string(longest_invisible_ns));
-    RecordProperty("top_class_unchecked_invisible_cycles", std::to_string(invisible_own_cycles));
+  return longest_invisible_ns > std::int64_t{kSpinMs} * 1'000'000 ||
+         invisible_own_cycles > static_cast<std::int64_t>(kHogCycles / 2);
+}
+
+/// What one recording beside the hog says against the cause test's checks: a line for each
+/// check that failed, none when all held. "preempted" is the top class (unless the host
+/// decides the order) and the hog its first culprit, covering half its bursts at least and
+/// outweighing every other named culprit of every class; the misses it caused name it, with
+/// its policy and priority, and the releases caught up after its bursts name it too.
+std::vector<std::string> CulpritFindings(const json& jitter) {
+  std::vector<std::string> findings;
+  const auto finding = [&findings](const std::string& what) { findings.push_back(what); };
+  if (jitter["causes"].empty()) return {"no causes recorded"};
+  if (!TheHostDecidesTheClassOrder(jitter) && jitter["causes"][0]["class"] != "preempted") {
+    finding("top class " + jitter["causes"][0]["class"].get<std::string>() + ", not preempted");
   }
   std::int64_t hog_cycles = 0;
   std::int64_t other_named_max = 0;
@@ -239,28 +256,59 @@ TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses)
       }
     }
   }
-  EXPECT_GE(hog_cycles, static_cast<std::int64_t>(expected_cycles / 2))
-      << r.err << jitter["causes"].dump(2);
-  EXPECT_GT(hog_cycles, other_named_max) << other_named << "\n" << jitter["causes"].dump(2);
-  // The misses the competitor caused name it, with its policy and priority (other threads,
-  // kernel workers say, may preempt the loop too on a busy machine).
+  if (hog_cycles < static_cast<std::int64_t>(kHogCycles / 2)) {
+    finding("the hog preempted " + std::to_string(hog_cycles) + " cycles, fewer than " +
+            std::to_string(kHogCycles / 2));
+  }
+  if (hog_cycles <= other_named_max) {
+    finding("the hog's " + std::to_string(hog_cycles) + " cycles do not outweigh " + other_named +
+            "'s " + std::to_string(other_named_max));
+  }
   int named = 0;
   int backlog = 0;
   for (const json& cycle : jitter["notable"]) {
     const json& cause = cycle["cause"];
+    const auto k = cycle["k"].get<std::uint64_t>();
     if (cause["class"] == "backlog" && cause["inherited"] == "preempted" &&
         cause["thread"] == "hiltwin-hog") {
       ++backlog;
-      EXPECT_LT(cause["behind_cycle"].get<std::uint64_t>(), cycle["k"].get<std::uint64_t>());
+      if (cause["behind_cycle"].get<std::uint64_t>() >= k) {
+        finding("cycle " + std::to_string(k) + " is backlog behind a later cycle");
+      }
     }
     if (cause["class"] != "preempted" || cause["thread"] != "hiltwin-hog") continue;
-    EXPECT_EQ(cause["policy"], "SCHED_FIFO");
-    EXPECT_EQ(cause["priority"], 95);
-    EXPECT_GT(cause["duration_ns"].get<std::int64_t>(), 0);
     ++named;
+    if (cause["policy"] != "SCHED_FIFO" || cause["priority"] != 95 ||
+        cause["duration_ns"].get<std::int64_t>() <= 0) {
+      finding("cycle " + std::to_string(k) + " names the hog as " + cause.dump());
+    }
   }
-  EXPECT_GT(named, 0);
-  EXPECT_GT(backlog, 0);  // each 3 ms burst leaves a dozen releases (at 4 kHz) to catch up
+  if (named == 0) finding("no notable miss names the hog");
+  // Each 3 ms burst leaves a dozen releases (at 4 kHz) to catch up.
+  if (backlog == 0) finding("no notable miss is backlog behind the hog");
+  return findings;
+}
+
+TEST_F(TraceCli, KernelNamesACompetingHigherPriorityThreadAsTheCauseOfTheMisses) {
+  if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
+  // CTest runs this test alone (tests/integration/trace/CMakeLists.txt); what it cannot keep
+  // out, the hypervisor taking the guest's CPU during the recording, a second recording
+  // answers: the checks must hold in one of two, and the first one's findings are printed.
+  constexpr int kRecordings = 2;
+  std::vector<std::string> findings;
+  json jitter;
+  for (int recording = 1; recording <= kRecordings; ++recording) {
+    RecordBesideTheHog(Path("trace" + std::to_string(recording)), jitter);
+    if (IsSkipped() || HasFatalFailure()) return;
+    findings = CulpritFindings(jitter);
+    if (findings.empty()) return;
+    std::string said;
+    for (const std::string& line : findings) said += line + "; ";
+    std::cout << "recording " << recording << " of " << kRecordings << ": " << said << "\n";
+    RecordProperty("recording_" + std::to_string(recording) + "_findings", said);
+  }
+  for (const std::string& line : findings) ADD_FAILURE() << line;
+  ADD_FAILURE() << "the causes of the last recording: " << jitter["causes"].dump();
 }
 
 TEST_F(TraceCli, KernelWithoutThePermissionExitsFiveWithTheReasonAndTheFix) {

@@ -71,6 +71,37 @@ class LttngSessionTest : public ::testing::Test {
     return pid;
   }
 
+  /// What RecordGatedEmitter recorded.
+  struct GatedRun {
+    int emitter_pid = 0;
+    int daemon_pid = 0;
+    LttngChannelFigures figures;
+  };
+
+  // The emitter started first, waiting for a `go` file; a session for it alone that awaits its
+  // registration, as `hiltwin trace` does; then `go`. Every cycle must be in the trace, however
+  // late LTTng-UST registers (a process started before, or just after, a fresh daemon).
+  [[nodiscard]] GatedRun RecordGatedEmitter(const std::string& name, int cycles) const {
+    const fs::path go = base_ / ("go_" + name);
+    fs::create_directories(base_);
+    ProcessOptions options;
+    options.out = OutputTarget::Discard();
+    Process emitter =
+        Process::Start({HILTWIN_TRACE_EMITTER, std::to_string(cycles), go.string()}, options);
+    GatedRun run;
+    run.emitter_pid = emitter.pid();  // pid() is -1 once reaped
+    LttngSessionConfig config = Config(name);
+    config.only_pid = run.emitter_pid;
+    config.await_registration = true;
+    LttngSession session(config);
+    run.daemon_pid = session.daemon_pid();
+    std::ofstream(go) << "go\n";
+    const auto status = emitter.WaitFor(std::chrono::seconds(30));
+    EXPECT_TRUE(status && status->Success()) << (status ? status->Describe() : "still running");
+    run.figures = session.Stop();
+    return run;
+  }
+
   // hiltwin:cycle events of process `pid` in the trace under `dir`, as babeltrace2 prints them:
   // "... hiltwin:cycle: { cpu_id = 0 }, { vpid = 123 }, { k = 0, ... }". The one context a
   // session adds is vpid: an event with vtid (which costs and nothing reads) fails the test.
@@ -158,27 +189,10 @@ TEST_F(LttngSessionTest, ASessionForOneProcessRecordsNoOtherProcess) {
 // process from its first event. (With a daemon already running, registration is immediate and
 // this checks only that awaiting it costs nothing.)
 TEST_F(LttngSessionTest, AProcessRunningBeforeTheDaemonIsRecordedFromItsFirstEvent) {
-  const fs::path go = base_ / "go";
-  fs::create_directories(base_);
-  ProcessOptions options;
-  options.out = OutputTarget::Discard();
-  Process emitter =
-      Process::Start({HILTWIN_TRACE_EMITTER, std::to_string(kCycles), go.string()}, options);
-  const int emitter_pid = emitter.pid();  // pid() is -1 once reaped
-  int daemon_pid = 0;
-  {
-    LttngSessionConfig config = Config("early");
-    config.only_pid = emitter_pid;
-    config.await_registration = true;
-    LttngSession session(config);
-    daemon_pid = session.daemon_pid();
-    std::ofstream(go) << "go\n";
-    const auto status = emitter.WaitFor(std::chrono::seconds(30));
-    ASSERT_TRUE(status && status->Success()) << (status ? status->Describe() : "still running");
-    EXPECT_EQ(session.Stop().discarded_events, 0U);
-    EXPECT_EQ(CyclesOf(base_ / "early", emitter_pid), kCycles);
-  }
-  ExpectDaemonHandledRightly(daemon_pid);
+  const GatedRun run = RecordGatedEmitter("early", kCycles);
+  EXPECT_EQ(run.figures.discarded_events, 0U);
+  EXPECT_EQ(CyclesOf(base_ / "early", run.emitter_pid), kCycles);
+  ExpectDaemonHandledRightly(run.daemon_pid);
 }
 
 TEST_F(LttngSessionTest, AwaitingAProcessThatNeverRegistersSaysSoInsteadOfRecordingNothing) {
@@ -220,25 +234,13 @@ TEST_F(LttngSessionTest, ASecondSessionKeepsTheDaemonWhileTheFirstEnds) {
   }
   ExpectDaemonHandledRightly(daemon_pid);
   {
-    // And once more after all ended, with a daemon started afresh. The emitter waits for `go`
-    // and the session awaits its registration, as `hiltwin trace` does: CI once recorded none
-    // of a process started just after a fresh daemon (not seen in 70 runs here, 40 of them
-    // beside stress-ng), and what this block checks is the daemon's lifecycle, not that race.
-    const fs::path go = base_ / "go_third";
-    ProcessOptions options;
-    options.out = OutputTarget::Discard();
-    Process emitter = Process::Start({HILTWIN_TRACE_EMITTER, "100", go.string()}, options);
-    const int emitter_pid = emitter.pid();  // pid() is -1 once reaped
-    LttngSessionConfig config = Config("third");
-    config.only_pid = emitter_pid;
-    config.await_registration = true;
-    LttngSession third(config);
-    std::ofstream(go) << "go\n";
-    const auto status = emitter.WaitFor(std::chrono::seconds(30));
-    ASSERT_TRUE(status && status->Success()) << (status ? status->Describe() : "still running");
-    third.Stop();
-    EXPECT_EQ(CyclesOf(base_ / "third", emitter_pid), 100);
-    daemon_pid = third.daemon_pid();
+    // And once more after all ended, with a daemon started afresh, gated as `hiltwin trace`
+    // is: CI once recorded none of a process started just after a fresh daemon (not seen in 70
+    // runs here, 40 of them beside stress-ng), and what this block checks is the daemon's
+    // lifecycle, not that race.
+    const GatedRun run = RecordGatedEmitter("third", 100);
+    EXPECT_EQ(CyclesOf(base_ / "third", run.emitter_pid), 100);
+    daemon_pid = run.daemon_pid;
   }
   ExpectDaemonHandledRightly(daemon_pid);
 }
