@@ -10,7 +10,8 @@ include(CMakePackageConfigHelpers)
 # The engine and the models (docs/architecture.md, "Tiers"). The RELbot, the tools outside the
 # loop (observe/) and the program (cli/) stay inside the binary: they would pull Cyclone DDS,
 # FFTW and babeltrace into every user's link for nothing a plant or controller needs.
-set(HILTWIN_EXPORTED_MODULES lockfree kernel_glue scheduler qos lifecycle io tracing runtime plant fmi)
+set(HILTWIN_EXPORTED_MODULES lockfree kernel_glue scheduler qos lifecycle io tracing runtime plant
+    controller fmi)
 set(HILTWIN_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/hiltwin")
 set(HILTWIN_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/hiltwin")
 
@@ -23,6 +24,15 @@ foreach(module IN LISTS HILTWIN_EXPORTED_MODULES)
   install(DIRECTORY "${module_dir}/include/" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
           COMPONENT dev)
 endforeach()
+# The C ABI of a controller library (hiltwin/controller_abi.h): the header alone, as the
+# INTERFACE target hiltwin::controller_abi, with hiltwin_add_controller to build a library
+# against it (cmake/HiltwinController.cmake, included by hiltwinConfig.cmake). The controller
+# module's C++ headers stay inside the binary with the module.
+install(FILES "${PROJECT_SOURCE_DIR}/models/controller/include/hiltwin/controller_abi.h"
+        DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/hiltwin" COMPONENT dev)
+list(APPEND exported_targets hiltwin_controller_abi)
+install(FILES "${PROJECT_SOURCE_DIR}/cmake/HiltwinController.cmake"
+        DESTINATION "${HILTWIN_INSTALL_CMAKEDIR}" COMPONENT dev)
 install(TARGETS ${exported_targets} EXPORT hiltwinTargets
         ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}" COMPONENT dev
         INCLUDES DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")

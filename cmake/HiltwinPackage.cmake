@@ -55,13 +55,14 @@ set(CPACK_COMPONENT_DEV_DESCRIPTION
 CMake package of hiltwin's framework, for plants and controllers built outside
 hiltwin. find_package(hiltwin) gives hiltwin::runtime, hiltwin::io,
 hiltwin::plant, hiltwin::fmi and the layers below them (lockfree, kernel_glue, scheduler,
-qos, lifecycle, tracing).")
+qos, lifecycle, tracing), and the C ABI of a controller library (hiltwin/controller_abi.h,
+hiltwin::controller_abi, hiltwin_add_controller) for hiltwin ecs --controller lib:PATH.so.")
 # hiltwin-dev Depends on hiltwin (= this version): component dependencies become package ones.
 set(CPACK_COMPONENT_DEV_DEPENDS runtime)
 set(CPACK_DEBIAN_ENABLE_COMPONENT_DEPENDS ON)
 # What cmake/hiltwinConfig.cmake.in finds, as Debian names it (Threads is libc's).
 set(dev_depends libspdlog-dev "nlohmann-json3-dev (>= 3.11)" libtomlplusplus-dev libxml2-dev
-    libzip-dev pkg-config)
+    libzip-dev libssl-dev pkg-config)
 if(HILTWIN_WITH_LTTNG)
   list(APPEND dev_depends liblttng-ust-dev)
 endif()

@@ -42,6 +42,7 @@ packages=(
   libjs-three                                   # three.js for the page's 3D view (embedded)
   chromium                                      # the web page test (headless)
   libzip-dev libxml2-dev                        # FMI 2.0 FMUs: unpacking, modelDescription.xml
+  libssl-dev                                    # SHA-256 of a controller's file (its report)
   yosys nextpnr-ice40 fpga-icestorm verilator   # the IcoBoard gateware (board/fpga/, docs/fpga.md)
   clang libclang-rt-14-dev                      # libFuzzer targets (fuzz/; the runtime is only recommended)
   stress-ng                                     # the fault matrix's CPU hog (docs/reliability.md)
@@ -59,6 +60,7 @@ cross_packages=(
   libfftw3-dev:arm64 liblttng-ust-dev:arm64 liblttng-ctl-dev:arm64 libbabeltrace2-dev:arm64
   libtracefs-dev:arm64 libtraceevent-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64
   cyclonedds-dev:arm64 libcpp-httplib-dev:arm64 libzip-dev:arm64 libxml2-dev:arm64
+  libssl-dev:arm64
 )
 
 if [[ $(id -u) -eq 0 ]]; then

@@ -24,6 +24,9 @@ struct EcsFlags {
   std::string mode = "closedloop";
   std::string setpoint = "closedloop";
   std::string input = "openloop";
+  std::string controller = "pid";
+  bool controller_given = false;
+  std::string controller_map_path;
   std::string gains_path;
   std::string config_path;
 };
@@ -34,6 +37,7 @@ std::vector<NamedFile> EcsFiles(const EcsFlags& f) {
   std::vector<NamedFile> files = SessionOutputFiles(f.session);
   files.push_back(ProfileFile("--setpoint", f.setpoint, BuiltinSetpointNames()));
   files.push_back(ProfileFile("--input", f.input, BuiltinProfileNames()));
+  files.push_back({"--controller-map", f.controller_map_path, false});
   files.push_back({"--gains", f.gains_path, false});
   files.push_back({"--config", f.config_path, false});
   return files;
@@ -47,6 +51,14 @@ EcsRunOptions EcsRunOptionsOf(const EcsFlags& f) {
   o.mode = f.mode == "openloop" ? EcsMode::kOpenLoop : EcsMode::kClosedLoop;  // CLI11-checked
   o.setpoint = f.setpoint;
   o.input = f.input;
+  // Open loop plays a duty profile: no controller runs, so naming one is a mistake.
+  if (f.mode == "openloop" && (f.controller_given || !f.controller_map_path.empty())) {
+    ThrowUsage(std::string(f.controller_given ? "--controller" : "--controller-map") +
+               " is for --mode closedloop; open loop plays --input's duties without a "
+               "controller: drop it, or use --mode closedloop");
+  }
+  o.controller = f.controller;
+  o.controller_map_path = f.controller_map_path;
   o.gains_path = f.gains_path;
   o.config_path = f.config_path;
   CheckFilesDistinct(EcsFiles(f));
@@ -59,9 +71,10 @@ Command AddEcsCommand(CLI::App& parent) {
   CLI::App* app = parent.add_subcommand(
       "ecs",
       "Run the RELbot's embedded controller (ECS) with a QoS verdict.\n"
-      "Closed loop (default): one position PID per wheel follows --setpoint (built-in\n"
-      "closedloop: 2.5 m forward, thesis 7.2) and reports the tracking error. "
-      "Open loop: plays the\n"
+      "Closed loop (default): the controller (--controller; default pid, one position PID per\n"
+      "wheel) follows --setpoint (built-in closedloop: 2.5 m forward, thesis 7.2) and reports\n"
+      "the tracking error; one that returns an error, NaN or a duty beyond its limit is\n"
+      "stopped with zero duty and the run ends ABORTED. Open loop: plays the\n"
       "duty profile --input and logs duty and measured wheel positions (thesis 5.2).\n"
       "The same controller drives the twin (--io wire:NAME, with `hiltwin run --io wire:NAME`)\n"
       "or the robot (--io spidev:/dev/spidev0.0). Default (m,k) rule: (1,2), never two misses\n"
@@ -73,7 +86,8 @@ Command AddEcsCommand(CLI::App& parent) {
   app->get_option("--duration")
       ->description("run length in seconds (default: the profile's length)")
       ->each([o](const std::string&) { o->duration_given = true; });
-  app->add_option("--mode", o->mode, "closedloop (PID on --setpoint) or openloop (--input duty)")
+  app->add_option("--mode", o->mode,
+                  "closedloop (--controller on --setpoint) or openloop (--input duty)")
       ->check(CLI::IsMember({"closedloop", "openloop"}))
       ->capture_default_str();
   app->add_option("--setpoint", o->setpoint,
@@ -82,8 +96,17 @@ Command AddEcsCommand(CLI::App& parent) {
   app->add_option("--input", o->input,
                   "open loop: built-in openloop, or a CSV duty file time,left,right")
       ->capture_default_str();
+  app->add_option("--controller", o->controller,
+                  "closed loop: the controller, pid (built in), lib:PATH.so (C ABI), 20sim:NAME or "
+                  "fmu:PATH.fmu (docs/controllers.md)")
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->controller_given = true; });
+  app->add_option("--controller-map", o->controller_map_path,
+                  "controller map (TOML): which encoder, setpoint column and PWM channel meet "
+                  "which controller port (default: the RELbot's, relbot/ecs_controller_map.toml)");
   app->add_option("--gains", o->gains_path,
-                  "PID gains and limits (TOML, see relbot/ecs_gains.toml; default: built in)");
+                  "--controller pid's gains and limits (TOML, see relbot/ecs_gains.toml; default: "
+                  "built in)");
   app->add_option("--config", o->config_path,
                   "RELbot parameter file for the wheel geometry (TOML, relbot/relbot.toml)");
   return {app, [o] { return RunEcs(EcsRunOptionsOf(*o)); }};

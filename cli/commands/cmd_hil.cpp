@@ -15,7 +15,9 @@
 #include "commands.h"
 #include "hiltwin/io/wire_bus.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/pid_controller.h"
 #include "hiltwin/relbot/setpoint_profile.h"
+#include "hiltwin/runs/controllers.h"
 #include "hiltwin/runs/hil_run.h"
 #include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/scheduler/executive.h"
@@ -72,10 +74,17 @@ void ValidateTelemetry(const telemetry::TelemetryOptions& t) {
 
 /// The flags, read once, in the order they are checked (exit 2 naming the flag): the files (no
 /// output names an input or another output), the rates and the duration (0: the profile's
-/// length, read here), the telemetry flags and the wire's name.
+/// length, read here), the controller map's syntax, the telemetry flags and the wire's name.
 HilRunOptions HilRunOptionsOf(HilRunOptions o) {
   CheckFilesDistinct(HilFiles(o));
   Validate(o);
+  // The controller and its map, made, bound and dropped here: a library that cannot be
+  // loaded, a map that does not parse or does not fit the controller is the parent's exit 2
+  // before either side starts, not an ECS that dies beside a twin waiting for it.
+  if (o.mode == "closedloop") {
+    static_cast<void>(MakeBoundController({o.controller.empty() ? kPidControllerName : o.controller,
+                                           o.controller_map_path, o.gains_path, o.config_path}));
+  }
   ValidateTelemetry(o.telemetry);
   if (o.wire.empty()) o.wire = "hil-" + std::to_string(::getpid());
   try {
@@ -102,14 +111,20 @@ Command AddHilCommand(CLI::App& parent) {
   app->add_option("--ecs-rate", o->ecs_rate_hz, "controller rate in Hz")->capture_default_str();
   app->add_option("--duration", o->duration_s,
                   "controller run length in seconds (default: the profile's length)");
-  app->add_option("--mode", o->mode, "closedloop (PID on --setpoint) or openloop (--input duty)")
+  app->add_option("--mode", o->mode,
+                  "closedloop (--controller on --setpoint) or openloop (--input duty)")
       ->check(CLI::IsMember({"closedloop", "openloop"}))
       ->capture_default_str();
   app->add_option("--setpoint", o->setpoint, "closed loop: closedloop or CSV time,left_m,right_m")
       ->capture_default_str();
   app->add_option("--input", o->input, "open loop: openloop or CSV time,left,right")
       ->capture_default_str();
-  app->add_option("--gains", o->gains_path, "PID gains (TOML, relbot/ecs_gains.toml)");
+  app->add_option("--controller", o->controller,
+                  "the ECS's controller: pid (default), lib:PATH.so, 20sim:NAME, fmu:PATH.fmu");
+  app->add_option("--controller-map", o->controller_map_path,
+                  "the ECS's controller map (TOML; default: relbot/ecs_controller_map.toml)");
+  app->add_option("--gains", o->gains_path,
+                  "--controller pid's gains (TOML, relbot/ecs_gains.toml)");
   app->add_option("--config", o->config_path, "RELbot parameters (TOML), for both sides");
   app->add_option("--twin-qos", o->twin_qos, "twin (m,k) rule M:K (repeatable)");
   app->add_option("--ecs-qos", o->ecs_qos, "controller (m,k) rule M:K (repeatable)");

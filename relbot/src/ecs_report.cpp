@@ -1,6 +1,8 @@
 #include "hiltwin/relbot/ecs_report.h"
 
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace hiltwin::app {
 
@@ -11,11 +13,83 @@ EcsFigures EcsFiguresOf(const EcsTask& task, const io::IcoBoardLink& driver,
   figures.tracking = task.tracking();
   figures.link = driver.counters();
   if (board != nullptr) figures.encoder_lines = board->encoder_lines().counters();
+  if (const controller::ControllerTask* loop = task.controller_task()) {
+    figures.controller = loop->controller().Info();
+    figures.fault = loop->fault();
+    figures.pairs = loop->tracking();
+  }
   return figures;
 }
 
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+const char* ToString(controller::ControllerFault::Kind kind) {
+  switch (kind) {
+    case controller::ControllerFault::Kind::kErrorStatus:
+      return "error status";
+    case controller::ControllerFault::Kind::kNotFinite:
+      return "not finite";
+    case controller::ControllerFault::Kind::kBeyondLimit:
+      return "beyond duty_limit";
+    case controller::ControllerFault::Kind::kNone:
+      break;
+  }
+  return "none";
+}
+
+Json PortsJson(const std::vector<controller::Port>& ports) {
+  Json out = Json::array();
+  for (const controller::Port& port : ports) {
+    out.push_back({{"name", port.name}, {"unit", port.unit}});
+  }
+  return out;
+}
+
+Json FaultJson(const controller::ControllerFault& f) {
+  if (f.kind == controller::ControllerFault::Kind::kNone) return nullptr;
+  // A non-finite value is not JSON: its text instead.
+  const Json value = std::isfinite(f.value) ? Json(f.value) : Json(std::to_string(f.value));
+  return {{"kind", ToString(f.kind)}, {"output", f.output},         {"value", value},
+          {"duty_limit", f.duty_limit}, {"reason", f.reason}, {"cycle", f.cycle}};
+}
+
+Json PairsJson(const EcsFigures& f) {
+  if (!f.controller) return nullptr;
+  Json out = Json::array();
+  for (const controller::TrackingPair& p : f.pairs) {
+    out.push_back({{"column", p.column},
+                   {"input", p.input},
+                   {"tracks", p.tracked},
+                   {"samples", p.samples},
+                   {"max_abs_error", p.max_abs_error},
+                   {"rms_error", p.rms_error},
+                   {"final_error", p.final_error}});
+  }
+  return out;
+}
+
+Json ControllerJson(const EcsFigures& f) {
+  if (!f.controller) return nullptr;
+  const controller::ControllerInfo& c = *f.controller;
+  Json details = Json::object();
+  for (const auto& [key, value] : c.details) details[key] = value;
+  return {{"spec", c.spec},
+          {"kind", c.kind},
+          {"name", c.name},
+          {"file", c.file},
+          {"content_sha256", c.content_sha256},
+          {"inputs", PortsJson(c.inputs)},
+          {"outputs", PortsJson(c.outputs)},
+          {"model_step_s", c.model_step_s},
+          {"details", details},
+          {"fault", FaultJson(f.fault)}};
+}
+
+}  // namespace
+
 nlohmann::ordered_json EcsReportJson(const runtime::RunReport& report, const EcsFigures& f) {
-  using Json = nlohmann::ordered_json;
   Json json = runtime::ToJson(report);
   const TrackingStats& t = f.tracking;
   json["tracking"] =
@@ -31,6 +105,8 @@ nlohmann::ordered_json EcsReportJson(const runtime::RunReport& report, const Ecs
                                     {"right", t.final_error_right_m}}},
                  {"saturated_cycles", t.saturated_cycles},
                  {"max_abs_duty", t.max_abs_duty}};
+  json["controller"] = ControllerJson(f);
+  json["tracking_pairs"] = PairsJson(f);
   const io::LinkCounters& l = f.link;
   json["link_counters"] = {{"frames_sent", l.frames_sent},
                            {"frames_received", l.frames_received},
@@ -61,6 +137,12 @@ std::string FormatEcsFigures(const EcsFigures& f) {
                   t.rms_error_m * 1e3, t.final_error_left_m * 1e3, t.final_error_right_m * 1e3,
                   static_cast<unsigned long long>(t.saturated_cycles));
     out += text;
+  }
+  if (f.fault.kind != controller::ControllerFault::Kind::kNone && f.controller) {
+    out += "controller " + f.controller->spec + " stopped at cycle " +
+           std::to_string(f.fault.cycle) + ": " + ToString(f.fault.kind) +
+           (f.fault.output.empty() ? "" : " on output " + f.fault.output) +
+           (f.fault.reason.empty() ? "" : " (" + f.fault.reason + ")") + "; safe outputs\n";
   }
   if (f.encoder_lines) {
     const io::EncoderLineCounters& e = *f.encoder_lines;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "hiltwin/relbot/ecs_gains.h"
+#include "hiltwin/relbot/pid_controller.h"
 #include "hiltwin/relbot/relbot_telemetry.h"
 
 namespace hiltwin::app {
@@ -21,11 +21,6 @@ std::int64_t CheckedPeriodNs(std::int64_t period_ns) {
   return period_ns;
 }
 
-const PidGains& CheckedGains(const PidGains& gains) {
-  ValidateEcsGains(gains, "ECS gains");
-  return gains;
-}
-
 double TimeS(std::uint64_t cycle, std::int64_t period_ns) noexcept {
   // From the integer nanosecond count, so every time is the exact multiple's nearest double
   // and nothing drifts over a long run.
@@ -34,28 +29,53 @@ double TimeS(std::uint64_t cycle, std::int64_t period_ns) noexcept {
 
 }  // namespace
 
-EcsTask::EcsTask(io::IcoBoard& board, EcsMode mode, const SetpointProfile* setpoints,
-                 const InputProfile* duty_profile, const PidGains& gains,
-                 const io::WheelGeometry& geometry, std::int64_t period_ns)
-    : board_(board),
-      mode_(mode),
-      setpoints_(setpoints),
-      duty_profile_(duty_profile),
-      geometry_(geometry),
-      counts_per_m_(io::CountsPerMetre(geometry)),
-      period_ns_(CheckedPeriodNs(period_ns)),
-      pid_left_(CheckedGains(gains), static_cast<double>(period_ns) * 1e-9),
-      pid_right_(gains, static_cast<double>(period_ns) * 1e-9) {}
+EcsTask::EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints,
+                 std::unique_ptr<controller::Controller> owned, const io::WheelGeometry& geometry,
+                 std::int64_t period_ns)
+    : EcsTask(board, setpoints, *owned,
+              controller::BindControllerMap(RelbotControllerMap(geometry), *owned), geometry,
+              period_ns) {
+  owned_controller_ = std::move(owned);
+}
 
 EcsTask::EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints, const PidGains& gains,
                  const io::WheelGeometry& geometry, std::int64_t period_ns)
-    : EcsTask(board, EcsMode::kClosedLoop, &setpoints, nullptr, gains, geometry, period_ns) {}
+    : EcsTask(board, setpoints, std::make_unique<PidController>(gains), geometry, period_ns) {}
+
+EcsTask::EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints,
+                 controller::Controller& controller, controller::BoundControllerMap map,
+                 const io::WheelGeometry& geometry, std::int64_t period_ns)
+    : board_(board),
+      mode_(EcsMode::kClosedLoop),
+      setpoints_(&setpoints),
+      duty_profile_(nullptr),
+      geometry_(geometry),
+      period_ns_(CheckedPeriodNs(period_ns)) {
+  columns_.emplace(setpoints);
+  loop_.emplace(board, controller, std::move(map), *columns_, period_ns);
+  pid_ = dynamic_cast<const PidController*>(&controller);
+}
 
 EcsTask::EcsTask(io::IcoBoard& board, const InputProfile& duty_profile,
                  const io::WheelGeometry& geometry, std::int64_t period_ns)
-    : EcsTask(board, EcsMode::kOpenLoop, nullptr, &duty_profile, PidGains{}, geometry, period_ns) {}
+    : board_(board),
+      mode_(EcsMode::kOpenLoop),
+      setpoints_(nullptr),
+      duty_profile_(&duty_profile),
+      geometry_(geometry),
+      period_ns_(CheckedPeriodNs(period_ns)) {}
+
+std::array<double, 2> EcsTask::ProfileColumns::At(double time_s) const noexcept {
+  const WheelPositions setpoint = profile_.At(time_s);
+  return {setpoint.left_m, setpoint.right_m};
+}
+
+const io::EcsInputs& EcsTask::inputs() const noexcept {
+  return loop_ ? loop_->board_inputs() : inputs_;
+}
 
 io::ExchangeStatus EcsTask::Exchange(bool live_outputs) noexcept {
+  if (loop_) return loop_->Exchange(live_outputs);
   // One full-duplex frame: the duty of the previous step goes out, the counts at this
   // moment come in (held by the driver on a bad frame). Safe outputs: motors off.
   if (live_outputs) {
@@ -89,36 +109,18 @@ void EcsTask::ReadWheels() noexcept {
                                   io::CountsToMetres(last_.counts[kRight], geometry_)};
 }
 
-double EcsTask::OnEncoderGrid(double metres) const noexcept {
-  // Through the same conversion as the measurement, so a wheel on the setpoint's count has an
-  // error of exactly zero. Beyond ±2^62 counts (no robot travels that far) it stays as is.
-  const double counts = metres * counts_per_m_;
-  if (!(std::abs(counts) < 4.6e18)) return metres;
-  return io::CountsToMetres(std::llround(counts), geometry_);
-}
-
-Duty EcsTask::StepClosedLoop() noexcept {
-  const WheelPositions setpoint = setpoints_->At(last_.time_s);
-  const WheelPositions& measured = last_.measured;
-  // The encoder only ever reads whole counts, so a setpoint between two counts can never be
-  // met: the integral would push the wheel back and forth across the count edge for ever
-  // (hunting). On the grid, error zero is reachable and the wheel can rest.
-  const Duty duty{pid_left_.Step(OnEncoderGrid(setpoint.left_m), measured.left_m),
-                  pid_right_.Step(OnEncoderGrid(setpoint.right_m), measured.right_m)};
-  last_.setpoint = setpoint;
-
-  const double error_left_m = setpoint.left_m - measured.left_m;
-  const double error_right_m = setpoint.right_m - measured.right_m;
-  ++sums_.samples;
-  sums_.max_abs_left_m = std::max(sums_.max_abs_left_m, std::abs(error_left_m));
-  sums_.max_abs_right_m = std::max(sums_.max_abs_right_m, std::abs(error_right_m));
-  sums_.sum_sq_left_m2 += error_left_m * error_left_m;
-  sums_.sum_sq_right_m2 += error_right_m * error_right_m;
-  sums_.final_left_m = error_left_m;
-  sums_.final_right_m = error_right_m;
-  if (pid_left_.last().saturated || pid_right_.last().saturated) ++sums_.saturated_cycles;
-  sums_.max_abs_duty = std::max({sums_.max_abs_duty, std::abs(duty.left), std::abs(duty.right)});
-  return duty;
+void EcsTask::RecordClosedLoop() noexcept {
+  const std::array<std::int32_t, io::kChannels>& sent = loop_->pwm_sent();
+  const std::array<std::int32_t, io::kChannels>& next = loop_->pwm_next();
+  const std::array<std::int64_t, io::kChannels>& counts = loop_->counts();
+  last_.time_s = loop_->time_s();
+  last_.duty_sent = Duty{io::PwmToDuty(sent[kLeftChannel]), io::PwmToDuty(sent[kRightChannel])};
+  last_.duty_next = Duty{io::PwmToDuty(next[kLeftChannel]), io::PwmToDuty(next[kRightChannel])};
+  last_.counts = {counts[kLeftChannel], counts[kRightChannel]};
+  last_.measured = WheelPositions{io::CountsToMetres(last_.counts[kLeft], geometry_),
+                                  io::CountsToMetres(last_.counts[kRight], geometry_)};
+  const std::array<double, 2>& setpoint = loop_->setpoint_columns();
+  last_.setpoint = WheelPositions{setpoint[0], setpoint[1]};
 }
 
 void EcsTask::SetNextDuty(const Duty& duty) noexcept {
@@ -135,22 +137,27 @@ runtime::StepStatus EcsTask::Step(const scheduler::CycleContext& context) noexce
         "the session's period differs from the ECS task's period (the PID was discretised "
         "for the task's)");
   }
-  // The profile's clock runs only while the controller runs: after a pause the setpoints go
-  // on from where they stopped instead of jumping ahead by the pause. Skipped releases (skip
-  // policy) still count, so the profile keeps to the wall clock then.
-  const std::uint64_t profile_cycle = context.cycle - held_cycles_;
   last_.cycle = context.cycle;
+  if (loop_) {
+    const runtime::StepStatus status = loop_->Step(context);
+    RecordClosedLoop();
+    if (pid_ != nullptr && status.code == runtime::StepStatus::Code::kOk &&
+        (pid_->left().last().saturated || pid_->right().last().saturated)) {
+      ++pid_saturated_cycles_;
+    }
+    return status;
+  }
+  // The profile's clock runs only while the task runs: after a pause the duties go on from
+  // where they stopped instead of jumping ahead by the pause. Skipped releases (skip policy)
+  // still count, so the profile keeps to the wall clock then.
+  const std::uint64_t profile_cycle = context.cycle - held_cycles_;
   last_.time_s = TimeS(profile_cycle, period_ns_);
   last_.duty_sent =
       Duty{io::PwmToDuty(pwm_sent_[kLeftChannel]), io::PwmToDuty(pwm_sent_[kRightChannel])};
   ReadWheels();
-  if (mode_ == EcsMode::kClosedLoop) {
-    SetNextDuty(StepClosedLoop());
-  } else {
-    // Sampled at the moment it goes on the wire (the next exchange), so the duty on the wire
-    // over [t_j, t_j+1) is the profile at t_j: the signal ProfilePwmSource plays into a twin.
-    SetNextDuty(duty_profile_->At(TimeS(profile_cycle + 1, period_ns_)));
-  }
+  // Sampled at the moment it goes on the wire (the next exchange), so the duty on the wire
+  // over [t_j, t_j+1) is the profile at t_j: the signal ProfilePwmSource plays into a twin.
+  SetNextDuty(duty_profile_->At(TimeS(profile_cycle + 1, period_ns_)));
   return runtime::StepStatus::Ok();
 }
 
@@ -194,19 +201,23 @@ double EcsTask::length_s() const noexcept {
 
 TrackingStats EcsTask::tracking() const noexcept {
   TrackingStats stats;
-  stats.samples = sums_.samples;
-  stats.max_abs_error_left_m = sums_.max_abs_left_m;
-  stats.max_abs_error_right_m = sums_.max_abs_right_m;
-  if (sums_.samples > 0) {
-    const auto n = static_cast<double>(sums_.samples);
-    stats.rms_error_left_m = std::sqrt(sums_.sum_sq_left_m2 / n);
-    stats.rms_error_right_m = std::sqrt(sums_.sum_sq_right_m2 / n);
-    stats.rms_error_m = std::sqrt((sums_.sum_sq_left_m2 + sums_.sum_sq_right_m2) / (2.0 * n));
+  if (!loop_) return stats;
+  // The left_m and right_m pairs of the controller map (the RELbot's: each wheel's setpoint
+  // against its encoder); a map without one leaves that wheel's figures at zero.
+  double sum_sq_m2 = 0.0;
+  for (const controller::TrackingPair& pair : loop_->tracking()) {
+    const bool left = pair.column == "left_m";
+    (left ? stats.max_abs_error_left_m : stats.max_abs_error_right_m) = pair.max_abs_error;
+    (left ? stats.rms_error_left_m : stats.rms_error_right_m) = pair.rms_error;
+    (left ? stats.final_error_left_m : stats.final_error_right_m) = pair.final_error;
+    stats.samples = pair.samples;
+    sum_sq_m2 += pair.sum_sq_error;
   }
-  stats.final_error_left_m = sums_.final_left_m;
-  stats.final_error_right_m = sums_.final_right_m;
-  stats.saturated_cycles = sums_.saturated_cycles;
-  stats.max_abs_duty = sums_.max_abs_duty;
+  if (stats.samples > 0) {
+    stats.rms_error_m = std::sqrt(sum_sq_m2 / (2.0 * static_cast<double>(stats.samples)));
+  }
+  stats.saturated_cycles = pid_ != nullptr ? pid_saturated_cycles_ : loop_->saturated_cycles();
+  stats.max_abs_duty = loop_->max_abs_duty();
   return stats;
 }
 

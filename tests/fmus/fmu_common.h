@@ -12,7 +12,7 @@
 #define HILTWIN_FMI2_FUNCTION_PROTOTYPES
 #include "hiltwin/fmi/fmi2_abi.h"
 
-#define FMU_MAX_REALS 8
+#define FMU_MAX_REALS 16
 
 typedef struct {
   double r[FMU_MAX_REALS]; /* value reference -> value */

@@ -19,9 +19,11 @@
 #include "hiltwin/relbot/ecs_task.h"
 #include "hiltwin/relbot/encoder_reading.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/pid_controller.h"
 #include "hiltwin/relbot/relbot_params.h"
 #include "hiltwin/relbot/setpoint_profile.h"
 #include "hiltwin/runs/command.h"
+#include "hiltwin/runs/controllers.h"
 #include "hiltwin/runtime/run_session.h"
 
 namespace hiltwin::app {
@@ -38,6 +40,9 @@ struct Ecs {
   PidGains gains = DefaultEcsGains();
   std::optional<SetpointProfile> setpoints;
   std::optional<InputProfile> duty_profile;
+  std::unique_ptr<controller::Controller> controller;  ///< closed loop
+  std::optional<controller::BoundControllerMap> map;   ///< closed loop, bound to `controller`
+  std::string map_source;                              ///< the map's file, or the built-in's name
   std::unique_ptr<io::IoBackend> backend;
   std::unique_ptr<io::IcoBoard> driver;
   std::optional<EcsTask> task;
@@ -45,6 +50,7 @@ struct Ecs {
 };
 
 void LoadEcsConfiguration(const EcsRunOptions& o, Ecs& ecs) {
+  CheckGainsFlag({o.controller, o.controller_map_path, o.gains_path, o.config_path});
   try {
     if (!o.config_path.empty()) ecs.params = LoadRelbotParams(o.config_path);
     if (!o.gains_path.empty()) ecs.gains = LoadEcsGains(o.gains_path);
@@ -62,25 +68,61 @@ void LoadEcsConfiguration(const EcsRunOptions& o, Ecs& ecs) {
   }
 }
 
-/// Loads gains and profiles (exit 2 with file:line), opens the link and checks the board's
-/// identity (exit 5 with the thesis's message), then builds the task.
+/// The closed loop's controller and its map, bound (exit 2 with the spec's or the map's
+/// message), before any board is opened.
+void MakeEcsController(const EcsRunOptions& o, Ecs& ecs) {
+  BoundController made =
+      MakeBoundController({o.controller, o.controller_map_path, o.gains_path, o.config_path});
+  ecs.controller = std::move(made.controller);
+  ecs.map = std::move(made.map);
+  ecs.map_source = std::move(made.map_source);
+}
+
+/// Loads gains, profiles and the controller (exit 2 with file:line), opens the link and checks
+/// the board's identity (exit 5 with the thesis's message), then builds the task, which starts
+/// the controller (exit 2 when it cannot run at the ECS's period).
 std::unique_ptr<Ecs> BuildEcs(const EcsRunOptions& o, kernel_glue::TimeNs period_ns) {
   auto ecs = std::make_unique<Ecs>();
   LoadEcsConfiguration(o, *ecs);
+  if (ecs->setpoints) MakeEcsController(o, *ecs);
   ecs->backend = OpenBoard(o.session, io::Image::kIcoboard);
   ecs->driver = std::make_unique<io::IcoBoard>(ecs->backend->bus());
   InitBoard(*ecs->driver, period_ns);
   const io::WheelGeometry geometry = WheelGeometryOf(ecs->params);
   try {
     if (ecs->setpoints) {
-      ecs->task.emplace(*ecs->driver, *ecs->setpoints, ecs->gains, geometry, period_ns);
+      ecs->task.emplace(*ecs->driver, *ecs->setpoints, *ecs->controller, std::move(*ecs->map),
+                        geometry, period_ns);
     } else {
       ecs->task.emplace(*ecs->driver, *ecs->duty_profile, geometry, period_ns);
     }
-  } catch (const ConfigError& e) {
-    ThrowUsage(std::string("--gains: ") + e.what());
+  } catch (const controller::ControllerError& e) {
+    ThrowUsage("--controller " + o.controller + ": " + e.what());
   }
   return ecs;
+}
+
+/// "setpoint_left_m [m], wheel_left_m [m]": a controller's ports as the start line and the
+/// report give them.
+std::string DescribePorts(const std::vector<controller::Port>& ports) {
+  std::string out;
+  for (const controller::Port& port : ports) {
+    out += (out.empty() ? "" : ", ") + port.name + " [" + port.unit + "]";
+  }
+  return out.empty() ? "none" : out;
+}
+
+/// "controller pid (built-in): pid; inputs ...; outputs ...; map ...", and the file with its
+/// SHA-256 when the code came from one.
+std::string ControllerLine(const Ecs& ecs) {
+  const controller::ControllerInfo& info = ecs.controller->Info();
+  std::string line = "controller " + info.spec + " (" + info.kind + "): " + info.name +
+                     "; inputs " + DescribePorts(info.inputs) + "; outputs " +
+                     DescribePorts(info.outputs) + "; map " + ecs.map_source + "\n";
+  if (!info.file.empty()) {
+    line += "controller file " + info.file + ", sha256 " + info.content_sha256 + "\n";
+  }
+  return line;
 }
 
 /// "kp 100 duty/m, ki 1000 duty/(m s), kd 3 duty s/m, filter 0.005 s, limit 1": each number in
@@ -97,13 +139,14 @@ std::string DescribeGains(const PidGains& g) {
 }
 
 void PrintStartLines(const EcsRunOptions& o, std::uint64_t planned, const std::string& profile,
-                     const kernel_glue::RtSetupRecord* rt) {
+                     const std::string& controller_line, const kernel_glue::RtSetupRecord* rt) {
   std::fprintf(stdout,
                "hiltwin ecs: RELbot controller (%s, %s) at %.0f Hz for %.3f s (%llu cycles), "
                "io %s, %s clock\n",
                ToString(o.mode), profile.c_str(), o.session.rate_hz, o.session.duration_s,
                static_cast<unsigned long long>(planned), o.session.io_text.c_str(),
                runtime::ToString(o.session.clock));
+  std::fputs(controller_line.c_str(), stdout);
   if (o.session.io.kind == io::BackendSpec::Kind::kMock) {
     std::fprintf(stdout,
                  "note: the mock board has no plant behind it, so the encoders stay at 0; drive "
@@ -138,20 +181,25 @@ int RunEcs(const EcsRunOptions& options) {
   config.details = {{"mode", ToString(o.mode)}, {"profile", ecs->profile_name}};
   // The gains the run used, to every digit: with the rates, profile and clock in the report,
   // a lockstep result can be reproduced from the report alone (docs/lockstep.md).
-  if (o.mode == EcsMode::kClosedLoop) {
+  if (o.mode == EcsMode::kClosedLoop && o.controller == kPidControllerName) {
     config.details.emplace_back("gains", DescribeGains(ecs->gains));
   }
-  config.on_ready = [o, planned, profile = ecs->profile_name](
-                        const kernel_glue::RtSetupRecord* rt) {
-    PrintStartLines(o, planned, profile, rt);
+  std::string controller_line;
+  if (o.mode == EcsMode::kClosedLoop) {
+    // The controller itself is the report's `controller` section (EcsReportJson).
+    config.details.emplace_back("controller_map", ecs->map_source);
+    controller_line = ControllerLine(*ecs);
+  }
+  config.on_ready = [o, planned, profile = ecs->profile_name,
+                     controller_line](const kernel_glue::RtSetupRecord* rt) {
+    PrintStartLines(o, planned, profile, controller_line, rt);
   };
   // Whether this rate follows the counts (the twin's rate is not known here: `hil` checks it).
   config.warnings =
       EncoderReadingWarnings({o.session.rate_hz, std::nullopt, TopCountsPerSecond(ecs->params)});
   PrintWarnings("ecs", config.warnings);
   const runtime::RunReport report = RunSessionOf(std::move(config), *ecs->task);
-  const EcsFigures figures =
-      EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
+  const EcsFigures figures = EcsFiguresOf(*ecs->task, *ecs->driver, ecs->backend->emulated_board());
   return PrintOutcome(role, report, EcsReportJson(report, figures), FormatEcsFigures(figures),
                       report_file);
 }

@@ -47,6 +47,35 @@ std::optional<HilTracking> TrackingOf(const std::optional<Json>& ecs) {
   return tracking;
 }
 
+/// The ECS report's `controller` section (closed loop), or null.
+Json ControllerOf(const HilSide& ecs) {
+  if (!ecs.report || !ecs.report->contains("controller")) return nullptr;
+  return (*ecs.report)["controller"];
+}
+
+/// "controller pid (built-in): pid" and, for code from a file, its path and SHA-256: which code
+/// produced the result.
+std::string ControllerLine(const Json& c) {
+  if (!c.is_object()) return "";
+  const auto text = [&c](const char* key) {
+    return c.contains(key) && c[key].is_string() ? c[key].get<std::string>() : std::string();
+  };
+  std::string line = "controller " + text("spec") + " (" + text("kind") + "): " + text("name");
+  if (!text("file").empty()) line += "; " + text("file") + ", sha256 " + text("content_sha256");
+  // A controller the ECS stopped: the pair's summary says so where it names the controller,
+  // as the ECS's own summary does (ecs_report.cpp).
+  if (c.contains("fault") && c["fault"].is_object()) {
+    const Json& f = c["fault"];
+    const auto field = [&f](const char* key) {
+      return f.contains(key) && f[key].is_string() ? f[key].get<std::string>() : std::string();
+    };
+    line += "; stopped at cycle " + std::to_string(f.value("cycle", 0ULL)) + ": " + field("kind");
+    if (!field("output").empty()) line += " on output " + field("output");
+    if (!field("reason").empty()) line += " (" + field("reason") + ")";
+  }
+  return line + "\n";
+}
+
 Json SideExit(const HilSide& side) {
   return {{"exit_code", ExitCodeOf(side.status)}, {"ended", side.status.Describe()}};
 }
@@ -79,6 +108,13 @@ int ExitCodeOf(const kernel_glue::ExitStatus& status) noexcept {
 int WorseExitCode(int a, int b) noexcept { return Severity(a) >= Severity(b) ? a : b; }
 
 namespace {
+
+/// "5", or "1, killed by signal 11 (SIGSEGV)": a side that did not exit counts as 1, and the
+/// summary says why rather than an exit code the side never gave.
+std::string CodeText(const kernel_glue::ExitStatus& status) {
+  const std::string code = std::to_string(ExitCodeOf(status));
+  return status.exited ? code : code + ", " + status.Describe();
+}
 
 /// A side that judged no cycle because its peer ended first (verdict NONE, stop peer_stopped)
 /// only echoes that peer's end: its exit 5 says nothing the peer's own code does not.
@@ -121,6 +157,7 @@ Json ToJson(const HilResult& r) {
   json["exit_code"] = r.exit_code;
   json["wire"] = r.wire;
   json["mode"] = r.mode;
+  json["controller"] = ControllerOf(r.ecs);
   if (r.tracking) {
     json["tracking_error_max_m"] = {{"left", r.tracking->max_left_m},
                                     {"right", r.tracking->max_right_m}};
@@ -144,7 +181,7 @@ Json ToJson(const HilResult& r) {
 }
 
 std::string FormatHilSummary(const HilResult& r) {
-  std::string out = SideLine(r.twin) + SideLine(r.ecs);
+  std::string out = SideLine(r.twin) + SideLine(r.ecs) + ControllerLine(ControllerOf(r.ecs));
   char text[400];
   if (r.tracking) {
     std::snprintf(text, sizeof text,
@@ -164,8 +201,9 @@ std::string FormatHilSummary(const HilResult& r) {
   const int twin_code = ExitCodeOf(r.twin.status);
   const int ecs_code = ExitCodeOf(r.ecs.status);
   const bool worse = r.exit_code == WorseExitCode(twin_code, ecs_code);
-  std::snprintf(text, sizeof text, "hil       exit %d (%s twin %d and ECS %d)\n", r.exit_code,
-                worse ? "the worse of" : "the side that failed first of", twin_code, ecs_code);
+  std::snprintf(text, sizeof text, "hil       exit %d (%s twin %s and ECS %s)\n", r.exit_code,
+                worse ? "the worse of" : "the side that failed first of",
+                CodeText(r.twin.status).c_str(), CodeText(r.ecs.status).c_str());
   return out + text;
 }
 

@@ -111,6 +111,8 @@ std::vector<std::string> TwinArgv(const HilRunOptions& o, const std::string& wir
                                    wire,
                                    "--rate",
                                    Num(o.twin_rate_hz),
+                                   "--input-rate",  // the ECS's: the twin checks it follows
+                                   Num(o.ecs_rate_hz),
                                    "--duration",
                                    Num(o.duration_s + kTwinExtraS),
                                    "--wait-peer",
@@ -157,6 +159,10 @@ std::vector<std::string> EcsArgv(const HilRunOptions& o, const std::string& wire
     argv.insert(argv.end(), {"--input", o.input});
   }
   if (!o.log_dir.empty()) argv.insert(argv.end(), {"--log", SideFile(dir, "ecs", kLog)});
+  if (!o.controller.empty()) argv.insert(argv.end(), {"--controller", o.controller});
+  if (!o.controller_map_path.empty()) {
+    argv.insert(argv.end(), {"--controller-map", o.controller_map_path});
+  }
   if (!o.gains_path.empty()) argv.insert(argv.end(), {"--gains", o.gains_path});
   if (!o.config_path.empty()) argv.insert(argv.end(), {"--config", o.config_path});
   AddRules(argv, o.ecs_qos, o.ecs_max_miss_pct, o.on_violation);
@@ -281,6 +287,7 @@ std::vector<NamedFile> HilFiles(const HilRunOptions& o) {
   std::vector<NamedFile> files = {
       ProfileFile("--setpoint", o.setpoint, BuiltinSetpointNames()),
       ProfileFile("--input", o.input, BuiltinProfileNames()),
+      {"--controller-map", o.controller_map_path, false},
       {"--gains", o.gains_path, false},
       {"--config", o.config_path, false},
       {"--report", o.report_path, true}};

@@ -44,6 +44,8 @@ class FmuPlantImpl final : public FmuPlant {
     return unpacked_.dir();
   }
   [[nodiscard]] FmuDirectCalls DirectCalls() const noexcept override;
+  /// What the FMU says about itself, for the controller adapter's checks (fmu_controller.cpp).
+  [[nodiscard]] const ModelDescription& model_description() const noexcept { return md_; }
 
  private:
   void BuildPorts();

@@ -2,24 +2,14 @@
 #include <optional>
 #include <set>
 
+#include "hiltwin/plant/map_toml.h"
 #include "hiltwin/plant/plant_map.h"
 
 namespace hiltwin::plant {
 namespace {
 
-std::optional<std::size_t> IndexOf(const std::vector<Port>& ports, const std::string& name) {
-  for (std::size_t i = 0; i < ports.size(); ++i) {
-    if (ports[i].name == name) return i;
-  }
-  return std::nullopt;
-}
-
-std::string Names(const std::vector<Port>& ports) {
-  if (ports.empty()) return "none";
-  std::string out;
-  for (const Port& port : ports) out += (out.empty() ? "" : ", ") + port.name;
-  return out;
-}
+using map_toml::PortIndex;
+using map_toml::PortNames;
 
 /// A line and column in the map.
 struct Place {
@@ -43,22 +33,22 @@ class Binder {
   /// An input by name; a name that is an output or something else gets its own message.
   std::size_t Input(const std::string& name, Place at, const char* what) const {
     const PlantInfo& info = plant_.Info();
-    if (const auto i = IndexOf(info.inputs, name)) return *i;
-    if (IndexOf(info.outputs, name)) {
+    if (const auto i = PortIndex(info.inputs, name)) return *i;
+    if (PortIndex(info.outputs, name)) {
       Fail(at, what + std::string(" '") + name +
                    "' is an output of the plant; only inputs can be driven (inputs: " +
-                   Names(info.inputs) + ")");
+                   PortNames(info.inputs) + ")");
     }
     Unknown(name, at, what, "inputs", info.inputs);
   }
 
   std::size_t Output(const std::string& name, Place at, const char* what) const {
     const PlantInfo& info = plant_.Info();
-    if (const auto i = IndexOf(info.outputs, name)) return *i;
-    if (IndexOf(info.inputs, name)) {
+    if (const auto i = PortIndex(info.outputs, name)) return *i;
+    if (PortIndex(info.inputs, name)) {
       Fail(at, what + std::string(" '") + name +
                    "' is an input of the plant; only outputs can be followed (outputs: " +
-                   Names(info.outputs) + ")");
+                   PortNames(info.outputs) + ")");
     }
     Unknown(name, at, what, "outputs", info.outputs);
   }
@@ -69,7 +59,7 @@ class Binder {
     const std::string known = plant_.ExplainNonPort(name);
     Fail(at, what + std::string(" '") + name + "' " +
                  (known.empty() ? "is not a port of the plant" : known) + " (" + kind + ": " +
-                 Names(ports) + ")");
+                 PortNames(ports) + ")");
   }
 
   const PlantMap& map_;

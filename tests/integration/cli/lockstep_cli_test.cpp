@@ -14,6 +14,7 @@
 //   (exit 5), outputs safe, a report, within 1 s of the event (LockstepFault, label rt: the
 //   only wall-clock bounds here).
 // Every test ends with the wire's segment gone from /dev/shm.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -118,12 +119,17 @@ class Lockstep : public ::testing::Test {
   }
   /// `hiltwin hil --clock virtual` on this test's wire, its report in DIR.json and its logs in
   /// DIR/ (both removed first, so nothing of an earlier run can stand in for this one's).
-  hiltwin::test::RunResult Hil(const std::string& dir) const {
+  hiltwin::test::RunResult Hil(const std::string& dir,
+                               const std::vector<std::string>& extra = {}) const {
     std::error_code ignored;
     fs::remove_all(Path(dir), ignored);
     fs::remove(Path(dir + ".json"), ignored);
-    return Hiltwin({"hil", "--clock", "virtual", "--wire", scratch_.WireName(), "--no-progress",
-                    "--report", Path(dir + ".json"), "--log-dir", Path(dir)});
+    std::vector<std::string> args = {"hil",      "--clock",  "virtual",
+                                     "--wire",   scratch_.WireName(),
+                                     "--no-progress", "--report", Path(dir + ".json"),
+                                     "--log-dir", Path(dir)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Hiltwin(args);
   }
   /// The twin's command line as hil builds it (the default rate, the ECS's 12 s + 2 s,
   /// --clock virtual), without the program; its report in NAME.json.
@@ -299,6 +305,31 @@ TEST_F(LockstepHil, TracksExactlyAsTheInProcessRig) {
 }
 
 // --- A pair started by hand ------------------------------------------------------------------
+
+// Issue 37: the built-in PID as `--controller pid` on the RELbot's controller map given as a
+// file runs the default run exactly: the same 2.5 m tracking figures as doubles and the same
+// ECS log, byte for byte; and the combined report names the controller.
+TEST_F(LockstepHil, ThePidOnTheShippedControllerMapTracksExactlyAsTheDefault) {
+  const auto plain = Hil("plain");
+  ASSERT_EQ(plain.exit_code, 0) << plain.out << plain.err;
+  const auto mapped =
+      Hil("mapped", {"--controller", "pid", "--controller-map", HILTWIN_ECS_CONTROLLER_MAP_TOML});
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.out << mapped.err;
+  const Json a = ReadJson(Path("plain.json"));
+  const Json b = ReadJson(Path("mapped.json"));
+  EXPECT_EQ(a["ecs"]["tracking"], b["ecs"]["tracking"]);  // every figure, as doubles
+  for (const char* key : {"tracking_error_max_m", "tracking_error_rms_m", "final_error_m"}) {
+    EXPECT_EQ(a[key], b[key]) << key;
+  }
+  EXPECT_NEAR(b["tracking_error_max_m"]["left"].get<double>(), 1.059e-3, 0.5e-6);
+  EXPECT_EQ(ReadFile(Path("plain/ecs.csv")), ReadFile(Path("mapped/ecs.csv")));
+  EXPECT_EQ(ReadFile(Path("plain/twin.csv")), ReadFile(Path("mapped/twin.csv")));
+  EXPECT_EQ(b["controller"]["spec"], "pid");
+  EXPECT_EQ(b["controller"]["kind"], "built-in");
+  EXPECT_EQ(b["ecs"]["controller_map"], HILTWIN_ECS_CONTROLLER_MAP_TOML);
+  EXPECT_EQ(a["ecs"]["controller_map"], "the built-in RELbot controller map");
+  EXPECT_THAT(mapped.out, ::testing::HasSubstr("controller pid (built-in): pid\n"));
+}
 
 class LockstepPair : public Lockstep {
  protected:

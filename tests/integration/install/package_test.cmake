@@ -146,6 +146,7 @@ endif()
 hiltwin_test_require_files("the installed packages"
                            "see the install rules in cmake/HiltwinInstall.cmake" "${root}"
                            usr/bin/hiltwin usr/include/hiltwin/runtime/run_session.h
+                           usr/include/hiltwin/controller_abi.h
                            usr/share/bash-completion/completions/hiltwin
                            usr/share/man/man1/hiltwin.1)
 

@@ -164,6 +164,37 @@ TEST(EcsTask, TrackingStatsCoverEveryStep) {
   EXPECT_EQ(stats.max_abs_duty, 1.0);
 }
 
+TEST(EcsTask, ThePidsSaturationIsAtItsOwnLimitNotTheMaps) {
+  // --gains may limit the PID below the controller map's duty_limit (1): the PID's own
+  // saturation counts, as it did before controllers were pluggable.
+  LoneBoard rig;
+  const SetpointProfile setpoints =
+      ParseCsvSetpoints("time,left_m,right_m\n0,0,0\n0.1,0.002,-0.001\n", "sp.csv");
+  PidGains gains = POnly(1000.0);
+  gains.duty_limit = 0.5;
+  EcsTask task(rig.driver, setpoints, gains, rig.geometry, kPeriodNs);
+  // The oracle: the same PIDs on the same inputs (the wheels never move; the setpoints on the
+  // encoder grid).
+  PositionPid left(gains, 1e-3);
+  PositionPid right(gains, 1e-3);
+  const double counts_per_m = io::CountsPerMetre(rig.geometry);
+  const auto grid = [counts_per_m](double m) {
+    return static_cast<double>(std::llround(m * counts_per_m)) / counts_per_m;
+  };
+  std::uint64_t saturated = 0;
+  for (std::uint64_t k = 0; k < 200; ++k) {
+    ASSERT_TRUE(task.Exchange(true).ok());
+    ASSERT_EQ(task.Step(Cycle(k)).code, runtime::StepStatus::Code::kOk);
+    const WheelPositions sp = setpoints.At(static_cast<double>(k) * 1e-3);
+    static_cast<void>(left.Step(grid(sp.left_m), 0.0));
+    static_cast<void>(right.Step(grid(sp.right_m), 0.0));
+    saturated += left.last().saturated || right.last().saturated ? 1U : 0U;
+  }
+  EXPECT_EQ(task.tracking().saturated_cycles, saturated);
+  EXPECT_GT(saturated, 150U);  // more than at the limit 1 (TrackingStatsCoverEveryStep)
+  EXPECT_EQ(task.tracking().max_abs_duty, 0.5);
+}
+
 TEST(EcsTask, TheFirstReadingIsTheOriginOfTheSetpoints) {
   // A real robot's encoders power up anywhere: the ECS measures travel from the reading of its
   // first step, and a frame that never arrived is no reading. A twin board moves the lines

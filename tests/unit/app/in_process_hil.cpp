@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "hiltwin/kernel_glue/clock.h"
+#include "hiltwin/relbot/pid_controller.h"
 
 namespace hiltwin::app::test {
 namespace {
@@ -51,6 +52,18 @@ class EmulatedBoards final : public HilBoards {
   io::EmulatedSpiBus ecs_bus_{ecs_board_};
 };
 
+/// The ECS as the configuration asks: open loop, the built-in PID, or another controller.
+EcsTask MakeEcs(const HilConfig& config, io::IcoBoard& driver, const io::WheelGeometry& geometry,
+                std::int64_t period_ns) {
+  if (config.setpoints == nullptr) return {driver, *config.duty_profile, geometry, period_ns};
+  if (config.controller == nullptr) {
+    return {driver, *config.setpoints, config.gains, geometry, period_ns};
+  }
+  return {driver, *config.setpoints, *config.controller,
+          controller::BindControllerMap(RelbotControllerMap(geometry), *config.controller),
+          geometry, period_ns};
+}
+
 }  // namespace
 
 std::unique_ptr<HilBoards> MakeEmulatedBoards() { return std::make_unique<EmulatedBoards>(); }
@@ -70,9 +83,7 @@ InProcessHil::InProcessHil(const HilConfig& config, std::unique_ptr<HilBoards> b
       twin_driver_(boards_->twin_bus()),
       ecs_driver_(boards_->ecs_bus()),
       twin_(twin_driver_, params_, Integrator::kRk4, 1.0 / config.twin_rate_hz),
-      ecs_(config.setpoints != nullptr
-               ? EcsTask(ecs_driver_, *config.setpoints, config.gains, geometry_, ecs_period_ns_)
-               : EcsTask(ecs_driver_, *config.duty_profile, geometry_, ecs_period_ns_)) {
+      ecs_(MakeEcs(config, ecs_driver_, geometry_, ecs_period_ns_)) {
   if (!twin_driver_.Init(twin_period_ns_).ok || !ecs_driver_.Init(ecs_period_ns_).ok) {
     throw std::runtime_error("the boards refused INIT");
   }

@@ -52,7 +52,10 @@ class HilBoards {
 struct HilConfig {
   double ecs_rate_hz = 1000.0;
   double twin_rate_hz = 4000.0;
-  PidGains gains;                              ///< closed loop
+  PidGains gains;                              ///< closed loop, without `controller`
+  /// Closed loop: another controller than the built-in PID, on the RELbot's controller map
+  /// (not owned; outlives the rig). Null: the PID with `gains`.
+  controller::Controller* controller = nullptr;
   const SetpointProfile* setpoints = nullptr;  ///< closed loop (null: open loop)
   const InputProfile* duty_profile = nullptr;  ///< open loop
   double duration_s = 0.0;                     ///< 0: the profile's length
@@ -98,6 +101,7 @@ class InProcessHil final : public runtime::RunTask {
   /// ECS cycles of the configured duration.
   [[nodiscard]] std::uint64_t planned_cycles() const noexcept { return planned_cycles_; }
   [[nodiscard]] const EcsTask& ecs() const noexcept { return ecs_; }
+  [[nodiscard]] const io::IcoBoard& ecs_driver() const noexcept { return ecs_driver_; }
   [[nodiscard]] const RelbotTwin& twin() const noexcept { return twin_; }
   [[nodiscard]] const RelbotModel& model() const noexcept { return twin_.model(); }
   [[nodiscard]] HilObservations observations() const noexcept;

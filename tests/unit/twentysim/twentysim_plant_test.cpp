@@ -53,7 +53,7 @@ Exact ExactResponse(double force_n, double t_s) {
 
 TwentySimPlantSpec MsdSpec(double finish_time_s) {
   TwentySimPlantSpec spec;
-  spec.plant_name = "msd_direct";
+  spec.name = "msd_direct";
   spec.class_name = "LoopController";
   spec.inputs = {{"force_n", "N"}};
   spec.outputs = {{"position_m", "m"}, {"velocity_m_per_s", "m/s"}};
@@ -144,7 +144,7 @@ struct Doubler {
 // starts where the first step continues (it was computed with u = 0 and jumped in step 1).
 TEST(TwentySimPlant, InitializeIsGivenTheInitialInputs) {
   TwentySimPlantSpec spec;
-  spec.plant_name = "doubler";
+  spec.name = "doubler";
   spec.class_name = "Doubler";
   spec.inputs = {{"u", "1"}};
   spec.outputs = {{"y", "1"}};

@@ -5,11 +5,13 @@
 /// step computed goes out, the encoder counts come in), then one step that computes the duty for
 /// the next exchange. Two modes:
 ///
-/// - closed loop (default): wheel position setpoints from a SetpointProfile, one PositionPid
-///   per wheel, tracking-error statistics (thesis §7.2, appendix E). The PID gets the setpoint
-///   rounded to a whole encoder count: the encoder reads only whole counts, so a setpoint
-///   between two of them could never be met and the integral would make the wheel hunt across
-///   the count edge at rest. Logs and statistics use the profile's own setpoint;
+/// - closed loop (default): wheel position setpoints from a SetpointProfile into any controller
+///   (controller/controller.h) through a controller map, run by a controller::ControllerTask;
+///   the built-in one is one PositionPid per wheel (PidController, thesis §7.2, appendix E) on
+///   the RELbot's map, whose setpoints are rounded to a whole encoder count: the encoder reads
+///   only whole counts, so a setpoint between two of them could never be met and the integral
+///   would make the wheel hunt across the count edge at rest. Logs and statistics use the
+///   profile's own setpoint and the RELbot's wheels (channels per relbot_channels.h);
 /// - open loop (`--mode openloop`): plays a duty InputProfile and logs the duty on the wire
 ///   and the measured wheel positions every cycle (thesis §5.2, fig. 5.2), so the log can be
 ///   replayed into a reference run (LoadInputProfile reads its duty_left,duty_right columns).
@@ -22,13 +24,19 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "hiltwin/controller/controller.h"
+#include "hiltwin/controller/controller_map.h"
+#include "hiltwin/controller/controller_task.h"
 #include "hiltwin/io/conversions.h"
 #include "hiltwin/io/icoboard.h"
 #include "hiltwin/relbot/input_profile.h"
+#include "hiltwin/relbot/pid_controller.h"
 #include "hiltwin/relbot/position_pid.h"
 #include "hiltwin/relbot/relbot_channels.h"
 #include "hiltwin/relbot/setpoint_profile.h"
@@ -49,7 +57,9 @@ struct TrackingStats {
   double rms_error_m = 0.0;         ///< over both wheels together
   double final_error_left_m = 0.0;  ///< at the last step
   double final_error_right_m = 0.0;
-  std::uint64_t saturated_cycles = 0;  ///< steps in which either wheel's output hit its limit
+  /// Steps in which either wheel's output hit its limit: the built-in PID's own (--gains),
+  /// another controller's duty at its route's duty_limit.
+  std::uint64_t saturated_cycles = 0;
   double max_abs_duty = 0.0;           ///< largest |duty| commanded, either wheel
 };
 
@@ -67,12 +77,20 @@ struct EcsCycleRecord {
 /// The ECS's cyclic work.
 class EcsTask final : public runtime::RunTask {
  public:
-  /// Closed loop. `geometry` converts counts to metres (WheelGeometryOf(params) of the robot
-  /// or twin being driven); `period_ns` is the ECS cycle and must equal the session's period.
-  /// Throws ConfigError for invalid gains and std::invalid_argument for period_ns <= 0.
-  /// `board` and `setpoints` are not owned and must outlive the task.
+  /// Closed loop with the built-in PID (PidController) on the RELbot's controller map.
+  /// `geometry` converts counts to metres (WheelGeometryOf(params) of the robot or twin being
+  /// driven); `period_ns` is the ECS cycle and must equal the session's period. Throws
+  /// ConfigError for invalid gains and std::invalid_argument for period_ns <= 0. `board` and
+  /// `setpoints` are not owned and must outlive the task.
   EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints, const PidGains& gains,
           const io::WheelGeometry& geometry, std::int64_t period_ns);
+  /// Closed loop with any controller, bound to `map`; starts it at period_ns (ControllerError
+  /// when it cannot run at it). `controller` is not owned and must outlive the task; the log
+  /// and statistics are the RELbot wheels' (`geometry`) and the left_m / right_m `tracks`
+  /// pairs'.
+  EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints, controller::Controller& controller,
+          controller::BoundControllerMap map, const io::WheelGeometry& geometry,
+          std::int64_t period_ns);
   /// Open loop: plays `duty_profile` (repeating with its period), sampled at the ECS's cycle.
   EcsTask(io::IcoBoard& board, const InputProfile& duty_profile, const io::WheelGeometry& geometry,
           std::int64_t period_ns);
@@ -104,31 +122,31 @@ class EcsTask final : public runtime::RunTask {
   /// Closed-loop statistics so far (all zero in open loop). Not synchronised: read it when
   /// the loop is not running (after RunSession::Run returns).
   [[nodiscard]] TrackingStats tracking() const noexcept;
-  [[nodiscard]] const PositionPid& pid_left() const noexcept { return pid_left_; }
-  [[nodiscard]] const PositionPid& pid_right() const noexcept { return pid_right_; }
-  [[nodiscard]] const io::EcsInputs& inputs() const noexcept { return inputs_; }
+  /// What the board reported at the last exchange.
+  [[nodiscard]] const io::EcsInputs& inputs() const noexcept;
+  /// The controller's task (closed loop; nullptr in open loop): its controller, per-pair
+  /// tracking and fault, for the report.
+  [[nodiscard]] const controller::ControllerTask* controller_task() const noexcept {
+    return loop_ ? &*loop_ : nullptr;
+  }
 
  private:
-  /// Running sums behind TrackingStats.
-  struct TrackingSums {
-    std::uint64_t samples = 0;
-    double max_abs_left_m = 0.0;
-    double max_abs_right_m = 0.0;
-    double sum_sq_left_m2 = 0.0;
-    double sum_sq_right_m2 = 0.0;
-    double final_left_m = 0.0;
-    double final_right_m = 0.0;
-    std::uint64_t saturated_cycles = 0;
-    double max_abs_duty = 0.0;
+  /// The setpoint profile as the controller task's columns (left_m, right_m).
+  class ProfileColumns final : public controller::SetpointColumns {
+   public:
+    explicit ProfileColumns(const SetpointProfile& profile) : profile_(profile) {}
+    [[nodiscard]] std::array<double, 2> At(double time_s) const noexcept override;
+
+   private:
+    const SetpointProfile& profile_;
   };
 
-  EcsTask(io::IcoBoard& board, EcsMode mode, const SetpointProfile* setpoints,
-          const InputProfile* duty_profile, const PidGains& gains,
-          const io::WheelGeometry& geometry, std::int64_t period_ns);
+  EcsTask(io::IcoBoard& board, const SetpointProfile& setpoints,
+          std::unique_ptr<controller::Controller> owned, const io::WheelGeometry& geometry,
+          std::int64_t period_ns);
   void ReadWheels() noexcept;
-  Duty StepClosedLoop() noexcept;
-  /// `metres` rounded to the nearest whole encoder count.
-  [[nodiscard]] double OnEncoderGrid(double metres) const noexcept;
+  /// The log's record of a closed-loop step, from the controller task's.
+  void RecordClosedLoop() noexcept;
   void SetNextDuty(const Duty& duty) noexcept;
 
   io::IcoBoard& board_;
@@ -136,19 +154,22 @@ class EcsTask final : public runtime::RunTask {
   const SetpointProfile* setpoints_;  ///< closed loop
   const InputProfile* duty_profile_;  ///< open loop
   io::WheelGeometry geometry_;
-  double counts_per_m_;  ///< io::CountsPerMetre(geometry_), once
   std::int64_t period_ns_;
-  PositionPid pid_left_;
-  PositionPid pid_right_;
-  io::EcsInputs inputs_{};
+  std::unique_ptr<controller::Controller> owned_controller_;  ///< the built-in PID's
+  /// The controller when it is the built-in PID: its own saturation flag counts saturated
+  /// cycles, as before controllers were pluggable (its --gains limit may be below the map's).
+  const PidController* pid_ = nullptr;
+  std::uint64_t pid_saturated_cycles_ = 0;
+  std::optional<ProfileColumns> columns_;                     ///< closed loop
+  std::optional<controller::ControllerTask> loop_;            ///< closed loop
+  io::EcsInputs inputs_{};  ///< open loop
   std::array<std::int32_t, io::kChannels> pwm_next_{};  ///< computed by the last step
   std::array<std::int32_t, io::kChannels> pwm_sent_{};  ///< on the wire since the last exchange
-  std::array<std::int64_t, 2> origin_counts_{};         ///< left, right at the first step
+  std::array<std::int64_t, 2> origin_counts_{};  ///< open loop: left, right at the first step
   bool have_inputs_ = false;       ///< an exchange has succeeded: the counts are a reading
   bool started_ = false;           ///< the origin is taken
   std::uint64_t held_cycles_ = 0;  ///< exchanges with safe outputs (paused): not profile time
   EcsCycleRecord last_{};
-  TrackingSums sums_{};
 };
 
 }  // namespace hiltwin::app

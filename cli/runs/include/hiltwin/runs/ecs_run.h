@@ -19,7 +19,11 @@ struct EcsRunOptions {
   EcsMode mode = EcsMode::kClosedLoop;
   std::string setpoint;  ///< closed loop: a built-in profile's name or a CSV file
   std::string input;     ///< open loop: a built-in profile's name or a CSV file
-  std::string gains_path;
+  /// Closed loop: the controller (--controller SPEC, controller_registry.h) and its map
+  /// (--controller-map; "": the RELbot's, RelbotControllerMap).
+  std::string controller = "pid";
+  std::string controller_map_path;
+  std::string gains_path;  ///< the built-in PID's only
   std::string config_path;
 };
 

@@ -21,6 +21,8 @@ struct HilRunOptions {
   std::string mode = "closedloop";  ///< closedloop or openloop
   std::string setpoint = "closedloop";
   std::string input = "openloop";
+  std::string controller;           ///< --controller for the ECS ("": its default, pid)
+  std::string controller_map_path;  ///< --controller-map for the ECS ("": the RELbot's)
   std::string gains_path;
   std::string config_path;
   std::vector<std::string> twin_qos, ecs_qos;
@@ -39,7 +41,8 @@ struct HilRunOptions {
 };
 
 /// Every file hil reads and writes, for CheckFilesDistinct: the profiles (unless built in),
-/// --gains, --config, --report and, with --log-dir, each side's report, log and output there.
+/// --controller-map, --gains, --config, --report and, with --log-dir, each side's report, log
+/// and output there.
 [[nodiscard]] std::vector<NamedFile> HilFiles(const HilRunOptions& o);
 
 /// Starts both sides, waits for them (a stop signal is passed on), prints the combined summary
