@@ -196,7 +196,11 @@ test_stage() {
     # to its neighbours. One that fails again fails the stage; one that passes is named as
     # flaky at the end of the run, with what it said the first time.
     failure_digest "$build_dir"
-    mapfile -t failed_tests < <(cut -d: -f2- "$build_dir/Testing/Temporary/LastTestsFailed.log")
+    local failed_log=$build_dir/Testing/Temporary/LastTestsFailed.log
+    # ctest failed with no failed test (killed, no test to run): --rerun-failed would then run
+    # every test again, so nothing is run again and the stage fails as ctest did.
+    [[ -s $failed_log ]] || exit "$status"
+    mapfile -t failed_tests < <(cut -d: -f2- "$failed_log")
     echo "== $name: running the ${#failed_tests[@]} failed test(s) once more, one at a time"
     status=0
     ctest --test-dir "$build_dir" --output-on-failure --rerun-failed -j 1 || status=$?
