@@ -50,6 +50,7 @@ packages=(
   help2man groff-base                           # the man page from --help, and its render test
   ccache                                        # the four builds of scripts/test.sh share one cache
   lld                                           # links 3x faster than GNU ld (CMakeLists.txt)
+  parallel libxml2-utils                        # `hiltwin test`'s tests: shards through GNU parallel, JUnit checked by xmllint
 )
 
 # The arm64 cross build: the libraries hiltwin links, as arm64 multiarch packages beside the

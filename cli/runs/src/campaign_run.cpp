@@ -104,7 +104,7 @@ std::unique_ptr<WorkDir> MakeWorkDir(const std::string& keep_dir) {
     std::error_code error;
     dir->path = fs::absolute(keep_dir);
     fs::create_directories(dir->path, error);
-    if (error) throw CommandError(ExitCode::kIo, "--keep " + keep_dir + ": " + error.message());
+    if (error) ThrowUsage("--keep " + keep_dir + ": " + error.message());
     return dir;
   }
   std::string pattern = (fs::temp_directory_path() / "hiltwin-test-XXXXXX").string();
@@ -129,7 +129,7 @@ Running Start(const CampaignScenario& s, const fs::path& work) {
   ScenarioFiles files{work / s.name};
   std::error_code error;
   fs::create_directories(files.dir, error);
-  if (error) throw CommandError(ExitCode::kIo, files.dir.string() + ": " + error.message());
+  if (error) throw std::runtime_error("cannot make its folder " + files.dir.string() + ": " + error.message());
   kernel_glue::ProcessOptions options;
   options.out = kernel_glue::OutputTarget::File(files.output());
   options.err = kernel_glue::OutputTarget::SameAsStdout();
@@ -153,6 +153,8 @@ class Pool {
     return std::move(results_);
   }
   [[nodiscard]] std::size_t not_run() const noexcept { return scenarios_.size() - started_; }
+  /// A scenario could not be started (its folder, its parameter file, the process).
+  [[nodiscard]] bool io_fault() const noexcept { return io_fault_; }
 
  private:
   [[nodiscard]] bool RealTimeRunning() const {
@@ -172,10 +174,36 @@ class Pool {
                     s.name.c_str());
         std::fflush(stdout);
       }
-      running_.push_back(Start(s, work_));
       ++next_;
       ++started_;
+      try {
+        running_.push_back(Start(s, work_));
+      } catch (const std::exception& e) {  // its folder, its parameter file, the spawn
+        ScenarioResult result = NotStarted(s, e.what());
+        io_fault_ = true;
+        Finish(std::move(result));
+      }
     }
+  }
+
+  static ScenarioResult NotStarted(const CampaignScenario& s, const std::string& why) {
+    ScenarioResult r;
+    r.index = s.index;
+    r.name = s.name;
+    r.kind = s.kind;
+    r.clock = s.clock;
+    r.exit_code = static_cast<int>(ExitCode::kIo);
+    r.error = "not started: " + why;
+    return r;
+  }
+
+  /// Records a scenario's result and prints its line.
+  void Finish(ScenarioResult result) {
+    results_.push_back(std::move(result));
+    const ScenarioResult& done = results_.back();
+    std::fputs(FormatScenarioLine(done, results_.size(), scenarios_.size()).c_str(), stdout);
+    std::fflush(stdout);
+    if (!done.passed() && o_.fail_fast) stopping_ = true;
   }
 
   void Reap() {
@@ -186,11 +214,7 @@ class Pool {
         ++it;
         continue;
       }
-      results_.push_back(JudgeScenario(*it->scenario, it->files, *status, SecondsSince(it->started)));
-      const ScenarioResult& result = results_.back();
-      std::fputs(FormatScenarioLine(result, results_.size(), scenarios_.size()).c_str(), stdout);
-      std::fflush(stdout);
-      if (!result.passed() && o_.fail_fast) stopping_ = true;
+      Finish(JudgeScenario(*it->scenario, it->files, *status, SecondsSince(it->started)));
       it = running_.erase(it);
     }
   }
@@ -212,6 +236,7 @@ class Pool {
   std::size_t started_ = 0;
   bool stopping_ = false;
   bool stopping_signalled_ = false;
+  bool io_fault_ = false;
 };
 
 /// The outputs, each opened before anything runs (a path that cannot be written is exit 5 at
@@ -347,7 +372,8 @@ int RunCampaign(const CampaignRunOptions& o) {
   }
   if (!o.keep_dir.empty()) std::printf("hiltwin test: logs and reports kept in %s\n", o.keep_dir.c_str());
   std::fflush(stdout);
-  const int exit_code = outputs.WriteAll(result, result.exit_code());
+  const int exit_code = outputs.WriteAll(
+      result, pool.io_fault() ? static_cast<int>(ExitCode::kIo) : result.exit_code());
   if (kernel_glue::StopRequested()) return 128 + kernel_glue::StopSignal();
   return exit_code;
 }
