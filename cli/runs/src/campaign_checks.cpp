@@ -17,7 +17,7 @@
 #include "hiltwin/scheduler/executive.h"
 
 namespace hiltwin::app {
-namespace {
+namespace campaign_checks_detail {
 
 namespace fs = std::filesystem;
 
@@ -102,17 +102,20 @@ void CheckProfiles(const CampaignScenario& s) {
   }
 }
 
-}  // namespace
+}  // namespace campaign_checks_detail
 
 void CheckLinkFault(const std::string& spec) {
+  using namespace campaign_checks_detail;  // this file's helpers
   static_cast<void>(io::ParseLinkFaultInjection(spec));
 }
 void CheckOverrun(const std::string& spec) {
+  using namespace campaign_checks_detail;  // this file's helpers
   static_cast<void>(runtime::ParseOverrunInjection(spec));
 }
 void CheckQosRule(const std::string& rule) { static_cast<void>(qos::ParseMkRule(rule)); }
 
 void CheckScenario(const CampaignScenario& s) {
+  using namespace campaign_checks_detail;  // this file's helpers
   CheckRate(s, "twin_rate_hz", s.twin_rate_hz);
   CheckRate(s, "ecs_rate_hz", s.ecs_rate_hz);
   if (s.kind == "run" && !s.ecs_overruns.empty()) {
@@ -134,6 +137,7 @@ void CheckScenario(const CampaignScenario& s) {
 }
 
 RelbotParams ScenarioRelbotParams(const CampaignScenario& s) {
+  using namespace campaign_checks_detail;  // this file's helpers
   RelbotParams params = DefaultRelbotParams();
   try {
     if (!s.config.empty()) params = LoadRelbotParams(s.config);
@@ -161,6 +165,7 @@ RelbotParams ScenarioRelbotParams(const CampaignScenario& s) {
 }
 
 std::string RelbotParamsToml(const RelbotParams& params) {
+  using namespace campaign_checks_detail;  // this file's helpers
   std::string text = "# Written by hiltwin test: a scenario's RELbot parameters.\n";
   std::string_view table;
   for (const ParamSpec& spec : RelbotParamSpecs()) {

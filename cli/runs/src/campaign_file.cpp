@@ -21,13 +21,13 @@
 #include "hiltwin/relbot/setpoint_profile.h"
 
 namespace hiltwin::app {
-namespace {
+namespace campaign_file_reading {
 
 namespace fs = std::filesystem;
 namespace mt = plant::map_toml;
 
 /// A table of the file being read, with the file's name and folder for messages and paths.
-struct Reader {
+struct CampaignReader {
   std::string source;  ///< the file, as messages name it
   std::string folder;  ///< where relative paths are read from
 
@@ -112,7 +112,7 @@ struct Reader {
   }
 };
 
-void ReadCriteria(const Reader& r, const toml::table& table, CampaignCriteria& c) {
+void ReadCriteria(const CampaignReader& r, const toml::table& table, CampaignCriteria& c) {
   mt::CheckKeys(r.source, table, "criteria",
                 {"verdict", "tracking_max_m", "tracking_rms_m", "final_error_m", "settling_time_s",
                  "settling_band_pct", "overshoot_pct", "duty_saturation_pct", "missed_deadlines",
@@ -143,7 +143,7 @@ void ReadCriteria(const Reader& r, const toml::table& table, CampaignCriteria& c
   }
 }
 
-void ReadParams(const Reader& r, const toml::node& node, CampaignScenario& s) {
+void ReadParams(const CampaignReader& r, const toml::node& node, CampaignScenario& s) {
   const toml::table* table = node.as_table();
   if (table == nullptr) r.Fail(node, "params must be a table of \"section.key\" = number");
   for (const auto& [key, value] : *table) {
@@ -152,7 +152,7 @@ void ReadParams(const Reader& r, const toml::node& node, CampaignScenario& s) {
 }
 
 /// Every scenario key but name and criteria, read into `s` (from [defaults] or a scenario).
-void ReadScenarioKey(const Reader& r, std::string_view key, const toml::node& node,
+void ReadScenarioKey(const CampaignReader& r, std::string_view key, const toml::node& node,
                      CampaignScenario& s) {
   if (key == "kind") s.kind = r.OneOf(node, key, {"hil", "run"});
   if (key == "clock") s.clock = r.OneOf(node, key, {"virtual", "realtime"});
@@ -180,7 +180,7 @@ void ReadScenarioKey(const Reader& r, std::string_view key, const toml::node& no
   if (key == "ecs_max_miss_pct") s.ecs_max_miss_pct = r.Bound(node, key, 0.0, false);
 }
 
-void ReadScenarioTable(const Reader& r, const toml::table& table, std::string_view table_name,
+void ReadScenarioTable(const CampaignReader& r, const toml::table& table, std::string_view table_name,
                        bool named, CampaignScenario& s) {
   // A scenario's name is its own; every other key may come from [defaults].
   toml::table keys = table;
@@ -202,7 +202,7 @@ void ReadScenarioTable(const Reader& r, const toml::table& table, std::string_vi
   }
 }
 
-void CheckName(const Reader& r, const toml::table& table, const CampaignScenario& s,
+void CheckName(const CampaignReader& r, const toml::table& table, const CampaignScenario& s,
                std::set<std::string>& names) {
   const toml::node* name = table.get("name");
   if (name == nullptr) r.Fail(table, "a [[scenario]] needs a name");
@@ -216,7 +216,7 @@ void CheckName(const Reader& r, const toml::table& table, const CampaignScenario
   if (!names.insert(s.name).second) r.Fail(*name, "scenario name \"" + s.name + "\" is used twice");
 }
 
-CampaignScenario Defaults(const Reader& r, const toml::table& root) {
+CampaignScenario Defaults(const CampaignReader& r, const toml::table& root) {
   CampaignScenario defaults;
   if (const toml::node* node = root.get("defaults")) {
     const toml::table* table = node->as_table();
@@ -226,7 +226,7 @@ CampaignScenario Defaults(const Reader& r, const toml::table& root) {
   return defaults;
 }
 
-void ReadCampaignTable(const Reader& r, const toml::table& root, Campaign& campaign) {
+void ReadCampaignTable(const CampaignReader& r, const toml::table& root, Campaign& campaign) {
   const toml::node* node = root.get("campaign");
   if (node == nullptr) return;
   const toml::table* table = node->as_table();
@@ -238,11 +238,12 @@ void ReadCampaignTable(const Reader& r, const toml::table& root, Campaign& campa
   }
 }
 
-}  // namespace
+}  // namespace campaign_file_reading
 
 Campaign ParseCampaign(const std::string& text, const std::string& source,
                        const std::string& folder) {
-  const Reader r{source, folder};
+  using namespace campaign_file_reading;  // this file's helpers
+  const CampaignReader r{source, folder};
   toml::table root;
   try {
     root = mt::ParseRoot(text, source);
@@ -278,6 +279,7 @@ Campaign ParseCampaign(const std::string& text, const std::string& source,
 }
 
 Campaign LoadCampaign(const std::string& path) {
+  using namespace campaign_file_reading;  // this file's helpers
   std::string text;
   try {
     text = mt::ReadMapFile(path, "campaign file",

@@ -66,6 +66,20 @@ void SortAndCheckShards(std::vector<ShardSpec>& shards) {
                                 " is given twice: give each shard's result once");
     }
   }
+  // A shard left out would leave its scenarios out of the joined result unseen: a grade made
+  // of part of the campaign.
+  std::string missing;
+  for (std::size_t k = 1, i = 0; k <= shards.front().count; ++k) {
+    if (i < shards.size() && shards[i].index == k) {
+      ++i;
+    } else {
+      missing += (missing.empty() ? "" : ", ") + label({k, shards.front().count});
+    }
+  }
+  if (!missing.empty()) {
+    throw CampaignResultError("cannot merge: shard " + missing +
+                              " is missing: give the result of every shard of the run");
+  }
 }
 
 void SortAndCheckScenarios(std::vector<ScenarioResult>& scenarios) {

@@ -34,7 +34,7 @@
 #include "hiltwin/runs/output_files.h"
 
 namespace hiltwin::app {
-namespace {
+namespace campaign_pool {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -44,7 +44,7 @@ double SecondsSince(Clock::time_point start) {
 }
 
 /// The scenarios this run covers: --filter's glob, then every N-th of those for --shard K/N.
-std::vector<CampaignScenario> Select(const Campaign& campaign, const CampaignRunOptions& o) {
+std::vector<CampaignScenario> SelectScenarios(const Campaign& campaign, const CampaignRunOptions& o) {
   std::vector<CampaignScenario> filtered;
   for (const CampaignScenario& s : campaign.scenarios) {
     if (o.filter.empty() || ::fnmatch(o.filter.c_str(), s.name.c_str(), 0) == 0) {
@@ -86,20 +86,20 @@ void PreflightControllers(const std::vector<CampaignScenario>& scenarios) {
 
 /// The folder every scenario's own folder is made in: --keep, or a temporary one removed at
 /// the end.
-struct WorkDir {
+struct CampaignWorkDir {
   fs::path path;
   bool temporary = false;
-  WorkDir(const WorkDir&) = delete;
-  WorkDir& operator=(const WorkDir&) = delete;
-  WorkDir() = default;
-  ~WorkDir() {
+  CampaignWorkDir(const CampaignWorkDir&) = delete;
+  CampaignWorkDir& operator=(const CampaignWorkDir&) = delete;
+  CampaignWorkDir() = default;
+  ~CampaignWorkDir() {
     std::error_code ignored;
     if (temporary) fs::remove_all(path, ignored);
   }
 };
 
-std::unique_ptr<WorkDir> MakeWorkDir(const std::string& keep_dir) {
-  auto dir = std::make_unique<WorkDir>();
+std::unique_ptr<CampaignWorkDir> MakeCampaignWorkDir(const std::string& keep_dir) {
+  auto dir = std::make_unique<CampaignWorkDir>();
   if (!keep_dir.empty()) {
     std::error_code error;
     dir->path = fs::absolute(keep_dir);
@@ -118,14 +118,14 @@ std::unique_ptr<WorkDir> MakeWorkDir(const std::string& keep_dir) {
 }
 
 /// A scenario's process while it runs.
-struct Running {
+struct RunningScenario {
   const CampaignScenario* scenario;
   ScenarioFiles files;
   kernel_glue::Process process;
   Clock::time_point started;
 };
 
-Running Start(const CampaignScenario& s, const fs::path& work) {
+RunningScenario StartScenario(const CampaignScenario& s, const fs::path& work) {
   ScenarioFiles files{work / s.name};
   std::error_code error;
   fs::create_directories(files.dir, error);
@@ -133,14 +133,14 @@ Running Start(const CampaignScenario& s, const fs::path& work) {
   kernel_glue::ProcessOptions options;
   options.out = kernel_glue::OutputTarget::File(files.output());
   options.err = kernel_glue::OutputTarget::SameAsStdout();
-  return Running{&s, files, kernel_glue::Process::Start(ScenarioArgv(s, files), options),
+  return RunningScenario{&s, files, kernel_glue::Process::Start(ScenarioArgv(s, files), options),
                  Clock::now()};
 }
 
 /// The pool: starts scenarios in campaign order while a slot is free, judges each as it ends.
-class Pool {
+class ScenarioPool {
  public:
-  Pool(const std::vector<CampaignScenario>& scenarios, const CampaignRunOptions& o, fs::path work)
+  ScenarioPool(const std::vector<CampaignScenario>& scenarios, const CampaignRunOptions& o, fs::path work)
       : scenarios_(scenarios), o_(o), work_(std::move(work)) {}
 
   std::vector<ScenarioResult> Run() {
@@ -158,7 +158,7 @@ class Pool {
 
  private:
   [[nodiscard]] bool RealTimeRunning() const {
-    for (const Running& r : running_) {
+    for (const RunningScenario& r : running_) {
       if (r.scenario->clock == "realtime") return true;
     }
     return false;
@@ -177,7 +177,7 @@ class Pool {
       ++next_;
       ++started_;
       try {
-        running_.push_back(Start(s, work_));
+        running_.push_back(StartScenario(s, work_));
       } catch (const std::exception& e) {  // its folder, its parameter file, the spawn
         ScenarioResult result = NotStarted(s, e.what());
         io_fault_ = true;
@@ -201,7 +201,7 @@ class Pool {
   void Finish(ScenarioResult result) {
     results_.push_back(std::move(result));
     const ScenarioResult& done = results_.back();
-    std::fputs(FormatScenarioLine(done, results_.size(), scenarios_.size()).c_str(), stdout);
+    std::printf("%s\n", FormatScenarioLine(done, results_.size(), scenarios_.size()).c_str());
     std::fflush(stdout);
     if (!done.passed() && o_.fail_fast) stopping_ = true;
   }
@@ -224,13 +224,13 @@ class Pool {
   void StopAll() {
     if (stopping_signalled_) return;
     stopping_ = stopping_signalled_ = true;
-    for (Running& r : running_) ::kill(r.process.pid(), SIGTERM);
+    for (RunningScenario& r : running_) ::kill(r.process.pid(), SIGTERM);
   }
 
   const std::vector<CampaignScenario>& scenarios_;
   const CampaignRunOptions& o_;
   fs::path work_;
-  std::vector<Running> running_;
+  std::vector<RunningScenario> running_;
   std::vector<ScenarioResult> results_;
   std::size_t next_ = 0;
   std::size_t started_ = 0;
@@ -238,6 +238,12 @@ class Pool {
   bool stopping_signalled_ = false;
   bool io_fault_ = false;
 };
+
+/// The JSON text: a scenario's error may quote a program's raw output, so bytes that are not
+/// UTF-8 are replaced rather than refused.
+std::string DumpResult(const nlohmann::ordered_json& json) {
+  return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + '\n';
+}
 
 /// The outputs, each opened before anything runs (a path that cannot be written is exit 5 at
 /// once, not after the campaign) and written whole at the end.
@@ -247,7 +253,7 @@ struct OutputFiles {
       : json(o.json_path, "--json"), junit(o.junit_path, "--junit"), html(o.html_path, "--html") {}
 
   int WriteAll(const CampaignResult& result, int exit_code) {
-    if (json.wanted()) exit_code = json.WriteAtEnd(ToJson(result).dump(2) + '\n', "test", exit_code);
+    if (json.wanted()) exit_code = json.WriteAtEnd(DumpResult(ToJson(result)), "test", exit_code);
     if (junit.wanted()) exit_code = junit.WriteAtEnd(ToJunitXml(result), "test", exit_code);
     if (html.wanted()) exit_code = html.WriteAtEnd(ToHtml(result), "test", exit_code);
     return exit_code;
@@ -305,9 +311,10 @@ std::optional<ShardSpec> ShardFromVariables(const std::map<std::string, std::str
   return ShardSpec{*k - first + 1, *n};
 }
 
-}  // namespace
+}  // namespace campaign_pool
 
 ShardSpec ParseShard(const std::string& text) {
+  using namespace campaign_pool;  // this file's helpers
   const std::size_t slash = text.find('/');
   const std::optional<std::size_t> k =
       slash == std::string::npos ? std::nullopt : WholeNumber(std::string_view(text).substr(0, slash));
@@ -320,6 +327,7 @@ ShardSpec ParseShard(const std::string& text) {
 }
 
 std::optional<ShardSpec> ShardFromEnvironment(const std::map<std::string, std::string>& env) {
+  using namespace campaign_pool;  // this file's helpers
   // A Slurm array's task ids run from SLURM_ARRAY_TASK_MIN (--array=0-2 or 1-3); GitLab's
   // parallel: numbers its jobs 1 .. CI_NODE_TOTAL.
   std::size_t slurm_first = 0;
@@ -339,6 +347,7 @@ std::optional<ShardSpec> ShardFromEnvironment(const std::map<std::string, std::s
 }
 
 int RunCampaign(const CampaignRunOptions& o) {
+  using namespace campaign_pool;  // this file's helpers
   kernel_glue::InstallStopSignalHandlers();
   CheckOutputsDistinct({{"the campaign file", o.campaign_path, false}}, o.outputs);
   Campaign campaign;
@@ -347,14 +356,14 @@ int RunCampaign(const CampaignRunOptions& o) {
   } catch (const CampaignFileError& e) {
     ThrowUsage(e.what());
   }
-  std::vector<CampaignScenario> selected = Select(campaign, o);
+  std::vector<CampaignScenario> selected = SelectScenarios(campaign, o);
   OverrideController(selected, o);
   PreflightControllers(selected);
   OutputFiles outputs(o.outputs);
-  const std::unique_ptr<WorkDir> work = MakeWorkDir(o.keep_dir);
+  const std::unique_ptr<CampaignWorkDir> work = MakeCampaignWorkDir(o.keep_dir);
   PrintHead(campaign, selected, o);
   const Clock::time_point start = Clock::now();
-  Pool pool(selected, o, work->path);
+  ScenarioPool pool(selected, o, work->path);
   CampaignResult result;
   result.name = campaign.name;
   result.file = o.campaign_path;
@@ -379,6 +388,7 @@ int RunCampaign(const CampaignRunOptions& o) {
 }
 
 int RunCampaignMerge(const std::vector<std::string>& inputs, const CampaignOutputs& outputs) {
+  using namespace campaign_pool;  // this file's helpers
   std::vector<NamedFile> files;
   for (const std::string& input : inputs) files.push_back({"a shard result", input, false});
   CheckOutputsDistinct(files, outputs);

@@ -14,7 +14,7 @@
 #include "hiltwin/runs/command.h"
 
 namespace hiltwin::app {
-namespace {
+namespace campaign_scenario_detail {
 
 /// A number as the command line reads it back exactly (to_chars' shortest form).
 std::string Arg(double value) {
@@ -105,7 +105,7 @@ std::string OutputTail(const ScenarioFiles& files) {
   return tail.empty() ? "no output" : tail;
 }
 
-std::optional<nlohmann::json> ReadJson(const std::filesystem::path& path) {
+std::optional<nlohmann::json> ReadScenarioReport(const std::filesystem::path& path) {
   std::ifstream file(path);
   if (!file) return std::nullopt;
   try {
@@ -115,15 +115,17 @@ std::optional<nlohmann::json> ReadJson(const std::filesystem::path& path) {
   }
 }
 
-}  // namespace
+}  // namespace campaign_scenario_detail
 
 std::vector<std::string> ScenarioArgv(const CampaignScenario& s, const ScenarioFiles& files) {
+  using namespace campaign_scenario_detail;  // this file's helpers
   const std::string config = ConfigPath(s, files);
   return s.kind == "hil" ? HilArgv(s, files, config) : RunArgv(s, files, config);
 }
 
 ScenarioResult JudgeScenario(const CampaignScenario& s, const ScenarioFiles& files,
                              const kernel_glue::ExitStatus& status, double wall_s) {
+  using namespace campaign_scenario_detail;  // this file's helpers
   ScenarioResult r;
   r.index = s.index;
   r.name = s.name;
@@ -140,7 +142,7 @@ ScenarioResult JudgeScenario(const CampaignScenario& s, const ScenarioFiles& fil
     r.error = command + " ended with " + status.Describe() + ": " + OutputTail(files) + " (" +
               files.output().string() + ")";
   }
-  const std::optional<nlohmann::json> report = ReadJson(files.report());
+  const std::optional<nlohmann::json> report = ReadScenarioReport(files.report());
   if (!report) {
     if (r.error.empty()) r.error = command + " wrote no report (" + files.output().string() + ")";
   } else {
