@@ -144,7 +144,7 @@ class ScenarioPool {
       : scenarios_(scenarios), o_(o), work_(std::move(work)) {}
 
   std::vector<ScenarioResult> Run() {
-    while (next_ < scenarios_.size() || !running_.empty()) {
+    while ((!stopping_ && next_ < scenarios_.size()) || !running_.empty()) {
       StartWhatFits();
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
       Reap();

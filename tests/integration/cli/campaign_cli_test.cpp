@@ -16,6 +16,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <thread>
+#include <csignal>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -82,9 +85,11 @@ Json WithoutWallClock(Json json, bool drop_shards = false) {
   return json;
 }
 
-/// JUnit XML without its time attributes (the wall clock's).
-std::string WithoutTimes(const std::string& xml) {
-  return std::regex_replace(xml, std::regex(R"( (time|timestamp)="[^"]*")"), "");
+/// JUnit XML without its time attributes (the wall clock's) and the property naming the shards
+/// it came from.
+std::string WithoutTimesAndShards(const std::string& xml) {
+  const std::string timeless = std::regex_replace(xml, std::regex(R"( (time|timestamp)="[^"]*")"), "");
+  return std::regex_replace(timeless, std::regex(R"( *<property name="shards"[^>]*/>\n)"), "");
 }
 
 class CampaignCli : public ::testing::Test {
@@ -154,7 +159,9 @@ TEST_F(CampaignCli, ThreeShardsThroughGnuParallelMergeIntoTheUnshardedResult) {
   EXPECT_EQ(merge.exit_code, 3) << merge.out << merge.err;
   EXPECT_EQ(WithoutWallClock(ReadJson(merged), true), WithoutWallClock(ReadJson(whole), true));
   EXPECT_EQ(ReadJson(merged)["shards"].size(), 3U);
-  EXPECT_EQ(WithoutTimes(ReadText(merged_xml)), WithoutTimes(ReadText(whole_xml)));
+  EXPECT_EQ(WithoutTimesAndShards(ReadText(merged_xml)),
+            WithoutTimesAndShards(ReadText(whole_xml)));
+  EXPECT_THAT(ReadText(merged_xml), HasSubstr("<property name=\"shards\" value=\"1/3+2/3+3/3\"/>"));
   // Each shard ran every third scenario: shard 2 of 3 the second.
   const Json two = ReadJson(dir_ / "shard2.json");
   ASSERT_EQ(two["scenarios"].size(), 1U);
@@ -174,10 +181,12 @@ TEST_F(CampaignCli, TheClustersEnvironmentPicksTheShard) {
   EXPECT_EQ(run({"CI_NODE_INDEX=2", "CI_NODE_TOTAL=2"}, gitlab).exit_code, 3);
   EXPECT_EQ(run({"SLURM_ARRAY_TASK_ID=0", "SLURM_ARRAY_TASK_COUNT=2"}, slurm).exit_code, 0);
   std::vector<std::string> names;
-  for (const Json& s : ReadJson(gitlab)["scenarios"]) names.push_back(s["name"]);
+  const Json gitlab_result = ReadJson(gitlab);  // kept: a loop over a temporary's member dangles
+  for (const Json& s : gitlab_result["scenarios"]) names.push_back(s["name"]);
   EXPECT_THAT(names, ::testing::ElementsAre("loop_1k", "too_strict"));
   names.clear();
-  for (const Json& s : ReadJson(slurm)["scenarios"]) names.push_back(s["name"]);
+  const Json slurm_result = ReadJson(slurm);
+  for (const Json& s : slurm_result["scenarios"]) names.push_back(s["name"]);
   EXPECT_THAT(names, ::testing::ElementsAre("loop_4k", "twin_alone"));
   const auto bad = run({"CI_NODE_INDEX=3", "CI_NODE_TOTAL=2"}, gitlab);
   EXPECT_EQ(bad.exit_code, 2);
@@ -192,9 +201,15 @@ TEST_F(CampaignCli, FilterFailFastAndKeepDoWhatTheySay) {
   EXPECT_TRUE(fs::is_regular_file(fs::path(kept) / "loop_4k" / "ecs.csv"));
   EXPECT_TRUE(fs::is_regular_file(fs::path(kept) / "loop_1k" / "result.json"));
   EXPECT_FALSE(fs::exists(fs::path(kept) / "twin_alone"));
-  // too_strict first, alone: the scenario after it is not started.
-  const auto fast = Test({campaign(), "--filter", "*t*", "--fail-fast", "--jobs", "1"});
+  // A failing scenario first, one at a time: the scenario after it is not started.
+  std::ofstream(dir_ / "fast.toml") << "[[scenario]]\nname = \"fails\"\nduration_s = 2\n"
+                                       "[scenario.criteria]\ntracking_max_m = 0.000001\n"
+                                       "[[scenario]]\nname = \"after\"\nkind = \"run\"\n"
+                                       "duration_s = 0.2\n";
+  const auto fast = Test({(dir_ / "fast.toml").string(), "--fail-fast", "--jobs", "1"});
   EXPECT_EQ(fast.exit_code, 3);
+  EXPECT_THAT(fast.out, HasSubstr("FAIL fails"));
+  EXPECT_THAT(fast.out, Not(HasSubstr("PASS after")));
   EXPECT_THAT(fast.out, HasSubstr("1 scenario(s) not run (--fail-fast)"));
 }
 
@@ -206,6 +221,33 @@ TEST_F(CampaignCli, ARealTimeScenarioIsSaidToRunAloneBeforeAndAsItRuns) {
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;  // no criteria: judged on having run
   EXPECT_THAT(r.out, HasSubstr("1 in real time, each alone"));
   EXPECT_THAT(r.out, HasSubstr("rt runs in real time, alone"));
+}
+
+TEST_F(CampaignCli, ACtrlCStopsTheRunningScenarioAndWritesWhatEndedExit130) {
+  // A lockstep scenario that ends at once, then a real-time one of 30 s that Ctrl-C stops.
+  std::ofstream(dir_ / "long.toml") << "[[scenario]]\nname = \"quick\"\nkind = \"run\"\n"
+                                       "duration_s = 0.2\n[[scenario]]\nname = \"long\"\n"
+                                       "kind = \"run\"\nclock = \"realtime\"\nduration_s = 30\n"
+                                       "[[scenario]]\nname = \"never\"\nkind = \"run\"\n"
+                                       "duration_s = 0.2\n";
+  const std::string json = (dir_ / "r.json").string();
+  const std::string out = (dir_ / "out.txt").string();
+  hiltwin::kernel_glue::Process test = hiltwin::test::Spawn(
+      {HILTWIN_BINARY, "test", (dir_ / "long.toml").string(), "--json", json}, out);
+  // Until the real-time scenario has started.
+  for (int i = 0; i < 300 && hiltwin::test::ReadOutput(out).find("long runs in real time") ==
+                                 std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(test.pid(), SIGINT);
+  const std::optional<hiltwin::kernel_glue::ExitStatus> status = test.WaitFor(std::chrono::seconds(20));
+  ASSERT_TRUE(status.has_value()) << "hiltwin test did not stop within 20 s of SIGINT";
+  EXPECT_EQ(status->code, 130) << hiltwin::test::ReadOutput(out);
+  const Json result = ReadJson(json);
+  ASSERT_EQ(result["scenarios"].size(), 2U);  // quick and the stopped long one; never not run
+  EXPECT_EQ(result["scenarios"][1]["name"], "long");
+  EXPECT_THAT(hiltwin::test::ReadOutput(out), HasSubstr("1 scenario(s) not run (stopped by a signal)"));
 }
 
 TEST_F(CampaignCli, ABadCampaignOrControllerIsExit2BeforeAnyScenarioRuns) {

@@ -128,8 +128,8 @@ TEST_P(CampaignGrading, TheShippedCampaignGradesTheExampleController) {
 
 INSTANTIATE_TEST_SUITE_P(ExampleControllers, CampaignGrading,
                          ::testing::Values(Tuned(), Sluggish(), Unstable()),
-                         [](const ::testing::TestParamInfo<Grade>& info) {
-                           return info.param.controller;
+                         [](const ::testing::TestParamInfo<Grade>& param) {
+                           return param.param.controller;
                          });
 
 }  // namespace
