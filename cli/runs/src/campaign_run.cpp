@@ -84,39 +84,6 @@ void PreflightControllers(const std::vector<CampaignScenario>& scenarios) {
   }
 }
 
-/// The folder every scenario's own folder is made in: --keep, or a temporary one removed at
-/// the end.
-struct CampaignWorkDir {
-  fs::path path;
-  bool temporary = false;
-  CampaignWorkDir(const CampaignWorkDir&) = delete;
-  CampaignWorkDir& operator=(const CampaignWorkDir&) = delete;
-  CampaignWorkDir() = default;
-  ~CampaignWorkDir() {
-    std::error_code ignored;
-    if (temporary) fs::remove_all(path, ignored);
-  }
-};
-
-std::unique_ptr<CampaignWorkDir> MakeCampaignWorkDir(const std::string& keep_dir) {
-  auto dir = std::make_unique<CampaignWorkDir>();
-  if (!keep_dir.empty()) {
-    std::error_code error;
-    dir->path = fs::absolute(keep_dir);
-    fs::create_directories(dir->path, error);
-    if (error) ThrowUsage("--keep " + keep_dir + ": " + error.message());
-    return dir;
-  }
-  std::string pattern = (fs::temp_directory_path() / "hiltwin-test-XXXXXX").string();
-  if (::mkdtemp(pattern.data()) == nullptr) {
-    throw CommandError(ExitCode::kIo,
-                       "cannot create a temporary folder in " + fs::temp_directory_path().string());
-  }
-  dir->path = pattern;
-  dir->temporary = true;
-  return dir;
-}
-
 /// A scenario's process while it runs.
 struct RunningScenario {
   const CampaignScenario* scenario;
@@ -360,10 +327,11 @@ int RunCampaign(const CampaignRunOptions& o) {
   OverrideController(selected, o);
   PreflightControllers(selected);
   OutputFiles outputs(o.outputs);
-  const std::unique_ptr<CampaignWorkDir> work = MakeCampaignWorkDir(o.keep_dir);
+  // Every scenario's own folder is made in it: --keep's, or a temporary one removed at the end.
+  const WorkFolder work(o.keep_dir, "--keep", "hiltwin-test");
   PrintHead(campaign, selected, o);
   const Clock::time_point start = Clock::now();
-  ScenarioPool pool(selected, o, work->path);
+  ScenarioPool pool(selected, o, work.path());
   CampaignResult result;
   result.name = campaign.name;
   result.file = o.campaign_path;

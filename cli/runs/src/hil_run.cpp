@@ -52,36 +52,6 @@ std::string SideFile(const fs::path& dir, const std::string& side, const char* s
   return (dir / (side + suffix)).string();
 }
 
-/// The folder for reports, logs and the two processes' output: --log-dir, or a temporary
-/// one removed at the end.
-struct WorkDir {
-  fs::path path;
-  bool temporary = false;
-  ~WorkDir() {
-    std::error_code ignored;
-    if (temporary) fs::remove_all(path, ignored);
-  }
-};
-
-std::unique_ptr<WorkDir> MakeWorkDir(const HilRunOptions& o) {
-  auto dir = std::make_unique<WorkDir>();
-  std::error_code error;
-  if (!o.log_dir.empty()) {
-    dir->path = o.log_dir;
-    fs::create_directories(dir->path, error);
-    if (error) ThrowUsage("--log-dir " + o.log_dir + ": " + error.message());
-    return dir;
-  }
-  std::string pattern = (fs::temp_directory_path() / "hiltwin-hil-XXXXXX").string();
-  if (::mkdtemp(pattern.data()) == nullptr) {
-    throw CommandError(ExitCode::kIo,
-                       "cannot create a temporary folder in " + fs::temp_directory_path().string());
-  }
-  dir->path = pattern;
-  dir->temporary = true;
-  return dir;
-}
-
 /// One side's telemetry flags: its own namespace under --namespace; the page on the twin only;
 /// --accept-commands to both sides, this pair's own processes, when hil was given it. False
 /// when the side gets no telemetry.
@@ -307,7 +277,8 @@ int RunHil(const HilRunOptions& o) {
   // leaving a half-made report or work folder (docs/reliability.md, row M13).
   kernel_glue::InstallStopSignalHandlers();
   const std::vector<std::string> warnings = PairWarnings(o);  // exit 2 before anything exists
-  const std::unique_ptr<WorkDir> dir = MakeWorkDir(o);  // first: the report may go into it
+  // First: the report may go into it. The two processes' output, reports and logs go here.
+  const WorkFolder dir(o.log_dir, "--log-dir", "hiltwin-hil");
   ReportFile report_file(o.report_path);
   std::printf("hiltwin hil: twin at %s Hz and ECS at %s Hz (%s) on %s for %s s, %s\n",
               Num(o.twin_rate_hz).c_str(), Num(o.ecs_rate_hz).c_str(), o.mode.c_str(), wire.c_str(),
@@ -315,16 +286,16 @@ int RunHil(const HilRunOptions& o) {
               o.clock == "virtual" ? "in lockstep on one virtual clock" : "in real time");
   std::fflush(stdout);
   PrintWarnings("hil", warnings);
-  Child twin = Start("twin", TwinArgv(o, wire, dir->path), dir->path);
-  Child ecs = Start("ecs", EcsArgv(o, wire, dir->path), dir->path);
+  Child twin = Start("twin", TwinArgv(o, wire, dir.path()), dir.path());
+  Child ecs = Start("ecs", EcsArgv(o, wire, dir.path()), dir.path());
   WaitForBoth(twin, ecs, o.duration_s, !o.no_progress && isatty(STDERR_FILENO) == 1);
   io::WireBus::Unlink(name);  // both are gone: nothing may be left in /dev/shm
-  ShowOutputOf(twin, dir->path);
-  ShowOutputOf(ecs, dir->path);
+  ShowOutputOf(twin, dir.path());
+  ShowOutputOf(ecs, dir.path());
   HilResult result =
       CombineHil(wire, o.mode,
-                 HilSide{"twin", *twin.status, ReadReport(SideFile(dir->path, "twin", kReport))},
-                 HilSide{"ecs", *ecs.status, ReadReport(SideFile(dir->path, "ecs", kReport))});
+                 HilSide{"twin", *twin.status, ReadReport(SideFile(dir.path(), "twin", kReport))},
+                 HilSide{"ecs", *ecs.status, ReadReport(SideFile(dir.path(), "ecs", kReport))});
   result.warnings = warnings;
   std::fputs(FormatHilSummary(result).c_str(), stdout);
   std::fflush(stdout);

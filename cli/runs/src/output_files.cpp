@@ -1,6 +1,8 @@
 // The files a command reads and writes (output_files.h): kept apart, and reports written whole.
 #include "hiltwin/runs/output_files.h"
 
+#include <stdlib.h>
+
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -123,6 +125,30 @@ int ReportFile::WriteAtEnd(const std::string& text, const char* command, int exi
     return WorseExitCode(exit_code, static_cast<int>(e.code()));
   }
   return exit_code;
+}
+
+WorkFolder::WorkFolder(const std::string& named_path, const std::string& flag,
+                       const std::string& prefix) {
+  namespace fs = std::filesystem;
+  if (!named_path.empty()) {
+    std::error_code error;
+    path_ = fs::absolute(named_path);
+    fs::create_directories(path_, error);
+    if (error) ThrowUsage(flag + " " + named_path + ": " + error.message());
+    return;
+  }
+  std::string pattern = (fs::temp_directory_path() / (prefix + "-XXXXXX")).string();
+  if (::mkdtemp(pattern.data()) == nullptr) {
+    throw CommandError(ExitCode::kIo,
+                       "cannot create a temporary folder in " + fs::temp_directory_path().string());
+  }
+  path_ = pattern;
+  temporary_ = true;
+}
+
+WorkFolder::~WorkFolder() {
+  std::error_code ignored;
+  if (temporary_) std::filesystem::remove_all(path_, ignored);
 }
 
 }  // namespace hiltwin::app

@@ -24,8 +24,9 @@ TEST(HelpCli, TheTopLevelHelpListsEachCommandOnOneLine) {
   const auto r = test::Run({HILTWIN_BINARY, "--help"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_NE(r.out.find("Subcommands:\n"), std::string::npos) << r.out;
-  const std::vector<std::string> expected = {"run",     "ecs",    "hil",    "trace",   "tune",
-                                             "monitor", "assess", "doctor", "io-test", "completion"};
+  const std::vector<std::string> expected = {"run",     "ecs",    "hil",    "test",    "trace",
+                                             "tune",    "monitor", "assess", "doctor", "io-test",
+                                             "completion"};
   const std::vector<std::string> lines = CommandLines(r.out);
   ASSERT_EQ(lines.size(), expected.size()) << r.out;
   for (std::size_t i = 0; i < lines.size(); ++i) {

@@ -6,6 +6,7 @@
 /// previous run's report and a full disk never leaves half a report.
 
 #include <span>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -58,6 +59,23 @@ class ReportFile {
  private:
   kernel_glue::ReplacementFile file_;
   std::string flag_;
+};
+
+/// The folder a command keeps its children's files in: the one the user named (made when
+/// missing; one that cannot be made is exit 2 naming `flag`), or, when none is named, a fresh
+/// temporary one, TMPDIR/PREFIX-XXXXXX (exit 5 when it cannot be made), removed with this
+/// object. `hil` keeps its sides' reports, logs and output there, `test` its scenarios'.
+class WorkFolder {
+ public:
+  WorkFolder(const std::string& named_path, const std::string& flag, const std::string& prefix);
+  ~WorkFolder();
+  WorkFolder(const WorkFolder&) = delete;
+  WorkFolder& operator=(const WorkFolder&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  bool temporary_ = false;
 };
 
 }  // namespace hiltwin::app
