@@ -97,7 +97,8 @@ Command AddTestCommand(CLI::App& parent) {
   app->add_option("--controller-map", f->run.controller_map,
                   "with --controller: its controller map (TOML)");
   app->add_option("--jobs,-j", f->run.jobs,
-                  "lockstep scenarios run at once (real-time ones always run alone)")
+                  "lockstep scenarios run at once (real-time ones always run alone); a lockstep "
+                  "hil scenario keeps two CPUs busy, so give it two per job")
       ->capture_default_str();
   app->add_option("--shard", f->shard,
                   "run every N-th scenario, the K-th of each N: K/N (default: from "
