@@ -38,13 +38,15 @@ struct TestFlags {
 CampaignRunOptions CampaignRunOptionsOf(TestFlags& f) {
   CampaignRunOptions o = f.run;
   if (o.campaign_path.empty()) {
-    ThrowUsage("give a campaign file: hiltwin test CAMPAIGN.toml (or hiltwin test merge "
-               "SHARD.json...); docs/testing-campaigns.md");
+    ThrowUsage(
+        "give a campaign file: hiltwin test CAMPAIGN.toml (or hiltwin test merge "
+        "SHARD.json...); docs/testing-campaigns.md");
   }
   if (o.jobs == 0) ThrowUsage("--jobs 0: give at least 1 scenario at a time");
   if (!o.controller_map.empty() && o.controller.empty()) {
-    ThrowUsage("--controller-map goes with --controller (the campaign's own scenarios name "
-               "their maps)");
+    ThrowUsage(
+        "--controller-map goes with --controller (the campaign's own scenarios name "
+        "their maps)");
   }
   try {
     if (!f.shard.empty()) {
@@ -105,13 +107,13 @@ Command AddTestCommand(CLI::App& parent) {
                   "SLURM_ARRAY_TASK_ID/COUNT or CI_NODE_INDEX/TOTAL when set, else 1/1)");
   app->add_option("--filter", f->run.filter,
                   "run only scenarios whose name matches this glob (e.g. 'twin_rate_*')");
-  app->add_flag("--fail-fast", f->run.fail_fast,
-                "start no scenario after the first that failed");
+  app->add_flag("--fail-fast", f->run.fail_fast, "start no scenario after the first that failed");
   app->add_option("--keep", f->run.keep_dir,
                   "keep every scenario's logs, reports and output in DIR/SCENARIO");
   AddOutputFlags(*app, f->run.outputs);
-  app->add_flag("--no-progress", [f](std::int64_t) { f->run.progress = false; },
-                "no line when a real-time scenario starts");
+  app->add_flag(
+      "--no-progress", [f](std::int64_t) { f->run.progress = false; },
+      "no line when a real-time scenario starts");
   AddMergeCommand(*app, f);
   app->require_subcommand(0, 1);
   return {app, [f, app] {

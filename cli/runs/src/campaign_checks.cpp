@@ -62,24 +62,28 @@ void CheckStep(const CampaignScenario& s) {
   for (std::size_t i = 1; i < knots.size(); ++i) {
     if (knots[i].time_s == knots[i - 1].time_s) return;
   }
-  Refuse(s, "settling_time_s and overshoot_pct need a setpoint with a step (a CSV with one time "
-            "given twice); setpoint " + s.setpoint + " has none");
+  Refuse(s,
+         "settling_time_s and overshoot_pct need a setpoint with a step (a CSV with one time "
+         "given twice); setpoint " +
+             s.setpoint + " has none");
 }
 
 void CheckCriteria(const CampaignScenario& s) {
   const CampaignCriteria& c = s.criteria;
   const bool closed_loop = s.kind == "hil" && s.mode == "closedloop";
   if (AsksTracking(c) && !closed_loop) {
-    Refuse(s, "tracking, final error, settling and overshoot bounds need kind = \"hil\" and "
-              "mode = \"closedloop\" (a controller following a setpoint)");
+    Refuse(s,
+           "tracking, final error, settling and overshoot bounds need kind = \"hil\" and "
+           "mode = \"closedloop\" (a controller following a setpoint)");
   }
   if (c.duty_saturation_pct && s.kind != "hil") {
     Refuse(s, "duty_saturation_pct needs kind = \"hil\": the ECS's duty is what saturates");
   }
   if (c.settling_time_s || c.overshoot_pct) CheckStep(s);
   if (c.credibility_min && (c.reference_file.empty() || c.reference_column.empty())) {
-    Refuse(s, "credibility_min needs reference_file and reference_column (the curve the "
-              "scenario's compare_column is scored against)");
+    Refuse(s,
+           "credibility_min needs reference_file and reference_column (the curve the "
+           "scenario's compare_column is scored against)");
   }
   if (!c.credibility_min && !c.reference_file.empty()) {
     Refuse(s, "reference_file is given without credibility_min: add the score it must reach");
@@ -121,7 +125,8 @@ void CheckScenario(const CampaignScenario& s) {
   if (s.kind == "run" && !s.ecs_overruns.empty()) {
     Refuse(s, "ecs_overruns needs kind = \"hil\" (a run has no ECS)");
   }
-  for (const auto& [key, path] : {std::pair{"config", &s.config}, {"gains", &s.gains},
+  for (const auto& [key, path] : {std::pair{"config", &s.config},
+                                  {"gains", &s.gains},
                                   {"controller_map", &s.controller_map},
                                   {"plant_map", &s.plant_map}}) {
     CheckFile(s, key, *path);
@@ -152,8 +157,9 @@ RelbotParams ScenarioRelbotParams(const CampaignScenario& s) {
       found = true;
     }
     if (!found) {
-      Refuse(s, "params \"" + name + "\": no such RELbot parameter (\"section.key\" as in "
-                "relbot/relbot.toml, e.g. \"body.mass_kg\")");
+      Refuse(s, "params \"" + name +
+                    "\": no such RELbot parameter (\"section.key\" as in "
+                    "relbot/relbot.toml, e.g. \"body.mass_kg\")");
     }
   }
   try {

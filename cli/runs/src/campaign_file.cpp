@@ -93,8 +93,9 @@ struct CampaignReader {
     const std::string text = String(node, "controller");
     for (const std::string_view prefix : {"lib:", "fmu:"}) {
       if (text.starts_with(prefix) && text.size() > prefix.size()) {
-        return std::string(prefix) +
-               (fs::absolute(fs::path(folder) / text.substr(prefix.size()))).lexically_normal().string();
+        return std::string(prefix) + (fs::absolute(fs::path(folder) / text.substr(prefix.size())))
+                                         .lexically_normal()
+                                         .string();
       }
     }
     return text;
@@ -180,16 +181,35 @@ void ReadScenarioKey(const CampaignReader& r, std::string_view key, const toml::
   if (key == "ecs_max_miss_pct") s.ecs_max_miss_pct = r.Bound(node, key, 0.0, false);
 }
 
-void ReadScenarioTable(const CampaignReader& r, const toml::table& table, std::string_view table_name,
-                       bool named, CampaignScenario& s) {
+void ReadScenarioTable(const CampaignReader& r, const toml::table& table,
+                       std::string_view table_name, bool named, CampaignScenario& s) {
   // A scenario's name is its own; every other key may come from [defaults].
   toml::table keys = table;
   if (named) keys.erase("name");
   mt::CheckKeys(r.source, keys, table_name,
-                {"kind", "clock", "mode", "controller", "controller_map", "gains", "plant",
-                 "plant_map", "config", "params", "setpoint", "input", "twin_rate_hz",
-                 "ecs_rate_hz", "duration_s", "link_faults", "twin_overruns", "ecs_overruns",
-                 "twin_qos", "ecs_qos", "twin_max_miss_pct", "ecs_max_miss_pct", "criteria"});
+                {"kind",
+                 "clock",
+                 "mode",
+                 "controller",
+                 "controller_map",
+                 "gains",
+                 "plant",
+                 "plant_map",
+                 "config",
+                 "params",
+                 "setpoint",
+                 "input",
+                 "twin_rate_hz",
+                 "ecs_rate_hz",
+                 "duration_s",
+                 "link_faults",
+                 "twin_overruns",
+                 "ecs_overruns",
+                 "twin_qos",
+                 "ecs_qos",
+                 "twin_max_miss_pct",
+                 "ecs_max_miss_pct",
+                 "criteria"});
   for (const auto& [key_name, node] : table) {
     const std::string_view key = key_name.str();
     if (key == "name") s.name = r.String(node, key);

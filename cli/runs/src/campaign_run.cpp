@@ -14,11 +14,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
 #include <stdexcept>
-#include <map>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -44,7 +44,8 @@ double SecondsSince(Clock::time_point start) {
 }
 
 /// The scenarios this run covers: --filter's glob, then every N-th of those for --shard K/N.
-std::vector<CampaignScenario> SelectScenarios(const Campaign& campaign, const CampaignRunOptions& o) {
+std::vector<CampaignScenario> SelectScenarios(const Campaign& campaign,
+                                              const CampaignRunOptions& o) {
   std::vector<CampaignScenario> filtered;
   for (const CampaignScenario& s : campaign.scenarios) {
     if (o.filter.empty() || ::fnmatch(o.filter.c_str(), s.name.c_str(), 0) == 0) {
@@ -96,18 +97,21 @@ RunningScenario StartScenario(const CampaignScenario& s, const fs::path& work) {
   ScenarioFiles files{work / s.name};
   std::error_code error;
   fs::create_directories(files.dir, error);
-  if (error) throw std::runtime_error("cannot make its folder " + files.dir.string() + ": " + error.message());
+  if (error)
+    throw std::runtime_error("cannot make its folder " + files.dir.string() + ": " +
+                             error.message());
   kernel_glue::ProcessOptions options;
   options.out = kernel_glue::OutputTarget::File(files.output());
   options.err = kernel_glue::OutputTarget::SameAsStdout();
   return RunningScenario{&s, files, kernel_glue::Process::Start(ScenarioArgv(s, files), options),
-                 Clock::now()};
+                         Clock::now()};
 }
 
 /// The pool: starts scenarios in campaign order while a slot is free, judges each as it ends.
 class ScenarioPool {
  public:
-  ScenarioPool(const std::vector<CampaignScenario>& scenarios, const CampaignRunOptions& o, fs::path work)
+  ScenarioPool(const std::vector<CampaignScenario>& scenarios, const CampaignRunOptions& o,
+               fs::path work)
       : scenarios_(scenarios), o_(o), work_(std::move(work)) {}
 
   std::vector<ScenarioResult> Run() {
@@ -137,8 +141,7 @@ class ScenarioPool {
       const CampaignScenario& s = scenarios_[next_];
       if (s.clock == "realtime" && !running_.empty()) return;  // it waits to run alone
       if (s.clock == "realtime" && o_.progress) {
-        std::printf("  %s runs in real time, alone: no other scenario beside it\n",
-                    s.name.c_str());
+        std::printf("  %s runs in real time, alone: no other scenario beside it\n", s.name.c_str());
         std::fflush(stdout);
       }
       ++next_;
@@ -212,8 +215,8 @@ std::string DumpResult(const nlohmann::ordered_json& json) {
   return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + '\n';
 }
 
-/// The outputs, each opened before anything runs (a path that cannot be written is exit 5 at
-/// once, not after the campaign) and written whole at the end.
+/// The outputs, each opened before anything runs (a path that cannot be written is exit 2 at
+/// once, not after the campaign) and written whole at the end (a disk that fills then: exit 5).
 struct OutputFiles {
   ReportFile json, junit, html;
   explicit OutputFiles(const CampaignOutputs& o)
@@ -283,10 +286,12 @@ std::optional<ShardSpec> ShardFromVariables(const std::map<std::string, std::str
 ShardSpec ParseShard(const std::string& text) {
   using namespace campaign_pool;  // this file's helpers
   const std::size_t slash = text.find('/');
-  const std::optional<std::size_t> k =
-      slash == std::string::npos ? std::nullopt : WholeNumber(std::string_view(text).substr(0, slash));
-  const std::optional<std::size_t> n =
-      slash == std::string::npos ? std::nullopt : WholeNumber(std::string_view(text).substr(slash + 1));
+  const std::optional<std::size_t> k = slash == std::string::npos
+                                           ? std::nullopt
+                                           : WholeNumber(std::string_view(text).substr(0, slash));
+  const std::optional<std::size_t> n = slash == std::string::npos
+                                           ? std::nullopt
+                                           : WholeNumber(std::string_view(text).substr(slash + 1));
   if (!k || !n || *n == 0 || *k == 0 || *k > *n) {
     throw std::invalid_argument("\"" + text + "\": expected K/N with 1 <= K <= N, e.g. 2/3");
   }
@@ -306,8 +311,8 @@ std::optional<ShardSpec> ShardFromEnvironment(const std::map<std::string, std::s
     }
     slurm_first = *first;
   }
-  if (auto slurm = ShardFromVariables(env, "SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT",
-                                      slurm_first)) {
+  if (auto slurm =
+          ShardFromVariables(env, "SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", slurm_first)) {
     return slurm;
   }
   return ShardFromVariables(env, "CI_NODE_INDEX", "CI_NODE_TOTAL", 1);
@@ -347,7 +352,8 @@ int RunCampaign(const CampaignRunOptions& o) {
     std::printf("hiltwin test: %zu scenario(s) not run (%s)\n", pool.not_run(),
                 kernel_glue::StopRequested() ? "stopped by a signal" : "--fail-fast");
   }
-  if (!o.keep_dir.empty()) std::printf("hiltwin test: logs and reports kept in %s\n", o.keep_dir.c_str());
+  if (!o.keep_dir.empty())
+    std::printf("hiltwin test: logs and reports kept in %s\n", o.keep_dir.c_str());
   std::fflush(stdout);
   const int exit_code = outputs.WriteAll(
       result, pool.io_fault() ? static_cast<int>(ExitCode::kIo) : result.exit_code());

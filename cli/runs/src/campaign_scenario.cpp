@@ -51,10 +51,14 @@ std::string ConfigPath(const CampaignScenario& s, const ScenarioFiles& files) {
 
 std::vector<std::string> HilArgv(const CampaignScenario& s, const ScenarioFiles& files,
                                  const std::string& config) {
-  std::vector<std::string> argv = {"/proc/self/exe", "hil", "--clock", s.clock, "--mode", s.mode,
-                                   "--twin-rate", Arg(s.twin_rate_hz), "--ecs-rate",
-                                   Arg(s.ecs_rate_hz), "--report", files.report().string(),
-                                   "--log-dir", files.dir.string(), "--no-progress"};
+  std::vector<std::string> argv = {"/proc/self/exe", "hil",
+                                   "--clock",        s.clock,
+                                   "--mode",         s.mode,
+                                   "--twin-rate",    Arg(s.twin_rate_hz),
+                                   "--ecs-rate",     Arg(s.ecs_rate_hz),
+                                   "--report",       files.report().string(),
+                                   "--log-dir",      files.dir.string(),
+                                   "--no-progress"};
   if (s.mode == "closedloop") {
     Add(argv, {"--setpoint", s.setpoint, "--controller", s.controller});
     if (!s.controller_map.empty()) Add(argv, {"--controller-map", s.controller_map});
@@ -77,10 +81,14 @@ std::vector<std::string> HilArgv(const CampaignScenario& s, const ScenarioFiles&
 
 std::vector<std::string> RunArgv(const CampaignScenario& s, const ScenarioFiles& files,
                                  const std::string& config) {
-  std::vector<std::string> argv = {"/proc/self/exe", "run", "--io", "mock", "--clock", s.clock,
-                                   "--rate", Arg(s.twin_rate_hz), "--input", s.input,
-                                   "--input-rate", Arg(s.ecs_rate_hz), "--report",
-                                   files.report().string(), "--log", files.log(s).string(),
+  std::vector<std::string> argv = {"/proc/self/exe", "run",
+                                   "--io",           "mock",
+                                   "--clock",        s.clock,
+                                   "--rate",         Arg(s.twin_rate_hz),
+                                   "--input",        s.input,
+                                   "--input-rate",   Arg(s.ecs_rate_hz),
+                                   "--report",       files.report().string(),
+                                   "--log",          files.log(s).string(),
                                    "--no-progress"};
   if (s.duration_s > 0.0) Add(argv, {"--duration", Arg(s.duration_s)});
   if (!config.empty()) Add(argv, {"--config", config});
@@ -136,7 +144,8 @@ ScenarioResult JudgeScenario(const CampaignScenario& s, const ScenarioFiles& fil
   r.wall_s = wall_s;
   // Exit 0, 3 (FLAGGED) and 4 (ABORTED) are verdicts the criteria judge; anything else (a
   // crash, a model fault, bad input, an I/O error) means the run itself did not hold.
-  const bool judged_exit = status.exited && (status.code == 0 || status.code == 3 || status.code == 4);
+  const bool judged_exit =
+      status.exited && (status.code == 0 || status.code == 3 || status.code == 4);
   const std::string command = "hiltwin " + s.kind;
   if (!judged_exit) {
     r.error = command + " ended with " + status.Describe() + ": " + OutputTail(files) + " (" +

@@ -11,15 +11,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
-#include <thread>
-#include <csignal>
-#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fakes/process.h"
@@ -88,7 +88,8 @@ Json WithoutWallClock(Json json, bool drop_shards = false) {
 /// JUnit XML without its time attributes (the wall clock's) and the property naming the shards
 /// it came from.
 std::string WithoutTimesAndShards(const std::string& xml) {
-  const std::string timeless = std::regex_replace(xml, std::regex(R"( (time|timestamp)="[^"]*")"), "");
+  const std::string timeless =
+      std::regex_replace(xml, std::regex(R"( (time|timestamp)="[^"]*")"), "");
   return std::regex_replace(timeless, std::regex(R"( *<property name="shards"[^>]*/>\n)"), "");
 }
 
@@ -145,17 +146,18 @@ TEST_F(CampaignCli, ThreeShardsThroughGnuParallelMergeIntoTheUnshardedResult) {
   const std::string whole_xml = (dir_ / "whole.xml").string();
   ASSERT_EQ(Test({campaign(), "--json", whole, "--junit", whole_xml}).exit_code, 3);
   // The shards as a job array would run them: three processes at once, each its own K/3.
-  const auto shards = hiltwin::test::Run(
-      {"parallel", "--will-cite", "--halt", "never", std::string(HILTWIN_BINARY) +
-       " test " + campaign() + " --shard {}/3 --json " + (dir_ / "shard{}.json").string(),
-       ":::", "1", "2", "3"},
-      180'000);
+  const auto shards =
+      hiltwin::test::Run({"parallel", "--will-cite", "--halt", "never",
+                          std::string(HILTWIN_BINARY) + " test " + campaign() +
+                              " --shard {}/3 --json " + (dir_ / "shard{}.json").string(),
+                          ":::", "1", "2", "3"},
+                         180'000);
   EXPECT_EQ(shards.exit_code, 1) << shards.out << shards.err;  // one shard holds too_strict
   const std::string merged = (dir_ / "merged.json").string();
   const std::string merged_xml = (dir_ / "merged.xml").string();
-  const auto merge = Test({"merge", (dir_ / "shard1.json").string(),
-                           (dir_ / "shard2.json").string(), (dir_ / "shard3.json").string(),
-                           "--json", merged, "--junit", merged_xml});
+  const auto merge =
+      Test({"merge", (dir_ / "shard1.json").string(), (dir_ / "shard2.json").string(),
+            (dir_ / "shard3.json").string(), "--json", merged, "--junit", merged_xml});
   EXPECT_EQ(merge.exit_code, 3) << merge.out << merge.err;
   EXPECT_EQ(WithoutWallClock(ReadJson(merged), true), WithoutWallClock(ReadJson(whole), true));
   EXPECT_EQ(ReadJson(merged)["shards"].size(), 3U);
@@ -236,18 +238,21 @@ TEST_F(CampaignCli, ACtrlCStopsTheRunningScenarioAndWritesWhatEndedExit130) {
       {HILTWIN_BINARY, "test", (dir_ / "long.toml").string(), "--json", json}, out);
   // Until the real-time scenario has started.
   for (int i = 0; i < 300 && hiltwin::test::ReadOutput(out).find("long runs in real time") ==
-                                 std::string::npos; ++i) {
+                                 std::string::npos;
+       ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   ::kill(test.pid(), SIGINT);
-  const std::optional<hiltwin::kernel_glue::ExitStatus> status = test.WaitFor(std::chrono::seconds(20));
+  const std::optional<hiltwin::kernel_glue::ExitStatus> status =
+      test.WaitFor(std::chrono::seconds(20));
   ASSERT_TRUE(status.has_value()) << "hiltwin test did not stop within 20 s of SIGINT";
   EXPECT_EQ(status->code, 130) << hiltwin::test::ReadOutput(out);
   const Json result = ReadJson(json);
   ASSERT_EQ(result["scenarios"].size(), 2U);  // quick and the stopped long one; never not run
   EXPECT_EQ(result["scenarios"][1]["name"], "long");
-  EXPECT_THAT(hiltwin::test::ReadOutput(out), HasSubstr("1 scenario(s) not run (stopped by a signal)"));
+  EXPECT_THAT(hiltwin::test::ReadOutput(out),
+              HasSubstr("1 scenario(s) not run (stopped by a signal)"));
 }
 
 TEST_F(CampaignCli, ABadCampaignOrControllerIsExit2BeforeAnyScenarioRuns) {
@@ -288,7 +293,8 @@ TEST_F(CampaignCli, AnOutputInAFolderThatCannotBeMadeIsExit2BeforeAnyScenarioRun
 }
 
 TEST_F(CampaignCli, MergeRefusesShardsOfTwoCampaignsAndATwiceGivenShard) {
-  std::ofstream(dir_ / "other.toml") << "[[scenario]]\nname = \"x\"\nkind = \"run\"\nduration_s = 0.2\n";
+  std::ofstream(dir_ / "other.toml")
+      << "[[scenario]]\nname = \"x\"\nkind = \"run\"\nduration_s = 0.2\n";
   const std::string one = (dir_ / "one.json").string();
   const std::string other = (dir_ / "other.json").string();
   ASSERT_EQ(Test({campaign(), "--filter", "twin_alone", "--json", one}).exit_code, 0);

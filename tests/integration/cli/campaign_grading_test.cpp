@@ -30,7 +30,7 @@ using FailedCriteria = std::map<std::string, std::set<std::string>>;  // scenari
 
 /// The closed-loop scenarios of the shipped campaign that follow the 2.5 m move.
 const std::vector<std::string> kMoveScenarios = {
-    "closedloop_2_5m", "lost_frames_20",  "twin_overrun_600us",  "twin_rate_1khz",
+    "closedloop_2_5m", "lost_frames_20", "twin_overrun_600us", "twin_rate_1khz",
     "twin_rate_4khz",  "twin_rate_8khz", "heavier_robot_10pct"};
 
 FailedCriteria OnEveryMove(const std::set<std::string>& criteria) {
@@ -91,8 +91,8 @@ TEST_P(CampaignGrading, TheShippedCampaignGradesTheExampleController) {
   const auto r = hiltwin::test::Run(
       {HILTWIN_BINARY, "test", std::string(HILTWIN_SOURCE_DIR) + "/campaigns/relbot_course.toml",
        "--jobs", "2", "--controller",
-       "lib:" + std::string(HILTWIN_TEST_CONTROLLER_DIR) + "/" + grade.controller + ".so",
-       "--json", json, "--junit", junit, "--html", html},
+       "lib:" + std::string(HILTWIN_TEST_CONTROLLER_DIR) + "/" + grade.controller + ".so", "--json",
+       json, "--junit", junit, "--html", html},
       300'000);
   ASSERT_EQ(r.exit_code, grade.exit_code) << r.out << r.err;
   std::ifstream in(json);
@@ -101,10 +101,9 @@ TEST_P(CampaignGrading, TheShippedCampaignGradesTheExampleController) {
   EXPECT_EQ(FailedIn(result), grade.failed);
   // The JUnit file as a CI server reads it: valid against the schema, one failure per failed
   // criterion.
-  const auto lint = hiltwin::test::Run({"xmllint", "--noout", "--schema",
-                                        std::string(HILTWIN_SOURCE_DIR) +
-                                            "/tests/unit/campaign/junit.xsd",
-                                        junit});
+  const auto lint = hiltwin::test::Run(
+      {"xmllint", "--noout", "--schema",
+       std::string(HILTWIN_SOURCE_DIR) + "/tests/unit/campaign/junit.xsd", junit});
   EXPECT_EQ(lint.exit_code, 0) << lint.out << lint.err;
   std::ifstream xml_in(junit);
   const std::string xml{std::istreambuf_iterator<char>(xml_in), std::istreambuf_iterator<char>()};
@@ -120,7 +119,8 @@ TEST_P(CampaignGrading, TheShippedCampaignGradesTheExampleController) {
   std::ifstream html_in(html);
   const std::string page{std::istreambuf_iterator<char>(html_in), std::istreambuf_iterator<char>()};
   std::size_t plots = 0;
-  for (std::size_t at = page.find("<svg"); at != std::string::npos; at = page.find("<svg", at + 1)) {
+  for (std::size_t at = page.find("<svg"); at != std::string::npos;
+       at = page.find("<svg", at + 1)) {
     ++plots;
   }
   EXPECT_GE(plots, 9U);

@@ -25,7 +25,8 @@ class CampaignFile : public ::testing::Test {
     std::string pattern = (fs::temp_directory_path() / "campaign-file-XXXXXX").string();
     ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
     dir_ = pattern;
-    std::ofstream(dir_ / "step.csv") << "time,left_m,right_m\n0,0,0\n0.5,0,0\n0.5,0.1,0.1\n3,0.1,0.1\n";
+    std::ofstream(dir_ / "step.csv")
+        << "time,left_m,right_m\n0,0,0\n0.5,0,0\n0.5,0.1,0.1\n3,0.1,0.1\n";
     std::ofstream(dir_ / "ramp.csv") << "time,left_m,right_m\n0,0,0\n3,0.1,0.1\n";
     std::ofstream(dir_ / "ref.csv") << "time_s,wheel_right_m\n0,0\n1,1\n";
     fs::create_directory(dir_ / "ctl");
@@ -93,9 +94,9 @@ settling_time_s = 0.5
 }
 
 TEST_F(CampaignFile, WithoutACampaignTableTheNameIsTheFilesStem) {
-  EXPECT_EQ(ParseCampaign("[[scenario]]\nname = \"a\"\n", "dir/relbot_course.toml", dir_.string())
-                .name,
-            "relbot_course");
+  EXPECT_EQ(
+      ParseCampaign("[[scenario]]\nname = \"a\"\n", "dir/relbot_course.toml", dir_.string()).name,
+      "relbot_course");
 }
 
 TEST_F(CampaignFile, AnUnknownKeyIsRefusedAtItsPlaceWithTheKnownOnes) {
@@ -108,8 +109,8 @@ TEST_F(CampaignFile, AnUnknownKeyIsRefusedAtItsPlaceWithTheKnownOnes) {
   EXPECT_NE(Refusal("[defaults]\nname = \"a\"\n[[scenario]]\nname = \"b\"\n")
                 .find("c.toml:2:1: unknown key 'name' in [defaults]"),
             std::string::npos);
-  EXPECT_NE(Refusal("[scenarios]\n").find("c.toml:1:2: unknown key 'scenarios'"),
-            std::string::npos) << Refusal("[scenarios]\n");
+  EXPECT_NE(Refusal("[scenarios]\n").find("c.toml:1:2: unknown key 'scenarios'"), std::string::npos)
+      << Refusal("[scenarios]\n");
 }
 
 TEST_F(CampaignFile, AFaultOverrunOrRuleTheCommandsWouldRefuseIsRefusedAtItsItem) {
@@ -120,8 +121,9 @@ TEST_F(CampaignFile, AFaultOverrunOrRuleTheCommandsWouldRefuseIsRefusedAtItsItem
   EXPECT_NE(Refusal("[[scenario]]\nname = \"a\"\ntwin_overruns = [\"at=5,extra-us=x\"]\n")
                 .find("c.toml:3:18: twin_overruns: "),
             std::string::npos);
-  EXPECT_NE(Refusal("[[scenario]]\nname = \"a\"\ntwin_qos = [\"5:4\"]\n").find("c.toml:3:13: twin_qos: "),
-            std::string::npos);
+  EXPECT_NE(
+      Refusal("[[scenario]]\nname = \"a\"\ntwin_qos = [\"5:4\"]\n").find("c.toml:3:13: twin_qos: "),
+      std::string::npos);
 }
 
 TEST_F(CampaignFile, NamesAreRequiredUniqueAndFitForAFileName) {
@@ -191,8 +193,9 @@ TEST_F(CampaignFile, AMissingFileIsRefusedNamingItsKeyAndWhereRelativePathsAreRe
 }
 
 TEST_F(CampaignFile, ParameterOverridesApplyToTheBuiltInSetAndAreWrittenExactly) {
-  const Campaign c = Parse("[[scenario]]\nname = \"heavy\"\nparams = { \"body.mass_kg\" = 2.0, "
-                           "\"wheel.mass_kg\" = 0.11 }\n");
+  const Campaign c = Parse(
+      "[[scenario]]\nname = \"heavy\"\nparams = { \"body.mass_kg\" = 2.0, "
+      "\"wheel.mass_kg\" = 0.11 }\n");
   const RelbotParams params = ScenarioRelbotParams(c.scenarios[0]);
   EXPECT_EQ(params.body_mass_kg, 2.0);
   EXPECT_EQ(params.wheel_mass_kg, 0.11);

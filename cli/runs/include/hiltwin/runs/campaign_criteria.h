@@ -19,19 +19,19 @@ namespace hiltwin::app {
 /// A scenario's criteria, as the campaign file gives them (docs/testing-campaigns.md): each
 /// bound is optional; a scenario with none is judged on nothing but having run.
 struct CampaignCriteria {
-  std::optional<std::string> verdict;           ///< the worst verdict allowed: "PASS" or "FLAGGED"
-  std::optional<double> tracking_max_m;         ///< <=: the larger wheel's max |error|, m
-  std::optional<double> tracking_rms_m;         ///< <=: RMS error of both wheels, m
-  std::optional<double> final_error_m;          ///< <=: the larger wheel's |error| at the end, m
-  std::optional<double> settling_time_s;        ///< <=: after the setpoint's step, s
-  double settling_band_pct = 2.0;               ///< the settling band, % of the step
-  std::optional<double> overshoot_pct;          ///< <=: beyond the step's target, % of the step
-  std::optional<double> duty_saturation_pct;    ///< <=: share of ECS cycles at full duty, %
+  std::optional<std::string> verdict;         ///< the worst verdict allowed: "PASS" or "FLAGGED"
+  std::optional<double> tracking_max_m;       ///< <=: the larger wheel's max |error|, m
+  std::optional<double> tracking_rms_m;       ///< <=: RMS error of both wheels, m
+  std::optional<double> final_error_m;        ///< <=: the larger wheel's |error| at the end, m
+  std::optional<double> settling_time_s;      ///< <=: after the setpoint's step, s
+  double settling_band_pct = 2.0;             ///< the settling band, % of the step
+  std::optional<double> overshoot_pct;        ///< <=: beyond the step's target, % of the step
+  std::optional<double> duty_saturation_pct;  ///< <=: share of ECS cycles at full duty, %
   std::optional<std::uint64_t> missed_deadlines;  ///< <=: both sides' deadline misses, summed
-  std::optional<double> credibility_min;        ///< >=: assess's score against `reference`
+  std::optional<double> credibility_min;          ///< >=: assess's score against `reference`
   std::string reference_file;    ///< CSV with the reference curve (absolute after loading)
   std::string reference_column;  ///< its column, by header name
-  std::string compare_column = "wheel_right_m";  ///< the scenario log's column compared with it
+  std::string compare_column = "wheel_right_m";   ///< the scenario log's column compared with it
   std::optional<double> credibility_max_delay_s;  ///< assess's --max-delay; default: assess's
 };
 
@@ -56,8 +56,7 @@ struct StepResponse {
 
 /// Share of samples, in %, in which either wheel's |duty| is at least 0.999 * duty_limit.
 [[nodiscard]] double DutySaturationPct(std::span<const double> duty_left,
-                                       std::span<const double> duty_right,
-                                       double duty_limit = 1.0);
+                                       std::span<const double> duty_right, double duty_limit = 1.0);
 
 /// What a scenario measured; nullopt: not measured (not asked for, or the run gave no figure).
 struct ScenarioMeasures {

@@ -26,10 +26,10 @@ class CampaignFileError : public std::runtime_error {
 /// One scenario, with the defaults applied and every path made absolute (relative paths are
 /// read from the campaign file's folder).
 struct CampaignScenario {
-  std::size_t index = 0;          ///< 0-based position in the file
-  std::string name;               ///< unique; letters, digits, '_', '-', '.'
-  std::string kind = "hil";       ///< "hil": twin + ECS; "run": the twin alone (open loop)
-  std::string clock = "virtual";  ///< "virtual" (lockstep, exact) or "realtime"
+  std::size_t index = 0;            ///< 0-based position in the file
+  std::string name;                 ///< unique; letters, digits, '_', '-', '.'
+  std::string kind = "hil";         ///< "hil": twin + ECS; "run": the twin alone (open loop)
+  std::string clock = "virtual";    ///< "virtual" (lockstep, exact) or "realtime"
   std::string mode = "closedloop";  ///< hil: closedloop (controller on setpoint) or openloop
   std::string controller = "pid";   ///< hil closedloop: the ECS's --controller
   std::string controller_map;       ///< "": the RELbot's

@@ -68,10 +68,10 @@ struct ShardSpec {
 };
 
 struct CampaignResult {
-  std::string name;                  ///< [campaign] name (or the file's stem)
-  std::string file;                  ///< the campaign file as given
-  std::size_t scenarios_in_file = 0; ///< before --filter and --shard
-  std::string filter;                ///< --filter, "" when none
+  std::string name;                   ///< [campaign] name (or the file's stem)
+  std::string file;                   ///< the campaign file as given
+  std::size_t scenarios_in_file = 0;  ///< before --filter and --shard
+  std::string filter;                 ///< --filter, "" when none
   /// The shards this result covers: {1/1} for a whole run; a merged result lists every shard
   /// it joined, in order.
   std::vector<ShardSpec> shards;
