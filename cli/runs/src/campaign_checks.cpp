@@ -2,7 +2,6 @@
 // scenario's place in the file, what is wrong and what to do.
 #include "campaign_checks.h"
 
-#include <charconv>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -13,6 +12,7 @@
 #include "hiltwin/relbot/config_error.h"
 #include "hiltwin/relbot/input_profile.h"
 #include "hiltwin/relbot/setpoint_profile.h"
+#include "hiltwin/runs/session_assembly.h"
 #include "hiltwin/runtime/overrun_injection.h"
 #include "hiltwin/scheduler/executive.h"
 
@@ -179,11 +179,8 @@ std::string RelbotParamsToml(const RelbotParams& params) {
       table = spec.table;
       text += "\n[" + std::string(table) + "]\n";
     }
-    char number[32];
-    const auto [end, error] = std::to_chars(number, number + sizeof number, params.*spec.member);
-    static_cast<void>(error);  // 32 characters hold every double
-    // to_chars' shortest form may be "2" or "1e-06": TOML needs a float to look like one.
-    std::string value(number, end);
+    // The shortest exact form may be "2" or "1e-06": TOML needs a float to look like one.
+    std::string value = ExactNum(params.*spec.member);
     if (value.find_first_of(".eEn") == std::string::npos) value += ".0";
     text += std::string(spec.key) + " = " + value + "\n";
   }

@@ -12,17 +12,11 @@
 #include "campaign_checks.h"
 #include "hiltwin/runs/campaign_criteria.h"
 #include "hiltwin/runs/command.h"
+#include "hiltwin/runs/output_files.h"
+#include "hiltwin/runs/session_assembly.h"
 
 namespace hiltwin::app {
 namespace campaign_scenario_detail {
-
-/// A number as the command line reads it back exactly (to_chars' shortest form).
-std::string Arg(double value) {
-  char text[32];
-  const auto [end, error] = std::to_chars(text, text + sizeof text, value);
-  static_cast<void>(error);  // 32 characters hold every double
-  return {text, end};
-}
 
 void Add(std::vector<std::string>& argv, std::initializer_list<std::string> args) {
   argv.insert(argv.end(), args);
@@ -54,8 +48,8 @@ std::vector<std::string> HilArgv(const CampaignScenario& s, const ScenarioFiles&
   std::vector<std::string> argv = {"/proc/self/exe", "hil",
                                    "--clock",        s.clock,
                                    "--mode",         s.mode,
-                                   "--twin-rate",    Arg(s.twin_rate_hz),
-                                   "--ecs-rate",     Arg(s.ecs_rate_hz),
+                                   "--twin-rate",    ExactNum(s.twin_rate_hz),
+                                   "--ecs-rate",     ExactNum(s.ecs_rate_hz),
                                    "--report",       files.report().string(),
                                    "--log-dir",      files.dir.string(),
                                    "--no-progress"};
@@ -66,12 +60,12 @@ std::vector<std::string> HilArgv(const CampaignScenario& s, const ScenarioFiles&
   } else {
     Add(argv, {"--input", s.input});
   }
-  if (s.duration_s > 0.0) Add(argv, {"--duration", Arg(s.duration_s)});
+  if (s.duration_s > 0.0) Add(argv, {"--duration", ExactNum(s.duration_s)});
   if (!config.empty()) Add(argv, {"--config", config});
   for (const std::string& rule : s.twin_qos) Add(argv, {"--twin-qos", rule});
   for (const std::string& rule : s.ecs_qos) Add(argv, {"--ecs-qos", rule});
-  if (s.twin_max_miss_pct) Add(argv, {"--twin-max-miss-pct", Arg(*s.twin_max_miss_pct)});
-  if (s.ecs_max_miss_pct) Add(argv, {"--ecs-max-miss-pct", Arg(*s.ecs_max_miss_pct)});
+  if (s.twin_max_miss_pct) Add(argv, {"--twin-max-miss-pct", ExactNum(*s.twin_max_miss_pct)});
+  if (s.ecs_max_miss_pct) Add(argv, {"--ecs-max-miss-pct", ExactNum(*s.ecs_max_miss_pct)});
   for (const std::string& flag : TwinFlags(s)) argv.push_back("--twin-arg=" + flag);
   for (const std::string& spec : s.ecs_overruns) {
     Add(argv, {"--ecs-arg=--inject-overrun", "--ecs-arg=" + spec});
@@ -84,16 +78,16 @@ std::vector<std::string> RunArgv(const CampaignScenario& s, const ScenarioFiles&
   std::vector<std::string> argv = {"/proc/self/exe", "run",
                                    "--io",           "mock",
                                    "--clock",        s.clock,
-                                   "--rate",         Arg(s.twin_rate_hz),
+                                   "--rate",         ExactNum(s.twin_rate_hz),
                                    "--input",        s.input,
-                                   "--input-rate",   Arg(s.ecs_rate_hz),
+                                   "--input-rate",   ExactNum(s.ecs_rate_hz),
                                    "--report",       files.report().string(),
                                    "--log",          files.log(s).string(),
                                    "--no-progress"};
-  if (s.duration_s > 0.0) Add(argv, {"--duration", Arg(s.duration_s)});
+  if (s.duration_s > 0.0) Add(argv, {"--duration", ExactNum(s.duration_s)});
   if (!config.empty()) Add(argv, {"--config", config});
   for (const std::string& rule : s.twin_qos) Add(argv, {"--qos", rule});
-  if (s.twin_max_miss_pct) Add(argv, {"--max-miss-pct", Arg(*s.twin_max_miss_pct)});
+  if (s.twin_max_miss_pct) Add(argv, {"--max-miss-pct", ExactNum(*s.twin_max_miss_pct)});
   const std::vector<std::string> twin = TwinFlags(s);
   argv.insert(argv.end(), twin.begin(), twin.end());
   return argv;
@@ -113,15 +107,6 @@ std::string OutputTail(const ScenarioFiles& files) {
   return tail.empty() ? "no output" : tail;
 }
 
-std::optional<nlohmann::json> ReadScenarioReport(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  if (!file) return std::nullopt;
-  try {
-    return nlohmann::json::parse(file);
-  } catch (const nlohmann::json::exception&) {
-    return std::nullopt;
-  }
-}
 
 }  // namespace campaign_scenario_detail
 
@@ -151,7 +136,7 @@ ScenarioResult JudgeScenario(const CampaignScenario& s, const ScenarioFiles& fil
     r.error = command + " ended with " + status.Describe() + ": " + OutputTail(files) + " (" +
               files.output().string() + ")";
   }
-  const std::optional<nlohmann::json> report = ReadScenarioReport(files.report());
+  const std::optional<nlohmann::ordered_json> report = ReadReportFile(files.report());
   if (!report) {
     if (r.error.empty()) r.error = command + " wrote no report (" + files.output().string() + ")";
   } else {

@@ -5,8 +5,6 @@
 // wire:NAME`, spidev:/dev/spidev0.0 on the robot.
 #include "hiltwin/runs/ecs_run.h"
 
-#include <array>
-#include <charconv>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -128,14 +126,9 @@ std::string ControllerLine(const Ecs& ecs) {
 /// "kp 100 duty/m, ki 1000 duty/(m s), kd 3 duty s/m, filter 0.005 s, limit 1": each number in
 /// its shortest form that reads back to the same double, so the report holds the exact gains.
 std::string DescribeGains(const PidGains& g) {
-  const auto exact = [](double value) {
-    std::array<char, 32> text{};
-    const auto end = std::to_chars(text.data(), text.data() + text.size(), value).ptr;
-    return std::string(text.data(), end);
-  };
-  return "kp " + exact(g.kp_duty_per_m) + " duty/m, ki " + exact(g.ki_duty_per_m_s) +
-         " duty/(m s), kd " + exact(g.kd_duty_s_per_m) + " duty s/m, filter " +
-         exact(g.derivative_filter_s) + " s, limit " + exact(g.duty_limit);
+  return "kp " + ExactNum(g.kp_duty_per_m) + " duty/m, ki " + ExactNum(g.ki_duty_per_m_s) +
+         " duty/(m s), kd " + ExactNum(g.kd_duty_s_per_m) + " duty s/m, filter " +
+         ExactNum(g.derivative_filter_s) + " s, limit " + ExactNum(g.duty_limit);
 }
 
 void PrintStartLines(const EcsRunOptions& o, std::uint64_t planned, const std::string& profile,

@@ -217,16 +217,6 @@ void WaitForBoth(Child& twin, Child& ecs, double duration_s, bool progress) {
   if (progress) std::fputc('\n', stderr);
 }
 
-std::optional<nlohmann::ordered_json> ReadReport(const fs::path& path) {
-  std::ifstream file(path);
-  if (!file) return std::nullopt;
-  try {
-    return nlohmann::ordered_json::parse(file);
-  } catch (const nlohmann::json::exception&) {
-    return std::nullopt;  // a side that died mid-write: said in the summary as "no report"
-  }
-}
-
 /// A side that did not pass shows its own output, so the cause is on the screen.
 void ShowOutputOf(const Child& child, const fs::path& dir) {
   const int code = ExitCodeOf(*child.status);
@@ -294,8 +284,8 @@ int RunHil(const HilRunOptions& o) {
   ShowOutputOf(ecs, dir.path());
   HilResult result =
       CombineHil(wire, o.mode,
-                 HilSide{"twin", *twin.status, ReadReport(SideFile(dir.path(), "twin", kReport))},
-                 HilSide{"ecs", *ecs.status, ReadReport(SideFile(dir.path(), "ecs", kReport))});
+                 HilSide{"twin", *twin.status, ReadReportFile(SideFile(dir.path(), "twin", kReport))},
+                 HilSide{"ecs", *ecs.status, ReadReportFile(SideFile(dir.path(), "ecs", kReport))});
   result.warnings = warnings;
   std::fputs(FormatHilSummary(result).c_str(), stdout);
   std::fflush(stdout);

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <system_error>
 #include <utility>
@@ -125,6 +126,16 @@ int ReportFile::WriteAtEnd(const std::string& text, const char* command, int exi
     return WorseExitCode(exit_code, static_cast<int>(e.code()));
   }
   return exit_code;
+}
+
+std::optional<nlohmann::ordered_json> ReadReportFile(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  if (!file) return std::nullopt;
+  try {
+    return nlohmann::ordered_json::parse(file);
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
 }
 
 WorkFolder::WorkFolder(const std::string& named_path, const std::string& flag,

@@ -4,6 +4,8 @@
 #include "hiltwin/kernel_glue/output_file.h"
 #include "hiltwin/kernel_glue/thread.h"
 
+#include <charconv>
+#include <array>
 #include <unistd.h>
 
 #include <cmath>
@@ -74,6 +76,12 @@ std::string Num(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", value);
   return text;
+}
+
+std::string ExactNum(double value) {
+  std::array<char, 32> text{};  // holds every double's shortest form
+  const auto end = std::to_chars(text.data(), text.data() + text.size(), value).ptr;
+  return {text.data(), end};
 }
 
 std::uint64_t PlannedCycles(const SessionSettings& s) {

@@ -7,6 +7,8 @@
 
 #include <span>
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -60,6 +62,10 @@ class ReportFile {
   kernel_glue::ReplacementFile file_;
   std::string flag_;
 };
+
+/// A run report another process wrote (a `hil` side's, a campaign scenario's); nullopt when
+/// there is none or it is not whole JSON (a process that died mid-write).
+[[nodiscard]] std::optional<nlohmann::ordered_json> ReadReportFile(const std::filesystem::path& path);
 
 /// The folder a command keeps its children's files in: the one the user named (made when
 /// missing; one that cannot be made is exit 2 naming `flag`), or, when none is named, a fresh

@@ -68,5 +68,8 @@ void PrintWarnings(const char* command, const std::vector<std::string>& warnings
 
 /// A number as a person writes it (4000, 0.25), for messages.
 [[nodiscard]] std::string Num(double value);
+/// A number in the shortest text that reads back as the same double (to_chars): for what is
+/// read again, a child's command line, a parameter file, a report's exact gains.
+[[nodiscard]] std::string ExactNum(double value);
 
 }  // namespace hiltwin::app
